@@ -1,0 +1,234 @@
+//! Projection: divide by w and map to sub-pixel fixed-point screen coordinates.
+//!
+//! # Bit budget
+//!
+//! For screens up to [`MAX_SCREEN`] = 2048 pixels per side and up to 8 sub-pixel bits:
+//!
+//! * Eye coordinates are I16F16 within ±2^14 units (±2^30 bits), `w >= near >= 2^-8` (2^8 bits).
+//! * The horizontal scale `ax = (W/2) · (focal/aspect) · 2^S` is held as a [`Scale`]: a 25-bit
+//!   mantissa and a right shift. `ax · x` is then below 2^55 before the shift.
+//! * The guard band keeps every projected vertex within `centre ± 4·W·2^S` (8 half-screens) in
+//!   x and `centre ± 4·H·2^S` in y, so `|X|, |Y| < 5 · 2^11 · 2^8 < 2^22` sub-pixel units.
+//!   Clipping against the guard band (see [`crate::clip`]) is what makes that true.
+//! * `X = round(C + N / w)` is computed as one i64 division: `C·w < 2^49`, `2N < 2^56`.
+//! * Depth `q = near / w` in I2F30: `near · 2^30 < 2^61`.
+
+use crate::vertex::EyePoint;
+use fixed::types::{I16F16, I2F30};
+
+/// Largest width or height of a render target, in pixels.
+pub const MAX_SCREEN: usize = 2048;
+
+/// Largest number of sub-pixel bits.
+pub const MAX_SUB_PIXEL_BITS: u32 = 8;
+
+/// Guard band half-width in units of the half-screen: vertices are kept within 8 half-screens of
+/// the screen centre.
+pub const GUARD_BAND_HALF_SCREENS: i64 = 8;
+
+/// Depth as stored in the span z-buffer: `q = near / w` in I2F30.
+///
+/// `q` is linear in screen space, so interpolating it across a triangle is perspective-correct.
+/// It is 1.0 at the near plane and `near/far` at the far plane; larger is nearer; 0 means
+/// nothing was drawn. Eye distance is `near / q`.
+pub type Depth = I2F30;
+
+/// A screen coordinate with `S` sub-pixel bits: Q(32−S).S in pixels, in an `i32`.
+///
+/// Pixel `(c, r)` has its centre at `((c + ½)·2^S, (r + ½)·2^S)`; row 0 is at the top.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct SubPx<const S: u32>(pub i32);
+
+impl<const S: u32> SubPx<S> {
+    /// The coordinate in pixels, as a float (for tests and tools).
+    pub fn to_f64(self) -> f64 {
+        self.0 as f64 / (1u64 << S) as f64
+    }
+}
+
+/// A positive scale factor `mantissa · 2^-shift` with a 25-bit mantissa (block floating point),
+/// so that a scale between 2^-40 and 2^25 keeps 24 significant bits in integer arithmetic.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Scale {
+    mantissa: i64,
+    shift: u32,
+}
+
+impl Scale {
+    /// `None` unless `0 < v < 2^25` and finite.
+    pub fn new(v: f32) -> Option<Scale> {
+        if !(v > 0.0) || !(v < (1u32 << 25) as f32) {
+            return None;
+        }
+        let mut m = v;
+        let mut shift = 0u32;
+        // Doubling an f32 is exact, so the mantissa is the float's own 24 bits.
+        while m < (1u32 << 24) as f32 && shift < 62 {
+            m *= 2.0;
+            shift += 1;
+        }
+        Some(Scale { mantissa: m as i64, shift })
+    }
+
+    /// `floor(self · v)` for `|v| <= 2^31`.
+    #[inline]
+    pub fn mul(self, v: i32) -> i64 {
+        (self.mantissa * v as i64) >> self.shift
+    }
+}
+
+/// Per-frame projection constants for a `width × height` target with `S` sub-pixel bits.
+#[derive(Clone, Copy, Debug)]
+pub struct Viewport<const S: u32> {
+    /// Width in pixels.
+    pub width: u16,
+    /// Height in pixels.
+    pub height: u16,
+    ax: Scale,
+    ay: Scale,
+    /// Near-plane distance.
+    pub near: I16F16,
+    /// Far-plane distance.
+    pub far: I16F16,
+    /// Guard band half-widths in sub-pixel units.
+    guard_x: i64,
+    guard_y: i64,
+}
+
+/// A projected vertex: snapped screen position, depth and colour attribute.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ScreenVertex<const S: u32> {
+    /// Horizontal position.
+    pub x: SubPx<S>,
+    /// Vertical position (down).
+    pub y: SubPx<S>,
+    /// Depth `near / w`.
+    pub q: Depth,
+    /// Colour channels 0–255 in I16F16 (used by Gouraud shading).
+    pub color: [I16F16; 3],
+}
+
+impl<const S: u32> Viewport<S> {
+    /// Projection for a camera with `focal = 1/tan(fovy/2)`. `None` when the size or the scale
+    /// is outside the envelope (size 1..=2048, `S <= 8`, scale below 2^25).
+    pub fn new(width: usize, height: usize, focal: f32, near: f32, far: f32) -> Option<Self> {
+        if width == 0 || height == 0 || width > MAX_SCREEN || height > MAX_SCREEN {
+            return None;
+        }
+        if S > MAX_SUB_PIXEL_BITS {
+            return None;
+        }
+        let aspect = width as f32 / height as f32;
+        let sub = (1u32 << S) as f32;
+        let ax = Scale::new(width as f32 * 0.5 * (focal / aspect) * sub)?;
+        let ay = Scale::new(height as f32 * 0.5 * focal * sub)?;
+        let near = I16F16::checked_from_num(near)?;
+        let far = I16F16::checked_from_num(far)?;
+        Some(Viewport {
+            width: width as u16,
+            height: height as u16,
+            ax,
+            ay,
+            near,
+            far,
+            guard_x: GUARD_BAND_HALF_SCREENS * (width as i64) << S >> 1,
+            guard_y: GUARD_BAND_HALF_SCREENS * (height as i64) << S >> 1,
+        })
+    }
+
+    /// The six clip distances of an eye point: `[near, far, left, right, top, bottom]`, each
+    /// `>= 0` inside. Near/far are in I16F16 bits; the guard planes in sub-pixels × w bits.
+    #[inline]
+    pub fn clip_distances(&self, p: &EyePoint) -> [i64; 6] {
+        let w = p.w.to_bits() as i64;
+        let nx = self.ax.mul(p.x.to_bits());
+        let ny = self.ay.mul(p.y.to_bits());
+        [
+            w - self.near.to_bits() as i64,
+            self.far.to_bits() as i64 - w,
+            self.guard_x * w + nx,
+            self.guard_x * w - nx,
+            self.guard_y * w - ny,
+            self.guard_y * w + ny,
+        ]
+    }
+
+    /// Projects a point that is inside all clip planes (so `w > 0`). `None` only if `w <= 0`,
+    /// which clipping rules out.
+    #[inline]
+    pub fn project(&self, p: &EyePoint, color: [I16F16; 3]) -> Option<ScreenVertex<S>> {
+        let w = p.w.to_bits() as i64;
+        if w <= 0 {
+            return None;
+        }
+        let cx = (self.width as i64) << S;
+        let cy = (self.height as i64) << S;
+        let nx = self.ax.mul(p.x.to_bits());
+        let ny = self.ay.mul(p.y.to_bits());
+        // round(c/2 + n/w) = floor((c·w + 2n + w) / 2w)
+        let x = (cx * w + 2 * nx + w).div_euclid(2 * w);
+        let y = (cy * w - 2 * ny + w).div_euclid(2 * w);
+        let q = ((self.near.to_bits() as i64) << 30) / w;
+        Some(ScreenVertex {
+            x: SubPx(x as i32),
+            y: SubPx(y as i32),
+            q: Depth::from_bits(q.min(i32::MAX as i64) as i32),
+            color,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn eye(x: f32, y: f32, w: f32) -> EyePoint {
+        EyePoint { x: I16F16::from_num(x), y: I16F16::from_num(y), w: I16F16::from_num(w) }
+    }
+
+    #[test]
+    fn centre_of_view_lands_on_screen_centre() {
+        let vp = Viewport::<4>::new(240, 160, 1.0, 0.5, 100.0).unwrap();
+        let s = vp.project(&eye(0.0, 0.0, 5.0), [I16F16::ZERO; 3]).unwrap();
+        assert_eq!((s.x.0, s.y.0), (120 * 16, 80 * 16));
+        assert_eq!(s.q, Depth::from_num(0.1));
+    }
+
+    #[test]
+    fn projection_matches_float_formula() {
+        let (w, h, focal) = (240usize, 160usize, 1.7320508f32);
+        let vp = Viewport::<4>::new(w, h, focal, 0.1, 100.0).unwrap();
+        for &(x, y, z) in &[(1.0f32, 0.5f32, 3.0f32), (-2.5, 1.25, 7.0), (0.3, -0.7, 0.2)] {
+            let s = vp.project(&eye(x, y, z), [I16F16::ZERO; 3]).unwrap();
+            let aspect = w as f64 / h as f64;
+            let px = w as f64 / 2.0 * (1.0 + focal as f64 / aspect * x as f64 / z as f64);
+            let py = h as f64 / 2.0 * (1.0 - focal as f64 * y as f64 / z as f64);
+            assert!((s.x.to_f64() - px).abs() <= 1.0 / 32.0 + 1e-3, "{} {}", s.x.to_f64(), px);
+            assert!((s.y.to_f64() - py).abs() <= 1.0 / 32.0 + 1e-3, "{} {}", s.y.to_f64(), py);
+        }
+    }
+
+    #[test]
+    fn odd_width_without_sub_pixels_rounds_the_centre() {
+        let vp = Viewport::<0>::new(5, 5, 1.0, 0.5, 100.0).unwrap();
+        let s = vp.project(&eye(0.0, 0.0, 5.0), [I16F16::ZERO; 3]).unwrap();
+        assert_eq!((s.x.0, s.y.0), (3, 3)); // 2.5 rounds half up
+    }
+
+    #[test]
+    fn invalid_viewports_are_rejected() {
+        assert!(Viewport::<4>::new(0, 10, 1.0, 0.5, 10.0).is_none());
+        assert!(Viewport::<4>::new(4096, 10, 1.0, 0.5, 10.0).is_none());
+        assert!(Viewport::<9>::new(10, 10, 1.0, 0.5, 10.0).is_none());
+        assert!(Viewport::<8>::new(2048, 2048, 1e6, 0.5, 10.0).is_none());
+    }
+
+    #[test]
+    fn scale_keeps_24_significant_bits() {
+        let s = Scale::new(3.0e-5).unwrap();
+        let v = s.mul(1 << 30) as f64;
+        assert!((v - 3.0e-5 * (1u64 << 30) as f64).abs() <= 1.0);
+        assert!(Scale::new(0.0).is_none());
+        assert!(Scale::new(f32::NAN).is_none());
+    }
+}

@@ -1,0 +1,558 @@
+//! Triangle setup and the exact scanline edge walk.
+//!
+//! # Rasterization rules
+//!
+//! * Pixel `(c, r)` is sampled at its centre `(c + ½, r + ½)`; row 0 is the top row.
+//! * Fill rule: top-left. A centre exactly on an edge is covered only if that edge is a left edge
+//!   or a horizontal top edge. In scanline terms: rows are half-open `[top, bottom)` and each
+//!   span is half-open `[left, right)`, where `left` is the first centre at or right of the left
+//!   edge and `right` the first centre at or right of the right edge.
+//! * Coverage therefore equals the exact edge-function test of the snapped vertices, ties
+//!   included: triangles sharing an edge cover every centre along it exactly once.
+//!
+//! # Exact edge walking
+//!
+//! Internally coordinates are doubled (`2^-(S+1)` pixel units) so pixel centres, at odd
+//! multiples of `2^S`, are integers even with zero sub-pixel bits. An edge is pre-stepped to the
+//! first centre row with one i64 division, then walks down one row at a time with an integer
+//! quotient and a remainder (the classic DDA of Bresenham/Pineda, exact rational arithmetic):
+//! no drift and no accumulated rounding, whatever the edge's length.
+//!
+//! # Bit budget
+//!
+//! Vertices are within ±2^22 sub-pixels ([`crate::project`]), so doubled coordinates are below
+//! 2^23 and their differences below 2^24. Prestep numerators are below 2^49 (i64); the per-row
+//! remainder is below `dy < 2^24` and `rem + step < 2^25` (i32). Attribute planes are solved in
+//! i128 once per triangle and stepped in i64 (depth) or i32 (colour).
+
+use crate::project::{Depth, ScreenVertex};
+use core::cmp::Ordering;
+use fixed::types::I16F16;
+
+/// First row (or column) whose centre lies at or after position `p` (doubled units, S bits):
+/// `ceil((p − 2^S) / 2^(S+1))`.
+#[inline]
+fn first_centre_at_or_after<const S: u32>(p_doubled: i64) -> i64 {
+    let den = 1i64 << (S + 1);
+    -((-(p_doubled - (1i64 << S))).div_euclid(den))
+}
+
+/// One edge, walked down the rows: `x` is the first column whose centre is at or right of the
+/// edge on the current row.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EdgeWalk {
+    x: i32,
+    rem: i32,
+    step: i32,
+    step_rem: i32,
+    dy: i32,
+}
+
+impl EdgeWalk {
+    /// The edge from `a` to `b` (sub-pixel `(x, y)`, `a.y < b.y`) positioned on `row`.
+    /// `None` if the edge is horizontal or upside down.
+    pub fn new<const S: u32>(a: (i32, i32), b: (i32, i32), row: i32) -> Option<EdgeWalk> {
+        let (ax, ay) = (2 * a.0 as i64, 2 * a.1 as i64);
+        let dx = 2 * (b.0 as i64 - a.0 as i64);
+        let dy = 2 * (b.1 as i64 - a.1 as i64);
+        if dy <= 0 {
+            return None;
+        }
+        let yc = (2 * row as i64 + 1) << S;
+        // Edge x at the row centre is ax + (yc − ay)·dx/dy. The first centre (2c + 1)·2^S at or
+        // right of it has c = ceil(num / den):
+        let num = (ax - (1i64 << S)) * dy + (yc - ay) * dx;
+        let den = dy << (S + 1);
+        let biased = num + den - 1;
+        let x = biased.div_euclid(den);
+        // The remainder's low S+1 bits never change while stepping (every increment is a
+        // multiple of 2^(S+1)), so only its high part, in [0, dy), is tracked.
+        let rem = biased.rem_euclid(den) >> (S + 1);
+        Some(EdgeWalk {
+            x: x as i32,
+            rem: rem as i32,
+            step: dx.div_euclid(dy) as i32,
+            step_rem: dx.rem_euclid(dy) as i32,
+            dy: dy as i32,
+        })
+    }
+
+    /// First column whose centre is at or right of the edge on the current row.
+    #[inline]
+    pub fn column(&self) -> i32 {
+        self.x
+    }
+
+    /// Moves to the next row.
+    #[inline]
+    pub fn step(&mut self) {
+        self.x = self.x.wrapping_add(self.step);
+        self.rem += self.step_rem;
+        if self.rem >= self.dy {
+            self.rem -= self.dy;
+            self.x = self.x.wrapping_add(1);
+        }
+    }
+}
+
+/// A triangle being walked row by row: a long edge on one side, two short edges on the other.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleWalk {
+    long: EdgeWalk,
+    short: EdgeWalk,
+    /// The lower short edge, set up when the walk reaches `mid_row`.
+    lower: [(i32, i32); 2],
+    row: i32,
+    mid_row: i32,
+    end_row: i32,
+    long_is_left: bool,
+}
+
+impl TriangleWalk {
+    /// Sets up the walk of the triangle `v` (sub-pixel `(x, y)`, any winding) starting at the
+    /// first row at or below `min_row`, stopping before `max_row`. `None` if it covers no row
+    /// there or has zero area.
+    pub fn new<const S: u32>(v: [(i32, i32); 3], min_row: i32, max_row: i32) -> Option<Self> {
+        let mut o = v;
+        // Sort by y (stable three-element network).
+        if o[1].1 < o[0].1 {
+            o.swap(0, 1);
+        }
+        if o[2].1 < o[1].1 {
+            o.swap(1, 2);
+        }
+        if o[1].1 < o[0].1 {
+            o.swap(0, 1);
+        }
+        let [top, mid, bottom] = o;
+        let cross = (bottom.0 as i64 - top.0 as i64) * (mid.1 as i64 - top.1 as i64)
+            - (bottom.1 as i64 - top.1 as i64) * (mid.0 as i64 - top.0 as i64);
+        let long_is_left = match cross.cmp(&0) {
+            Ordering::Less => true,
+            Ordering::Greater => false,
+            Ordering::Equal => return None,
+        };
+        let row_of = |y: i32| first_centre_at_or_after::<S>(2 * y as i64);
+        let r0 = row_of(top.1).max(min_row as i64);
+        let r1 = row_of(mid.1);
+        let r2 = row_of(bottom.1).min(max_row as i64);
+        if r0 >= r2 {
+            return None;
+        }
+        let (r0, r1, r2) = (r0 as i32, r1.clamp(i32::MIN as i64, i32::MAX as i64) as i32, r2 as i32);
+        let long = EdgeWalk::new::<S>(top, bottom, r0)?;
+        let short = if r0 < r1 {
+            EdgeWalk::new::<S>(top, mid, r0)?
+        } else {
+            EdgeWalk::new::<S>(mid, bottom, r0)?
+        };
+        Some(TriangleWalk {
+            long,
+            short,
+            lower: [mid, bottom],
+            row: r0,
+            mid_row: r1,
+            end_row: r2,
+            long_is_left,
+        })
+    }
+
+    /// The row the walk is on.
+    #[inline]
+    pub fn row(&self) -> i32 {
+        self.row
+    }
+
+    /// The current row's span `[left, right)` in columns (not clipped to the screen; may be empty).
+    #[inline]
+    pub fn span(&self) -> (i32, i32) {
+        if self.long_is_left {
+            (self.long.column(), self.short.column())
+        } else {
+            (self.short.column(), self.long.column())
+        }
+    }
+
+    /// Moves to the next row; `false` when the triangle is finished.
+    #[inline]
+    pub fn advance<const S: u32>(&mut self) -> bool {
+        self.row += 1;
+        if self.row >= self.end_row {
+            return false;
+        }
+        self.long.step();
+        if self.row == self.mid_row {
+            match EdgeWalk::new::<S>(self.lower[0], self.lower[1], self.row) {
+                Some(e) => self.short = e,
+                None => return false,
+            }
+        } else {
+            self.short.step();
+        }
+        true
+    }
+}
+
+/// Calls `f(row, x0, x1)` for every non-empty span of triangle `v` inside a `width × height`
+/// screen, top to bottom. The same walk the renderer uses, exposed for tests and tools.
+///
+/// ```
+/// use scanline3d::raster::for_each_span;
+/// // A right triangle with 4 sub-pixel bits: corners (0,0), (4,0), (0,4) in pixels.
+/// let mut spans = Vec::new();
+/// for_each_span::<4>([(0, 0), (64, 0), (0, 64)], 8, 8, |r, x0, x1| spans.push((r, x0, x1)));
+/// // The hypotenuse is a right edge: centres on it, like (3.5, 0.5), are not covered.
+/// assert_eq!(spans, [(0, 0, 3), (1, 0, 2), (2, 0, 1)]);
+/// ```
+pub fn for_each_span<const S: u32>(
+    v: [(i32, i32); 3],
+    width: i32,
+    height: i32,
+    mut f: impl FnMut(i32, i32, i32),
+) {
+    let Some(mut walk) = TriangleWalk::new::<S>(v, 0, height) else {
+        return;
+    };
+    loop {
+        let (l, r) = walk.span();
+        let (l, r) = (l.max(0), r.min(width));
+        if l < r {
+            f(walk.row(), l, r);
+        }
+        if !walk.advance::<S>() {
+            break;
+        }
+    }
+}
+
+/// An attribute plane `value + dx·(c − c_ref) + dy·(r − r_ref)` over pixel centres, with
+/// fractional bits set by the caller's format (depth: I24F40; colour: I48F16).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Plane {
+    value: i64,
+    dx: i64,
+    dy: i64,
+}
+
+/// The pixel whose centre is a triangle's plane reference point: the pixel containing vertex 0,
+/// so extrapolation distances, and with them gradient rounding errors, stay small.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelOrigin {
+    c: i32,
+    r: i32,
+}
+
+impl PixelOrigin {
+    /// Value of `plane` at pixel centre `(c, r)`, wrapping (exact when the true value fits).
+    #[inline]
+    pub fn at(&self, plane: &Plane, c: i32, r: i32) -> i64 {
+        plane
+            .value
+            .wrapping_add(plane.dx.wrapping_mul((c as i64).wrapping_sub(self.c as i64)))
+            .wrapping_add(plane.dy.wrapping_mul((r as i64).wrapping_sub(self.r as i64)))
+    }
+}
+
+/// Solves attribute planes over one triangle's snapped vertices (setup only, not stored).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PlaneSolver {
+    origin: PixelOrigin,
+    /// Doubled-unit offset from vertex 0 to the reference centre, and the two edge vectors.
+    to_ref: (i64, i64),
+    e1: (i64, i64),
+    e2: (i64, i64),
+    /// Twice the doubled-unit area, made positive (`flip` remembers the sign).
+    area: i64,
+    flip: bool,
+    sub_bits: u32,
+}
+
+impl PlaneSolver {
+    /// Geometry shared by all planes of triangle `v`; `None` for zero area.
+    pub fn new<const S: u32>(v: &[ScreenVertex<S>; 3]) -> Option<Self> {
+        let p = |s: &ScreenVertex<S>| (2 * s.x.0 as i64, 2 * s.y.0 as i64);
+        let (p0, p1, p2) = (p(&v[0]), p(&v[1]), p(&v[2]));
+        let e1 = (p1.0 - p0.0, p1.1 - p0.1);
+        let e2 = (p2.0 - p0.0, p2.1 - p0.1);
+        let area = e1.0 * e2.1 - e2.0 * e1.1;
+        if area == 0 {
+            return None;
+        }
+        let c = v[0].x.0 >> S;
+        let r = v[0].y.0 >> S;
+        let centre = |i: i32| ((2 * i as i64) + 1) << S;
+        Some(PlaneSolver {
+            origin: PixelOrigin { c, r },
+            to_ref: (centre(c) - p0.0, centre(r) - p0.1),
+            e1,
+            e2,
+            area: area.abs(),
+            flip: area < 0,
+            sub_bits: S,
+        })
+    }
+
+    /// The reference pixel of the planes this solver produces.
+    pub fn origin(&self) -> PixelOrigin {
+        self.origin
+    }
+
+    /// Solves the plane through values `f` at the three vertices (raw bits of any format below
+    /// 2^32 in magnitude), returning it with `extra` more fractional bits.
+    pub fn plane(&self, f: [i64; 3], extra: u32) -> Plane {
+        let (d1, d2) = ((f[1] - f[0]) as i128, (f[2] - f[0]) as i128);
+        // Gradient per doubled unit = num / area.
+        let mut num_x = d1 * self.e2.1 as i128 - d2 * self.e1.1 as i128;
+        let mut num_y = d2 * self.e1.0 as i128 - d1 * self.e2.0 as i128;
+        if self.flip {
+            num_x = -num_x;
+            num_y = -num_y;
+        }
+        let area = self.area as i128;
+        let div = |n: i128| (2 * n + area).div_euclid(2 * area);
+        let px = 1i128 << (self.sub_bits + 1 + extra); // doubled units per pixel, scaled
+        let value = ((f[0] as i128) << extra)
+            + div((num_x * self.to_ref.0 as i128 + num_y * self.to_ref.1 as i128) << extra);
+        let sat = |v: i128| v.clamp(i64::MIN as i128, i64::MAX as i128) as i64;
+        Plane { value: value as i64, dx: sat(div(num_x * px)), dy: sat(div(num_y * px)) }
+    }
+}
+
+/// The depth plane: `q` in I24F40 (40 fractional bits, 10 more than [`Depth`]).
+#[derive(Clone, Copy, Debug)]
+pub struct DepthPlane {
+    origin: PixelOrigin,
+    q: Plane,
+}
+
+/// Extra fractional bits of the depth plane over [`Depth`].
+const DEPTH_PLANE_EXTRA_BITS: u32 = 10;
+
+impl DepthPlane {
+    /// Depth plane of triangle `v`; `None` for zero area.
+    pub fn new<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> Self {
+        let q = solver.plane(v.each_ref().map(|s| s.q.to_bits() as i64), DEPTH_PLANE_EXTRA_BITS);
+        DepthPlane { origin: solver.origin(), q }
+    }
+
+    /// Start value and per-pixel step, in [`Depth`] bits, for the span starting at `(c, r)`.
+    ///
+    /// The start is clamped to `[0, i32::MAX]`; the step saturates at ±2^31, which only happens
+    /// for triangles too thin to hold two centres in a row, where the step is never used.
+    #[inline]
+    pub fn span_start(&self, c: i32, r: i32) -> (i32, i32) {
+        let q = self.origin.at(&self.q, c, r) >> DEPTH_PLANE_EXTRA_BITS;
+        let dq = self.q.dx >> DEPTH_PLANE_EXTRA_BITS;
+        (q.clamp(0, i32::MAX as i64) as i32, dq.clamp(i32::MIN as i64, i32::MAX as i64) as i32)
+    }
+
+    /// The reference pixel, shared with the triangle's colour planes.
+    pub fn origin(&self) -> &PixelOrigin {
+        &self.origin
+    }
+
+    /// Depth at pixel centre `(c, r)` in I2F30, unclamped (for tests).
+    pub fn depth_at(&self, c: i32, r: i32) -> Depth {
+        let q = self.origin.at(&self.q, c, r) >> DEPTH_PLANE_EXTRA_BITS;
+        Depth::from_bits(q.clamp(i32::MIN as i64, i32::MAX as i64) as i32)
+    }
+}
+
+/// Three colour-channel planes for Gouraud shading, in I16F16 (channel 0–255 plus fraction).
+#[derive(Clone, Copy, Debug)]
+pub struct ColorPlanes {
+    value: [i32; 3],
+    dx: [i32; 3],
+    dy: [i32; 3],
+}
+
+impl ColorPlanes {
+    /// Colour planes of triangle `v` over the geometry `origin`.
+    pub fn new<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> Self {
+        let mut out = ColorPlanes { value: [0; 3], dx: [0; 3], dy: [0; 3] };
+        for k in 0..3 {
+            let p = solver.plane(v.each_ref().map(|s| s.color[k].to_bits() as i64), 0);
+            // Channels are within 0..=255 (2^24 bits); a gradient that does not fit i32 belongs
+            // to a triangle too thin to hold two centres in a row, so saturation is harmless.
+            let sat = |x: i64| x.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+            out.value[k] = sat(p.value);
+            out.dx[k] = sat(p.dx);
+            out.dy[k] = sat(p.dy);
+        }
+        out
+    }
+
+    /// Channel values (I16F16 bits) at pixel centre `(c, r)` and their per-pixel steps.
+    #[inline]
+    pub fn span_start(&self, origin: &PixelOrigin, c: i32, r: i32) -> ([i32; 3], [i32; 3]) {
+        let mut v = [0i32; 3];
+        for (k, out) in v.iter_mut().enumerate() {
+            let p = Plane {
+                value: self.value[k] as i64,
+                dx: self.dx[k] as i64,
+                dy: self.dy[k] as i64,
+            };
+            *out = origin.at(&p, c, r).clamp(0, 255 << 16) as i32;
+        }
+        (v, self.dx)
+    }
+}
+
+/// Converts an I16F16 channel value to a byte, clamped.
+#[inline]
+pub fn channel(v: i32) -> u8 {
+    (v >> 16).clamp(0, 255) as u8
+}
+
+/// `I16F16` colour channels from a byte colour.
+pub fn color_channels(c: embedded_graphics::pixelcolor::Rgb888) -> [I16F16; 3] {
+    use embedded_graphics::pixelcolor::RgbColor;
+    [c.r(), c.g(), c.b()].map(I16F16::from_num)
+}
+
+/// Sub-pixel `(x, y)` of a screen vertex.
+#[inline]
+pub fn xy<const S: u32>(v: &ScreenVertex<S>) -> (i32, i32) {
+    (v.x.0, v.y.0)
+}
+
+/// Signed doubled area of a screen triangle (y down): negative for front faces (counter-clockwise
+/// in the world as seen by the camera).
+#[inline]
+pub fn signed_area<const S: u32>(v: &[ScreenVertex<S>; 3]) -> i64 {
+    let (a, b, c) = (xy(&v[0]), xy(&v[1]), xy(&v[2]));
+    (b.0 as i64 - a.0 as i64) * (c.1 as i64 - a.1 as i64)
+        - (c.0 as i64 - a.0 as i64) * (b.1 as i64 - a.1 as i64)
+}
+
+/// The first row a triangle's walk would cover on a `width × height` screen, or `None` when
+/// its bounding box holds no pixel centre of the screen (by the same half-open rules as the
+/// walk, so nothing the walk would draw is rejected). Used by bucketing.
+pub fn first_row<const S: u32>(v: &[ScreenVertex<S>; 3], width: i32, height: i32) -> Option<i32> {
+    let range = |k: fn(&ScreenVertex<S>) -> i32, limit: i32| {
+        let (lo, hi) = v.iter().map(k).fold((i32::MAX, i32::MIN), |(l, h), x| (l.min(x), h.max(x)));
+        let first = first_centre_at_or_after::<S>(2 * lo as i64).max(0);
+        let end = first_centre_at_or_after::<S>(2 * hi as i64).min(limit as i64);
+        (first < end).then_some(first as i32)
+    };
+    range(|s| s.x.0, width)?;
+    range(|s| s.y.0, height)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::vec::Vec;
+
+    /// Independent reference: exact edge functions with the top-left tie rule.
+    fn covers(v: [(i64, i64); 3], s: u32, c: i64, r: i64) -> bool {
+        let (px, py) = ((2 * c + 1) << s, (2 * r + 1) << s);
+        let v = v.map(|(x, y)| (2 * x, 2 * y));
+        let area = (v[1].0 - v[0].0) * (v[2].1 - v[0].1) - (v[2].0 - v[0].0) * (v[1].1 - v[0].1);
+        if area == 0 {
+            return false;
+        }
+        for i in 0..3 {
+            let (a, b) = if area > 0 { (v[i], v[(i + 1) % 3]) } else { (v[(i + 1) % 3], v[i]) };
+            // With area > 0 in y-down coordinates the interior is where e > 0 for edges a→b.
+            let e = (b.0 - a.0) * (py - a.1) - (b.1 - a.1) * (px - a.0);
+            if e < 0 {
+                return false;
+            }
+            if e == 0 {
+                // Top edge: horizontal with the interior below (y-down), which for e > 0 inside
+                // means b.x > a.x. Left edge: interior to its right, which means it goes up.
+                let top = a.1 == b.1 && b.0 > a.0;
+                let left = b.1 < a.1;
+                if !(top || left) {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    fn raster(v: [(i32, i32); 3], s: u32, w: i32, h: i32) -> Vec<(i32, i32)> {
+        let mut out = Vec::new();
+        let f = |r: i32, x0: i32, x1: i32| {
+            for c in x0..x1 {
+                out.push((c, r));
+            }
+        };
+        match s {
+            0 => for_each_span::<0>(v, w, h, f),
+            2 => for_each_span::<2>(v, w, h, f),
+            4 => for_each_span::<4>(v, w, h, f),
+            8 => for_each_span::<8>(v, w, h, f),
+            _ => unreachable!(),
+        }
+        out
+    }
+
+    fn reference(v: [(i32, i32); 3], s: u32, w: i32, h: i32) -> Vec<(i32, i32)> {
+        let v64 = v.map(|(x, y)| (x as i64, y as i64));
+        let mut out = Vec::new();
+        for r in 0..h {
+            for c in 0..w {
+                if covers(v64, s, c as i64, r as i64) {
+                    out.push((c, r));
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn reference_tie_rule_agrees_with_known_cases() {
+        // Square (0,0)-(2,2) pixels split on the diagonal, S = 0: vertices at pixel corners.
+        let a = [(0, 0), (2, 0), (0, 2)];
+        let b = [(2, 0), (2, 2), (0, 2)];
+        // The diagonal is a right edge of `a` and a left edge of `b`: its centres go to `b`.
+        assert_eq!(reference(a, 0, 4, 4), [(0, 0)]);
+        assert_eq!(reference(b, 0, 4, 4), [(1, 0), (0, 1), (1, 1)]);
+    }
+
+    #[test]
+    fn walk_equals_edge_functions_on_tricky_triangles() {
+        let cases: &[[(i32, i32); 3]] = &[
+            [(8, 8), (40, 8), (8, 40)],        // flat top, vertices on centres (S = 4)
+            [(8, 8), (40, 40), (8, 40)],       // flat bottom
+            [(3, -20), (90, 33), (-17, 71)],   // general, partly off-screen
+            [(24, 24), (25, 120), (26, 24)],   // sliver
+            [(0, 0), (100, 1), (200, 2)],      // collinear
+            [(56, 8), (8, 56), (104, 104)],    // edges through centres
+            [(-500, -500), (900, 10), (10, 900)],
+        ];
+        for &v in cases {
+            for s in [0u32, 2, 4, 8] {
+                let scaled = v.map(|(x, y)| (x << s >> 2, y << s >> 2));
+                assert_eq!(
+                    raster(scaled, s, 12, 12),
+                    reference(scaled, s, 12, 12),
+                    "{scaled:?} S={s}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn depth_plane_interpolates_vertex_values() {
+        use crate::project::SubPx;
+        let sv = |x: i32, y: i32, q: f32| ScreenVertex::<4> {
+            x: SubPx(x),
+            y: SubPx(y),
+            q: Depth::from_num(q),
+            color: [I16F16::ZERO; 3],
+        };
+        // Vertices on pixel centres so the plane is sampled exactly there.
+        let v = [sv(8, 8, 0.5), sv(8 + 160, 8, 0.25), sv(8, 8 + 160, 1.0)];
+        let p = DepthPlane::new(&PlaneSolver::new(&v).unwrap(), &v);
+        assert_eq!(p.depth_at(0, 0), Depth::from_num(0.5));
+        assert!((p.depth_at(10, 0).to_num::<f64>() - 0.25).abs() < 1e-8);
+        assert!((p.depth_at(0, 10).to_num::<f64>() - 1.0).abs() < 1e-8);
+        assert!((p.depth_at(5, 5).to_num::<f64>() - 0.625).abs() < 1e-8);
+        let (q, dq) = p.span_start(2, 3);
+        assert!((q as f64 / (1u64 << 30) as f64 - (0.5 - 0.05 + 0.15)).abs() < 1e-8);
+        assert!((dq as f64 / (1u64 << 30) as f64 + 0.025).abs() < 1e-8);
+    }
+}

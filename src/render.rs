@@ -1,0 +1,543 @@
+//! The frame driver: bucket triangles by first row, then walk the rows top to bottom, resolving
+//! visibility with a one-row depth buffer (the span z-buffer) and handing each finished row to
+//! the sink.
+//!
+//! # Two passes, no per-vertex memory
+//!
+//! Pass 1 transforms, clips, projects and culls every triangle just far enough to know its
+//! first row, and files its id in that row's bucket (a linked list threaded through two
+//! `u16` arrays: 4 bytes per triangle). Pass 2 walks the rows; when a row's bucket comes up,
+//! each triangle in it is transformed again and fully set up (edges, depth plane, shading) into
+//! the active list, which holds only the triangles crossing the current row. This trades a
+//! second transform for not storing transformed vertices (a 642-vertex mesh would need ~10 KiB).
+//!
+//! # Memory (all in [`Workspace`], sizes in bytes)
+//!
+//! `4·W` depth row + `size_of::<P>()·W` pixel row + `2·H` bucket heads + `4·TRIS` bucket lists +
+//! `ACTIVE · size_of` of an active triangle (about 104 for flat shading). See
+//! [`Workspace::BYTES`].
+
+use crate::clip::{clip_triangle, ClipVertex, Clipped};
+use crate::project::{Depth, ScreenVertex, Viewport};
+use crate::raster::{color_channels, first_row, signed_area, xy, DepthPlane, PlaneSolver, TriangleWalk};
+use crate::scene::{Instance, MeshColors, Scene};
+use crate::shading::{Shading, SpanDepth};
+use crate::sink::{Row, RowPixel, RowSink};
+use crate::vertex::{shade, Lighting, ModelView, TransformError};
+use embedded_graphics::pixelcolor::Rgb888;
+use fixed::types::I16F16;
+use heapless::{Vec, VecView};
+
+/// Most mesh instances in one scene.
+pub const MAX_INSTANCES: usize = 8;
+
+/// Options for one render. `SUB_BITS` is the number of sub-pixel bits vertices snap to
+/// (0 to 8; default 4, i.e. 1/16 pixel).
+///
+/// ```
+/// use scanline3d::render::RenderOptions;
+/// let default = RenderOptions::default(); // 4 sub-pixel bits, back faces culled
+/// let finer: RenderOptions<8> = default.with_sub_pixel_bits::<8>();
+/// assert!(finer.cull_back_faces);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderOptions<const SUB_BITS: u32 = 4> {
+    /// Skip triangles whose front (counter-clockwise) side faces away from the camera.
+    pub cull_back_faces: bool,
+}
+
+impl Default for RenderOptions<4> {
+    fn default() -> Self {
+        RenderOptions { cull_back_faces: true }
+    }
+}
+
+impl<const SUB_BITS: u32> RenderOptions<SUB_BITS> {
+    /// The same options with another number of sub-pixel bits.
+    pub const fn with_sub_pixel_bits<const N: u32>(self) -> RenderOptions<N> {
+        RenderOptions { cull_back_faces: self.cull_back_faces }
+    }
+}
+
+/// What one frame did. Counts are of triangles unless named otherwise.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameStats {
+    /// Triangles in the scene.
+    pub triangles_in: u32,
+    /// Back faces skipped.
+    pub culled: u32,
+    /// Triangles that crossed a clip plane and were cut.
+    pub clipped: u32,
+    /// Triangles outside the view volume or the screen, or of zero area once snapped.
+    pub rejected: u32,
+    /// Triangles filed in row buckets.
+    pub bucketed: u32,
+    /// Triangles (or clipped pieces) set up for the walk.
+    pub activated: u32,
+    /// Non-empty spans walked.
+    pub spans: u32,
+    /// Pixel centres covered by spans, before the depth test.
+    pub fragments: u32,
+    /// Pixels that passed the depth test (a pixel may be written more than once).
+    pub pixels_written: u32,
+    /// Largest number of triangles active on one row.
+    pub peak_active: u16,
+    /// Triangle pieces not drawn because the active list was full (0 in a complete frame).
+    pub dropped: u32,
+    /// First row on which a piece was dropped.
+    pub first_dropped_row: Option<u16>,
+    /// Rows handed to the sink.
+    pub rows: u16,
+}
+
+impl FrameStats {
+    /// Whether every triangle was drawn (no capacity degradation).
+    pub fn is_complete(&self) -> bool {
+        self.dropped == 0
+    }
+}
+
+/// A buffer that was too small.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CapacityKind {
+    /// `TRIS`: triangles that survive culling and clipping, filed in row buckets.
+    Triangles,
+    /// [`MAX_INSTANCES`]: mesh instances in the scene.
+    Instances,
+}
+
+/// Why a frame could not be rendered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RenderError<E> {
+    /// Target size outside 1..=2048 per side, or a projection scale outside the envelope
+    /// (for example a field of view under about 1° on a 2048-pixel target at 8 sub-pixel bits).
+    InvalidTarget,
+    /// An instance's transform is not finite or moves the mesh outside the eye envelope (±2^14).
+    Transform {
+        /// Instance index.
+        instance: usize,
+        /// What was wrong.
+        error: TransformError,
+    },
+    /// A capacity was exceeded before any row was sent (the sink received nothing).
+    Capacity {
+        /// Which buffer.
+        what: CapacityKind,
+        /// How many entries the frame needs.
+        needed: usize,
+        /// How many the buffer holds.
+        capacity: usize,
+    },
+    /// The sink failed on `row`; rows before it were delivered, none after.
+    Sink {
+        /// The row that failed.
+        row: u16,
+        /// The sink's error.
+        error: E,
+    },
+}
+
+impl<E: core::fmt::Debug> core::fmt::Display for RenderError<E> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::InvalidTarget => write!(f, "render target size or projection outside the envelope"),
+            Self::Transform { instance, error } => {
+                write!(f, "instance {instance}: transform rejected ({error:?})")
+            }
+            Self::Capacity { what, needed, capacity } => {
+                write!(f, "capacity exceeded: {what:?} needs {needed}, holds {capacity}")
+            }
+            Self::Sink { row, error } => write!(f, "sink failed on row {row}: {error:?}"),
+        }
+    }
+}
+
+/// A triangle on the active list.
+#[derive(Clone, Copy, Debug)]
+struct ActiveTri<T> {
+    walk: TriangleWalk,
+    depth: DepthPlane,
+    payload: T,
+}
+
+const NO_ENTRY: u16 = u16::MAX;
+
+/// All the memory a render needs, sized at compile time.
+///
+/// * `P`: the pixel type ([`RowPixel`]); `S`: the shading model ([`crate::Flat`] or
+///   [`crate::Gouraud`]);
+/// * `W × H`: the target size (1..=2048 each);
+/// * `TRIS`: triangles that may survive culling in one frame (≤ 65535);
+/// * `ACTIVE`: triangles that may cross one row (more are dropped and reported in
+///   [`FrameStats::dropped`]).
+///
+/// ```
+/// use embedded_graphics::pixelcolor::Rgb565;
+/// use scanline3d::{Flat, Workspace};
+/// type Ws = Workspace<Rgb565, Flat, 240, 240, 1280, 64>;
+/// assert!(Ws::BYTES < 16 * 1024);
+/// ```
+pub struct Workspace<
+    P: RowPixel,
+    S: Shading,
+    const W: usize,
+    const H: usize,
+    const TRIS: usize = 1024,
+    const ACTIVE: usize = 64,
+> {
+    depth: [Depth; W],
+    pixels: [P; W],
+    background: P,
+    heads: [u16; H],
+    next: [u16; TRIS],
+    refs: [u16; TRIS],
+    active: Vec<ActiveTri<S::Payload<P>>, ACTIVE>,
+}
+
+/// The workspace as slices, so the driver is not generic over the capacities.
+struct View<'a, P: RowPixel, S: Shading> {
+    depth: &'a mut [Depth],
+    pixels: &'a mut [P],
+    background: P,
+    heads: &'a mut [u16],
+    next: &'a mut [u16],
+    refs: &'a mut [u16],
+    active: &'a mut VecView<ActiveTri<S::Payload<P>>>,
+}
+
+impl<P: RowPixel, S: Shading, const W: usize, const H: usize, const TRIS: usize, const ACTIVE: usize>
+    Workspace<P, S, W, H, TRIS, ACTIVE>
+{
+    /// Size of this workspace in bytes.
+    pub const BYTES: usize = core::mem::size_of::<Self>();
+
+    const VALID: () = {
+        assert!(W >= 1 && W <= crate::project::MAX_SCREEN, "width must be 1..=2048");
+        assert!(H >= 1 && H <= crate::project::MAX_SCREEN, "height must be 1..=2048");
+        assert!(TRIS < NO_ENTRY as usize, "TRIS must be below 65535");
+    };
+
+    /// An empty workspace whose background pixels are `background`.
+    pub const fn new(background: P) -> Self {
+        #[allow(clippy::let_unit_value)]
+        let () = Self::VALID;
+        Workspace {
+            depth: [Depth::ZERO; W],
+            pixels: [background; W],
+            background,
+            heads: [NO_ENTRY; H],
+            next: [NO_ENTRY; TRIS],
+            refs: [0; TRIS],
+            active: Vec::new(),
+        }
+    }
+
+    /// Renders `scene`, handing each of the `H` rows to `sink` once, top to bottom.
+    ///
+    /// ```
+    /// use embedded_graphics::{mock_display::MockDisplay, pixelcolor::BinaryColor};
+    /// use fixed::types::I16F16;
+    /// use scanline3d::{scene::*, sink::DrawTargetSink, Flat, RenderOptions, Workspace};
+    ///
+    /// let v = |x: f32, y: f32| [I16F16::from_num(x), I16F16::from_num(y), I16F16::ZERO];
+    /// let verts = [v(-1.0, -1.0), v(1.0, -1.0), v(-1.0, 1.0)];
+    /// let tris = [[0u16, 1, 2]];
+    /// let mesh = Mesh::new(&verts, &tris, MeshColors::Uniform(embedded_graphics::pixelcolor::Rgb888::new(255, 255, 255)), None)?;
+    /// let instances = [Instance { mesh: &mesh, transform: Transform::IDENTITY }];
+    /// // At distance 1 with a 90° field of view the triangle's corners land on screen corners.
+    /// let camera = Camera::look_at([0.0, 0.0, 1.0], [0.0; 3], [0.0, 1.0, 0.0])?.perspective(90.0, 0.5, 10.0)?;
+    /// let scene = Scene { instances: &instances, camera, light: Light::new([0.0, 0.0, 1.0], 0.0, 1.0)? };
+    ///
+    /// let mut display = MockDisplay::<BinaryColor>::new();
+    /// let mut ws: Workspace<BinaryColor, Flat, 8, 8, 4, 4> = Workspace::new(BinaryColor::Off);
+    /// let stats = ws.render(&scene, &RenderOptions::default(), &mut DrawTargetSink::new(&mut display)).unwrap();
+    /// // The diagonal is the triangle's right edge, so centres on it are not covered.
+    /// display.assert_pattern(&[
+    ///     "........",
+    ///     "#.......",
+    ///     "##......",
+    ///     "###.....",
+    ///     "####....",
+    ///     "#####...",
+    ///     "######..",
+    ///     "#######.",
+    /// ]);
+    /// assert_eq!(stats.fragments, 28);
+    /// # Ok::<(), scanline3d::scene::SceneError>(())
+    /// ```
+    pub fn render<const SUB_BITS: u32, K: RowSink<P>>(
+        &mut self,
+        scene: &Scene<'_>,
+        options: &RenderOptions<SUB_BITS>,
+        sink: &mut K,
+    ) -> Result<FrameStats, RenderError<K::Error>> {
+        let camera = &scene.camera;
+        let vp = Viewport::<SUB_BITS>::new(W, H, camera.focal(), camera.near(), camera.far())
+            .ok_or(RenderError::InvalidTarget)?;
+        let view = View::<P, S> {
+            depth: &mut self.depth,
+            pixels: &mut self.pixels,
+            background: self.background,
+            heads: &mut self.heads,
+            next: &mut self.next,
+            refs: &mut self.refs,
+            active: self.active.as_mut_view(),
+        };
+        render_frame(view, scene, options, &vp, sink)
+    }
+}
+
+/// Per-instance constants for one frame.
+struct InstanceSetup<'a> {
+    instance: &'a Instance<'a>,
+    mv: ModelView,
+    lighting: Lighting,
+    first_id: u32,
+}
+
+fn setup_instances<'a, E>(
+    scene: &'a Scene<'a>,
+) -> Result<Vec<InstanceSetup<'a>, MAX_INSTANCES>, RenderError<E>> {
+    let mut out = Vec::new();
+    let view = &scene.camera.view().world_to_eye;
+    let mut first_id = 0u32;
+    for (i, inst) in scene.instances.iter().enumerate() {
+        let mv = ModelView::new(&inst.transform, view, inst.mesh.max_abs_bits())
+            .map_err(|error| RenderError::Transform { instance: i, error })?;
+        let lighting = Lighting::new(&scene.light, &inst.transform);
+        let setup = InstanceSetup { instance: inst, mv, lighting, first_id };
+        if out.push(setup).is_err() {
+            return Err(RenderError::Capacity {
+                what: CapacityKind::Instances,
+                needed: scene.instances.len(),
+                capacity: MAX_INSTANCES,
+            });
+        }
+        first_id += inst.mesh.triangles().len() as u32;
+    }
+    Ok(out)
+}
+
+/// How pass 1 classified a triangle.
+enum Fate {
+    Culled,
+    Rejected,
+    Visible { first_row: i32, clipped: bool },
+}
+
+impl InstanceSetup<'_> {
+    fn vertex_colors(&self, tri: usize, idx: [u16; 3]) -> [Rgb888; 3] {
+        let mesh = self.instance.mesh;
+        let pick = |i: u16| match mesh.colors() {
+            MeshColors::Uniform(c) => c,
+            MeshColors::PerFace(c) => c.get(tri).copied().unwrap_or(Rgb888::new(0, 0, 0)),
+            MeshColors::PerVertex(c) => c.get(i as usize).copied().unwrap_or(Rgb888::new(0, 0, 0)),
+        };
+        idx.map(pick)
+    }
+
+    /// The lit flat colour of triangle `tri`.
+    fn face_color(&self, tri: usize, idx: [u16; 3]) -> Rgb888 {
+        let verts = self.instance.mesh.vertices();
+        let zero = [I16F16::ZERO; 3];
+        let v = idx.map(|i| verts.get(i as usize).unwrap_or(&zero));
+        shade(self.vertex_colors(tri, idx)[0], self.lighting.face(v))
+    }
+
+    /// Transforms (and, for Gouraud, lights) the three vertices of triangle `tri`.
+    fn clip_vertices(&self, tri: usize, idx: [u16; 3], lit: bool) -> [ClipVertex; 3] {
+        let mesh = self.instance.mesh;
+        let verts = mesh.vertices();
+        let zero = [I16F16::ZERO; 3];
+        let v = idx.map(|i| verts.get(i as usize).unwrap_or(&zero));
+        let colors = if lit {
+            let base = self.vertex_colors(tri, idx);
+            let intensity = match mesh.normals() {
+                Some(n) => idx.map(|i| self.lighting.vertex(n.get(i as usize).unwrap_or(&zero))),
+                None => [self.lighting.face(v); 3],
+            };
+            [0, 1, 2].map(|k| color_channels(shade(base[k], intensity[k])))
+        } else {
+            [[I16F16::ZERO; 3]; 3]
+        };
+        [0, 1, 2].map(|k| ClipVertex { p: self.mv.apply(v[k]), color: colors[k] })
+    }
+
+    /// Clips and projects triangle `tri`, calling `f` with each visible screen triangle.
+    fn screen_triangles<const S: u32>(
+        &self,
+        tri: usize,
+        vp: &Viewport<S>,
+        cull: bool,
+        lit: bool,
+        mut f: impl FnMut([ScreenVertex<S>; 3]),
+    ) -> Fate {
+        let Some(&idx) = self.instance.mesh.triangles().get(tri) else {
+            return Fate::Rejected;
+        };
+        let cv = self.clip_vertices(tri, idx, lit);
+        let (w, h) = (vp.width as i32, vp.height as i32);
+        let mut first: Option<i32> = None;
+        let mut culled = false;
+        let mut emit = |s: [ScreenVertex<S>; 3]| {
+            let area = signed_area(&s);
+            // Front faces have negative area in y-down screen coordinates.
+            if area == 0 {
+                return;
+            }
+            if cull && area > 0 {
+                culled = true;
+                return;
+            }
+            if let Some(r) = first_row(&s, w, h) {
+                first = Some(first.map_or(r, |f| f.min(r)));
+                f(s);
+            }
+        };
+        let project = |c: &ClipVertex| vp.project(&c.p, c.color);
+        let clipped = match clip_triangle(vp, &cv) {
+            Clipped::Outside => return Fate::Rejected,
+            Clipped::Inside => {
+                if let [Some(a), Some(b), Some(c)] = cv.each_ref().map(project) {
+                    emit([a, b, c]);
+                }
+                false
+            }
+            Clipped::Polygon(poly) => {
+                let projected: Vec<ScreenVertex<S>, 9> = poly.iter().filter_map(project).collect();
+                if let Some((&a, rest)) = projected.split_first() {
+                    for pair in rest.windows(2) {
+                        if let [b, c] = pair {
+                            emit([a, *b, *c]);
+                        }
+                    }
+                }
+                true
+            }
+        };
+        match first {
+            Some(first_row) => Fate::Visible { first_row, clipped },
+            None if culled => Fate::Culled,
+            None => Fate::Rejected,
+        }
+    }
+}
+
+/// Finds the instance owning global triangle id `id`.
+fn locate<'s, 'a>(setups: &'s [InstanceSetup<'a>], id: u32) -> Option<(&'s InstanceSetup<'a>, usize)> {
+    setups.iter().rev().find(|s| s.first_id <= id).map(|s| (s, (id - s.first_id) as usize))
+}
+
+fn render_frame<P: RowPixel, S: Shading, const SUB: u32, K: RowSink<P>>(
+    ws: View<'_, P, S>,
+    scene: &Scene<'_>,
+    options: &RenderOptions<SUB>,
+    vp: &Viewport<SUB>,
+    sink: &mut K,
+) -> Result<FrameStats, RenderError<K::Error>> {
+    let setups = setup_instances(scene)?;
+    let mut stats = FrameStats::default();
+    let (width, height) = (ws.depth.len().min(ws.pixels.len()), ws.heads.len());
+    let capacity = ws.refs.len().min(ws.next.len());
+
+    // Pass 1: file every visible triangle under its first row. Iterating in reverse and pushing
+    // at the head leaves each row's list in ascending id order.
+    ws.heads.fill(NO_ENTRY);
+    let mut filed = 0usize;
+    for setup in setups.iter().rev() {
+        let n = setup.instance.mesh.triangles().len();
+        stats.triangles_in += n as u32;
+        for tri in (0..n).rev() {
+            match setup.screen_triangles(tri, vp, options.cull_back_faces, false, |_| {}) {
+                Fate::Culled => stats.culled += 1,
+                Fate::Rejected => stats.rejected += 1,
+                Fate::Visible { first_row, clipped } => {
+                    stats.clipped += clipped as u32;
+                    stats.bucketed += 1;
+                    if filed < capacity {
+                        let id = setup.first_id + tri as u32;
+                        let row = first_row as usize;
+                        if let (Some(head), Some(next), Some(r)) =
+                            (ws.heads.get_mut(row), ws.next.get_mut(filed), ws.refs.get_mut(filed))
+                        {
+                            *r = id as u16;
+                            *next = *head;
+                            *head = filed as u16;
+                        }
+                    }
+                    filed += 1;
+                }
+            }
+        }
+    }
+    if filed > capacity {
+        return Err(RenderError::Capacity {
+            what: CapacityKind::Triangles,
+            needed: filed,
+            capacity,
+        });
+    }
+
+    // Pass 2: rows top to bottom.
+    ws.active.clear();
+    for row in 0..height {
+        let y = row as i32;
+        // Activate this row's bucket.
+        let mut entry = ws.heads.get(row).copied().unwrap_or(NO_ENTRY);
+        while entry != NO_ENTRY {
+            let e = entry as usize;
+            entry = ws.next.get(e).copied().unwrap_or(NO_ENTRY);
+            let Some(&id) = ws.refs.get(e) else { continue };
+            let Some((setup, tri)) = locate(&setups, id as u32) else { continue };
+            let Some(&idx) = setup.instance.mesh.triangles().get(tri) else { continue };
+            let face = if S::PER_VERTEX { Rgb888::new(0, 0, 0) } else { setup.face_color(tri, idx) };
+            let active = &mut *ws.active;
+            setup.screen_triangles(tri, vp, options.cull_back_faces, S::PER_VERTEX, |s| {
+                let (Some(walk), Some(solver)) =
+                    (TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32), PlaneSolver::new(&s))
+                else {
+                    return;
+                };
+                let tri_state = ActiveTri {
+                    walk,
+                    depth: DepthPlane::new(&solver, &s),
+                    payload: S::payload::<P, SUB>(face, id as u32, &solver, &s),
+                };
+                if active.push(tri_state).is_ok() {
+                    stats.activated += 1;
+                } else {
+                    stats.dropped += 1;
+                    stats.first_dropped_row.get_or_insert(row as u16);
+                }
+            });
+        }
+        stats.peak_active = stats.peak_active.max(ws.active.len() as u16);
+
+        // Resolve the row.
+        ws.depth.fill(Depth::ZERO);
+        ws.pixels.fill(ws.background);
+        let (depth, pixels) = (&mut *ws.depth, &mut *ws.pixels);
+        ws.active.retain_mut(|t| {
+            if t.walk.row() > y {
+                return true; // a clipped piece that starts lower down
+            }
+            let (l, r) = t.walk.span();
+            let (l, r) = (l.max(0), r.min(width as i32));
+            if l < r {
+                let (q, dq) = t.depth.span_start(l, y);
+                let span = SpanDepth { x0: l, y, q, dq };
+                let cols = l as usize..r as usize;
+                if let (Some(d), Some(p)) = (depth.get_mut(cols.clone()), pixels.get_mut(cols)) {
+                    stats.spans += 1;
+                    stats.fragments += (r - l) as u32;
+                    stats.pixels_written += S::fill(&t.payload, t.depth.origin(), span, d, p);
+                }
+            }
+            t.walk.advance::<SUB>()
+        });
+        sink.write_row(Row { y: row as u16, pixels: ws.pixels, depth: ws.depth })
+            .map_err(|error| RenderError::Sink { row: row as u16, error })?;
+        stats.rows += 1;
+    }
+    Ok(stats)
+}

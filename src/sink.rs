@@ -1,0 +1,265 @@
+//! Output: pixel formats and row sinks.
+//!
+//! The renderer hands every finished row to a [`RowSink`] exactly once, top to bottom. Adapters:
+//! [`DrawTargetSink`] for any embedded-graphics `DrawTarget` (one `fill_contiguous` per row),
+//! [`OrderedDither`] for monochrome targets, [`FrameBuffer`] for a frame in RAM and [`FnSink`]
+//! for a closure (for example a panel driver that streams the row over SPI).
+
+use crate::project::Depth;
+use embedded_graphics::pixelcolor::{BinaryColor, Gray8, GrayColor, Rgb565, Rgb888, RgbColor};
+use embedded_graphics::prelude::{DrawTarget, Point, Size};
+use embedded_graphics::primitives::Rectangle;
+
+/// A pixel the renderer can produce from a shaded colour and the triangle id.
+///
+/// Implemented for [`Rgb565`], [`Rgb888`], [`Gray8`] (BT.601 luma), [`BinaryColor`] (luma
+/// threshold at 128; see [`OrderedDither`] for dithering) and [`TriangleId`] (an id image).
+pub trait RowPixel: Copy {
+    /// The pixel for a surface of colour `color` belonging to triangle `triangle`.
+    fn from_shade(color: Rgb888, triangle: u32) -> Self;
+}
+
+/// Luma (BT.601, integer weights summing to 256).
+#[inline]
+fn luma(c: Rgb888) -> u8 {
+    ((77 * c.r() as u32 + 150 * c.g() as u32 + 29 * c.b() as u32) >> 8) as u8
+}
+
+impl RowPixel for Rgb888 {
+    #[inline]
+    fn from_shade(color: Rgb888, _: u32) -> Self {
+        color
+    }
+}
+
+impl RowPixel for Rgb565 {
+    #[inline]
+    fn from_shade(color: Rgb888, _: u32) -> Self {
+        color.into()
+    }
+}
+
+impl RowPixel for Gray8 {
+    #[inline]
+    fn from_shade(color: Rgb888, _: u32) -> Self {
+        Gray8::new(luma(color))
+    }
+}
+
+impl RowPixel for BinaryColor {
+    #[inline]
+    fn from_shade(color: Rgb888, _: u32) -> Self {
+        if luma(color) >= 128 {
+            BinaryColor::On
+        } else {
+            BinaryColor::Off
+        }
+    }
+}
+
+/// The id of the triangle that owns a pixel: 0-based over the scene's instances in order,
+/// [`TriangleId::NONE`] (−1) for background. Render into `TriangleId` pixels to get an id image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct TriangleId(pub i32);
+
+impl TriangleId {
+    /// Background.
+    pub const NONE: TriangleId = TriangleId(-1);
+}
+
+impl RowPixel for TriangleId {
+    #[inline]
+    fn from_shade(_: Rgb888, triangle: u32) -> Self {
+        TriangleId(triangle as i32)
+    }
+}
+
+/// One finished row.
+#[derive(Clone, Copy, Debug)]
+pub struct Row<'a, P> {
+    /// Row index, 0 at the top.
+    pub y: u16,
+    /// The row's pixels, left to right (length = target width).
+    pub pixels: &'a [P],
+    /// The row's depth (`near / w`, 0 = background), same length.
+    pub depth: &'a [Depth],
+}
+
+/// Receives finished rows, each exactly once, top to bottom.
+///
+/// If `write_row` fails, rendering stops and the error is returned as
+/// [`RenderError::Sink`](crate::render::RenderError::Sink); rows after it are never sent.
+pub trait RowSink<P> {
+    /// The sink's error type.
+    type Error;
+    /// Takes one finished row.
+    fn write_row(&mut self, row: Row<'_, P>) -> Result<(), Self::Error>;
+}
+
+/// Sends each row to an embedded-graphics [`DrawTarget`] with one `fill_contiguous` call on a
+/// one-row rectangle.
+///
+/// ```
+/// use embedded_graphics::mock_display::MockDisplay;
+/// use embedded_graphics::pixelcolor::BinaryColor;
+/// use scanline3d::sink::{DrawTargetSink, Row, RowSink};
+/// let mut display = MockDisplay::<BinaryColor>::new();
+/// let mut sink = DrawTargetSink::new(&mut display);
+/// let pixels = [BinaryColor::On, BinaryColor::Off];
+/// sink.write_row(Row { y: 1, pixels: &pixels, depth: &[Default::default(); 2] }).unwrap();
+/// display.assert_pattern(&[
+///     "  ",
+///     "#.",
+/// ]);
+/// ```
+pub struct DrawTargetSink<'a, D> {
+    target: &'a mut D,
+}
+
+impl<'a, D> DrawTargetSink<'a, D> {
+    /// Wraps a draw target.
+    pub fn new(target: &'a mut D) -> Self {
+        DrawTargetSink { target }
+    }
+}
+
+fn row_rect(y: u16, width: usize) -> Rectangle {
+    Rectangle::new(Point::new(0, y as i32), Size::new(width as u32, 1))
+}
+
+impl<D: DrawTarget> RowSink<D::Color> for DrawTargetSink<'_, D> {
+    type Error = D::Error;
+    fn write_row(&mut self, row: Row<'_, D::Color>) -> Result<(), D::Error> {
+        self.target.fill_contiguous(&row_rect(row.y, row.pixels.len()), row.pixels.iter().copied())
+    }
+}
+
+/// Turns [`Gray8`] rows into [`BinaryColor`] with a 4×4 ordered (Bayer) dither, for
+/// monochrome displays. No row buffer: pixels are converted as the target consumes them.
+pub struct OrderedDither<'a, D> {
+    target: &'a mut D,
+}
+
+impl<'a, D> OrderedDither<'a, D> {
+    /// Wraps a monochrome draw target.
+    pub fn new(target: &'a mut D) -> Self {
+        OrderedDither { target }
+    }
+}
+
+/// 4×4 Bayer thresholds scaled to 0..256 (centred in each step).
+const BAYER4: [[u8; 4]; 4] =
+    [[8, 136, 40, 168], [200, 72, 232, 104], [56, 184, 24, 152], [248, 120, 216, 88]];
+
+/// Ordered-dither decision for a grey level at `(x, y)`.
+pub fn dither(level: u8, x: usize, y: u16) -> BinaryColor {
+    let t = BAYER4[(y & 3) as usize][x & 3];
+    if level >= t {
+        BinaryColor::On
+    } else {
+        BinaryColor::Off
+    }
+}
+
+impl<D: DrawTarget<Color = BinaryColor>> RowSink<Gray8> for OrderedDither<'_, D> {
+    type Error = D::Error;
+    fn write_row(&mut self, row: Row<'_, Gray8>) -> Result<(), D::Error> {
+        let y = row.y;
+        let pixels = row.pixels.iter().enumerate().map(|(x, g)| dither(g.luma(), x, y));
+        self.target.fill_contiguous(&row_rect(y, row.pixels.len()), pixels)
+    }
+}
+
+/// Errors of [`FrameBuffer`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FrameBufferError {
+    /// The row does not fit the buffer (buffer smaller than the render target).
+    OutOfBounds,
+}
+
+/// A frame in a caller-provided slice, `width` pixels per row, row-major from the top.
+///
+/// ```
+/// use embedded_graphics::pixelcolor::Gray8;
+/// use scanline3d::sink::{FrameBuffer, Row, RowSink};
+/// let mut pixels = [Gray8::new(0); 6];
+/// let mut fb = FrameBuffer::new(&mut pixels, 3);
+/// fb.write_row(Row { y: 1, pixels: &[Gray8::new(9); 3], depth: &[Default::default(); 3] }).unwrap();
+/// assert_eq!(pixels[3], Gray8::new(9));
+/// ```
+pub struct FrameBuffer<'a, P> {
+    pixels: &'a mut [P],
+    width: usize,
+}
+
+impl<'a, P> FrameBuffer<'a, P> {
+    /// Wraps `pixels` as rows of `width`.
+    pub fn new(pixels: &'a mut [P], width: usize) -> Self {
+        FrameBuffer { pixels, width }
+    }
+}
+
+impl<P: Copy> RowSink<P> for FrameBuffer<'_, P> {
+    type Error = FrameBufferError;
+    fn write_row(&mut self, row: Row<'_, P>) -> Result<(), FrameBufferError> {
+        let start = row.y as usize * self.width;
+        let n = row.pixels.len().min(self.width);
+        let dst = self.pixels.get_mut(start..start + n).ok_or(FrameBufferError::OutOfBounds)?;
+        let src = row.pixels.get(..n).ok_or(FrameBufferError::OutOfBounds)?;
+        dst.copy_from_slice(src);
+        Ok(())
+    }
+}
+
+/// A closure as a sink.
+///
+/// ```
+/// use embedded_graphics::pixelcolor::Rgb565;
+/// use scanline3d::sink::{FnSink, Row, RowSink};
+/// let mut rows = 0;
+/// let mut sink = FnSink(|row: Row<'_, Rgb565>| -> Result<(), ()> { rows += row.y as usize; Ok(()) });
+/// sink.write_row(Row { y: 2, pixels: &[], depth: &[] }).unwrap();
+/// assert_eq!(rows, 2);
+/// ```
+pub struct FnSink<F>(pub F);
+
+impl<P, E, F: FnMut(Row<'_, P>) -> Result<(), E>> RowSink<P> for FnSink<F> {
+    type Error = E;
+    fn write_row(&mut self, row: Row<'_, P>) -> Result<(), E> {
+        (self.0)(row)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pixel_conversions() {
+        let c = Rgb888::new(255, 0, 0);
+        assert_eq!(Rgb565::from_shade(c, 0), Rgb565::RED);
+        assert_eq!(Gray8::from_shade(Rgb888::WHITE, 0), Gray8::new(255));
+        assert_eq!(BinaryColor::from_shade(Rgb888::WHITE, 0), BinaryColor::On);
+        assert_eq!(BinaryColor::from_shade(Rgb888::new(60, 60, 60), 0), BinaryColor::Off);
+        assert_eq!(TriangleId::from_shade(c, 7), TriangleId(7));
+    }
+
+    #[test]
+    fn dither_density_follows_level() {
+        for level in [0u8, 64, 128, 192, 255] {
+            let on = (0..4)
+                .flat_map(|y| (0..4).map(move |x| dither(level, x, y)))
+                .filter(|c| *c == BinaryColor::On)
+                .count();
+            assert_eq!(on, (level as usize * 16 + 128) / 256, "level {level}");
+        }
+    }
+
+    #[test]
+    fn frame_buffer_rejects_rows_outside() {
+        let mut px = [0u8; 4];
+        let mut fb = FrameBuffer::new(&mut px, 2);
+        let row = Row { y: 2, pixels: &[1u8, 2], depth: &[Depth::ZERO; 2] };
+        assert_eq!(fb.write_row(row), Err(FrameBufferError::OutOfBounds));
+    }
+}

@@ -1,0 +1,261 @@
+//! Vertex stage: fixed-point model→eye transform and Lambert lighting.
+//!
+//! # Bit budget
+//!
+//! * Model vertices are I16F16 within ±2^12 ([`MAX_MODEL_COORD`]).
+//! * The model-view matrix is composed in `f32` once per frame and converted to I16F16 entries.
+//!   Before use, [`ModelView::new`] proves with integers that every transformed vertex of the mesh
+//!   satisfies `|x|, |y|, |z| <= 2^14` ([`MAX_EYE_COORD_BITS`]): `sum |m_ij| * max|v| + |t_i|`.
+//!   Each product `m_ij * v_j` is then below 2^14 in value (2^46 in I32F32 bits) and the i64 sum
+//!   cannot overflow. Eye coordinates are I16F16 with a 2× margin left for clipping.
+//! * Lighting uses I2F30 unit vectors and intensities (`1.0 = 2^30`); products of two are below
+//!   2^61 and summed three at a time in i64.
+//!
+//! [`MAX_MODEL_COORD`]: crate::scene::MAX_MODEL_COORD
+
+use crate::math::{dot_q30, normalize_i64};
+use crate::scene::{Light, Transform, Vertex};
+use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
+use fixed::types::{I16F16, I2F30};
+
+/// Largest |eye coordinate| the transform may produce, in I16F16 bits: 2^14 units.
+pub const MAX_EYE_COORD_BITS: i64 = 1 << (14 + 16);
+
+/// An eye-space point in I16F16. `w = −z_eye` is the distance in front of the camera.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EyePoint {
+    /// Right.
+    pub x: I16F16,
+    /// Up.
+    pub y: I16F16,
+    /// Forward distance (−z).
+    pub w: I16F16,
+}
+
+/// Why a per-frame transform could not be used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransformError {
+    /// A matrix entry was NaN or infinite.
+    NonFinite,
+    /// Some vertex would land beyond ±2^14 eye units.
+    OutOfEnvelope,
+}
+
+/// The model→eye transform of one instance, in I16F16, with the third row negated so that it
+/// yields `w = −z` directly.
+#[derive(Clone, Copy, Debug)]
+pub struct ModelView {
+    m: [[I16F16; 3]; 3],
+    t: [I16F16; 3],
+}
+
+impl ModelView {
+    /// Composes `view ∘ model` and converts it, checking that a mesh whose coordinates are at
+    /// most `max_abs_bits` (I16F16 bits) in magnitude stays inside the eye envelope.
+    pub fn new(
+        model: &Transform,
+        view: &Transform,
+        max_abs_bits: i32,
+    ) -> Result<Self, TransformError> {
+        if !model.is_finite() || !view.is_finite() {
+            return Err(TransformError::NonFinite);
+        }
+        let mv = view.then_after(model);
+        let mut m = [[I16F16::ZERO; 3]; 3];
+        let mut t = [I16F16::ZERO; 3];
+        for r in 0..3 {
+            let sign = if r == 2 { -1.0 } else { 1.0 };
+            let mut bound: i64 = 0;
+            for c in 0..3 {
+                let v = I16F16::checked_from_num(sign * mv.m[r][c])
+                    .ok_or(TransformError::OutOfEnvelope)?;
+                m[r][c] = v;
+                bound += (v.to_bits() as i64).abs() * max_abs_bits as i64;
+            }
+            let tv = I16F16::checked_from_num(sign * mv.m[r][3])
+                .ok_or(TransformError::OutOfEnvelope)?;
+            t[r] = tv;
+            bound += (tv.to_bits() as i64).abs() << 16;
+            if bound > MAX_EYE_COORD_BITS << 16 {
+                return Err(TransformError::OutOfEnvelope);
+            }
+        }
+        Ok(ModelView { m, t })
+    }
+
+    /// Transforms a model vertex (validated mesh, so inside the proven envelope).
+    #[inline]
+    pub fn apply(&self, v: &Vertex) -> EyePoint {
+        let row = |r: usize| {
+            let sum = self.m[r][0].to_bits() as i64 * v[0].to_bits() as i64
+                + self.m[r][1].to_bits() as i64 * v[1].to_bits() as i64
+                + self.m[r][2].to_bits() as i64 * v[2].to_bits() as i64
+                + ((self.t[r].to_bits() as i64) << 16);
+            // I32F32 -> I16F16, rounding to nearest; the envelope proof bounds the result.
+            I16F16::from_bits(((sum + (1 << 15)) >> 16) as i32)
+        };
+        EyePoint { x: row(0), y: row(1), w: row(2) }
+    }
+}
+
+/// Per-instance lighting constants: light direction and the normal transform, in I2F30.
+#[derive(Clone, Copy, Debug)]
+pub struct Lighting {
+    /// Cofactor matrix of the model's linear part, scaled so its largest entry is ±1 (I2F30
+    /// bits). It maps model-space cross products to world-space cross products exactly (up to
+    /// scale), which is what a face normal is; `flip` fixes the sign for vertex normals under
+    /// mirroring transforms.
+    normal_matrix: [[i32; 3]; 3],
+    flip: bool,
+    direction: [i32; 3],
+    ambient: I2F30,
+    diffuse: I2F30,
+}
+
+fn q30(v: f32) -> i32 {
+    I2F30::saturating_from_num(v).to_bits()
+}
+
+impl Lighting {
+    /// Lighting for one instance with the given model transform (finite, checked by the caller).
+    pub fn new(light: &Light, model: &Transform) -> Lighting {
+        let a = &model.m;
+        let cof = |r0: usize, r1: usize, c0: usize, c1: usize| {
+            a[r0][c0] * a[r1][c1] - a[r0][c1] * a[r1][c0]
+        };
+        let c = [
+            [cof(1, 2, 1, 2), -cof(1, 2, 0, 2), cof(1, 2, 0, 1)],
+            [-cof(0, 2, 1, 2), cof(0, 2, 0, 2), -cof(0, 2, 0, 1)],
+            [cof(0, 1, 1, 2), -cof(0, 1, 0, 2), cof(0, 1, 0, 1)],
+        ];
+        let det = a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
+        let max = c.iter().flatten().fold(0.0f32, |m, v| m.max(v.abs()));
+        let scale = if max > 0.0 && max.is_finite() { 1.0 / max } else { 0.0 };
+        let normal_matrix = c.map(|row| row.map(|v| q30(v * scale)));
+        Lighting {
+            normal_matrix,
+            flip: det < 0.0,
+            direction: light.direction().map(q30),
+            ambient: I2F30::saturating_from_num(light.ambient()),
+            diffuse: I2F30::saturating_from_num(light.diffuse()),
+        }
+    }
+
+    fn intensity_of_world_normal(&self, n: [i64; 3]) -> I2F30 {
+        let lambert = match normalize_i64(n) {
+            Some(unit) => dot_q30(unit, self.direction).max(0),
+            None => 0,
+        };
+        let i = self.ambient.to_bits() as i64
+            + ((self.diffuse.to_bits() as i64 * lambert as i64) >> 30);
+        I2F30::from_bits(i.clamp(0, 1 << 30) as i32)
+    }
+
+    fn to_world(&self, n: [i32; 3]) -> [i64; 3] {
+        self.normal_matrix.map(|row| (0..3).map(|k| row[k] as i64 * n[k] as i64).sum())
+    }
+
+    /// Intensity of a face with model-space vertices `v` (counter-clockwise = front).
+    pub fn face(&self, v: [&Vertex; 3]) -> I2F30 {
+        let d = |a: &Vertex, b: &Vertex, k: usize| b[k].to_bits() as i64 - a[k].to_bits() as i64;
+        let e1 = [0, 1, 2].map(|k| d(v[0], v[1], k));
+        let e2 = [0, 1, 2].map(|k| d(v[0], v[2], k));
+        // Coordinates within ±2^28 bits: edge components < 2^29, products < 2^58, sums < 2^59.
+        let n = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        match normalize_i64(n) {
+            Some(unit) => self.intensity_of_world_normal(self.to_world(unit)),
+            None => self.ambient,
+        }
+    }
+
+    /// Intensity at a vertex with model-space normal `n` (any non-zero length).
+    pub fn vertex(&self, n: &Vertex) -> I2F30 {
+        match normalize_i64(n.map(|c| c.to_bits() as i64)) {
+            Some(unit) => {
+                let w = self.to_world(unit);
+                let w = if self.flip { w.map(|c| -c) } else { w };
+                self.intensity_of_world_normal(w)
+            }
+            None => self.ambient,
+        }
+    }
+}
+
+/// `base * intensity` per channel, rounded to nearest.
+pub fn shade(base: Rgb888, intensity: I2F30) -> Rgb888 {
+    let i = intensity.to_bits() as i64;
+    let ch = |c: u8| (((c as i64 * i) + (1 << 29)) >> 30).clamp(0, 255) as u8;
+    Rgb888::new(ch(base.r()), ch(base.g()), ch(base.b()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Coord;
+
+    fn v(x: f32, y: f32, z: f32) -> Vertex {
+        [Coord::from_num(x), Coord::from_num(y), Coord::from_num(z)]
+    }
+
+    #[test]
+    fn model_view_matches_float_composition() {
+        let model = Transform::rotation_y(0.7).then_after(&Transform::scale([1.5; 3]));
+        let view = crate::scene::Camera::look_at([3.0, 2.0, 5.0], [0.0; 3], [0.0, 1.0, 0.0])
+            .unwrap()
+            .world_to_eye;
+        let p = v(0.75, -1.25, 2.0);
+        let mv = ModelView::new(&model, &view, p.iter().map(|c| c.to_bits().abs()).max().unwrap())
+            .unwrap();
+        let e = mv.apply(&p);
+        let f = view.then_after(&model).apply([0.75, -1.25, 2.0]);
+        assert!((e.x.to_num::<f32>() - f[0]).abs() < 1e-3);
+        assert!((e.y.to_num::<f32>() - f[1]).abs() < 1e-3);
+        assert!((e.w.to_num::<f32>() + f[2]).abs() < 1e-3);
+    }
+
+    #[test]
+    fn envelope_is_enforced() {
+        let big = Transform::scale([8.0; 3]);
+        let ok = ModelView::new(&big, &Transform::IDENTITY, 1000 << 16);
+        assert!(ok.is_ok());
+        let too_far = ModelView::new(&big, &Transform::IDENTITY, 4096 << 16);
+        assert_eq!(too_far.unwrap_err(), TransformError::OutOfEnvelope);
+        let nan = Transform::translation([f32::NAN, 0.0, 0.0]);
+        assert_eq!(
+            ModelView::new(&nan, &Transform::IDENTITY, 1).unwrap_err(),
+            TransformError::NonFinite
+        );
+    }
+
+    #[test]
+    fn lambert_face_lighting() {
+        let light = Light::new([0.0, 0.0, 1.0], 0.25, 0.75).unwrap();
+        let l = Lighting::new(&light, &Transform::IDENTITY);
+        let (a, b, c) = (v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0));
+        // Faces +z: full light.
+        assert_eq!(l.face([&a, &b, &c]), I2F30::from_bits(1 << 30));
+        // Faces -z: ambient only.
+        assert_eq!(l.face([&a, &c, &b]), I2F30::from_num(0.25));
+        // Rotated 60° away: 0.25 + 0.75 * 0.5.
+        let r = Lighting::new(&light, &Transform::rotation_x(core::f32::consts::FRAC_PI_3));
+        let i: f32 = r.face([&a, &b, &c]).to_num();
+        assert!((i - 0.625).abs() < 1e-5, "{i}");
+        // Mirroring z leaves this z = 0 triangle where it is (still facing +z, fully lit) but
+        // turns a +z vertex normal into -z.
+        let m = Lighting::new(&light, &Transform::scale([1.0, 1.0, -1.0]));
+        assert_eq!(m.face([&a, &b, &c]), I2F30::from_bits(1 << 30));
+        assert_eq!(m.vertex(&v(0.0, 0.0, 1.0)), I2F30::from_num(0.25));
+        assert_eq!(m.vertex(&v(0.0, 0.0, -3.0)), I2F30::from_bits(1 << 30));
+    }
+
+    #[test]
+    fn shade_scales_channels() {
+        let c = shade(Rgb888::new(200, 100, 0), I2F30::from_num(0.5));
+        assert_eq!(c, Rgb888::new(100, 50, 0));
+        assert_eq!(shade(Rgb888::new(255, 255, 255), I2F30::from_bits(1 << 30)), Rgb888::WHITE);
+    }
+}
