@@ -84,8 +84,10 @@ pub fn clip_triangle<const S: u32>(vp: &Viewport<S>, tri: &[ClipVertex; 3]) -> C
     for plane in 0..6 {
         let mut next: ClipPolygon = Vec::new();
         let n = poly.len();
-        let dist: Vec<i64, MAX_CLIPPED_VERTICES> =
-            poly.iter().map(|v| vp.clip_distances(&v.p)[plane]).collect();
+        let dist: Vec<i64, MAX_CLIPPED_VERTICES> = poly
+            .iter()
+            .map(|v| vp.clip_distances(&v.p)[plane])
+            .collect();
         if dist.iter().all(|&x| x >= 0) {
             continue;
         }
@@ -93,7 +95,10 @@ pub fn clip_triangle<const S: u32>(vp: &Viewport<S>, tri: &[ClipVertex; 3]) -> C
             let (Some(cur), Some(prev)) = (poly.get(i), poly.get((i + n - 1) % n)) else {
                 continue;
             };
-            let (dc, dp) = (dist.get(i).copied().unwrap_or(0), dist.get((i + n - 1) % n).copied().unwrap_or(0));
+            let (dc, dp) = (
+                dist.get(i).copied().unwrap_or(0),
+                dist.get((i + n - 1) % n).copied().unwrap_or(0),
+            );
             // Each plane adds at most one vertex to a convex polygon, so 9 slots suffice.
             if dp >= 0 && dc < 0 {
                 let _ = next.push(intersect(prev, dp, cur, dc));
@@ -118,7 +123,11 @@ mod tests {
 
     fn cv(x: f32, y: f32, w: f32) -> ClipVertex {
         ClipVertex {
-            p: EyePoint { x: I16F16::from_num(x), y: I16F16::from_num(y), w: I16F16::from_num(w) },
+            p: EyePoint {
+                x: I16F16::from_num(x),
+                y: I16F16::from_num(y),
+                w: I16F16::from_num(w),
+            },
             color: [I16F16::ZERO; 3],
         }
     }
@@ -132,14 +141,18 @@ mod tests {
         assert_eq!(clip_triangle(&vp, &behind), Clipped::Outside);
         // One vertex behind the eye: the near plane cuts it into a quad.
         let crossing = [cv(0.0, 0.0, -2.0), cv(1.0, 0.0, 5.0), cv(0.0, 1.0, 5.0)];
-        let Clipped::Polygon(p) = clip_triangle(&vp, &crossing) else { panic!() };
+        let Clipped::Polygon(p) = clip_triangle(&vp, &crossing) else {
+            panic!()
+        };
         assert_eq!(p.len(), 4);
         for v in &p {
             assert!(v.p.w >= I16F16::from_num(1.0) - I16F16::DELTA);
         }
         // Two vertices behind: a triangle remains.
         let two = [cv(0.0, 0.0, -2.0), cv(1.0, 0.0, -3.0), cv(0.0, 1.0, 5.0)];
-        let Clipped::Polygon(p) = clip_triangle(&vp, &two) else { panic!() };
+        let Clipped::Polygon(p) = clip_triangle(&vp, &two) else {
+            panic!()
+        };
         assert_eq!(p.len(), 3);
     }
 
@@ -155,20 +168,34 @@ mod tests {
             panic!()
         };
         let on_near = |p: &ClipPolygon| {
-            p.iter().filter(|v| v.p.w.to_bits() <= vp.near.to_bits() + 1).copied().collect::<std::vec::Vec<_>>()
+            p.iter()
+                .filter(|v| v.p.w.to_bits() <= vp.near.to_bits() + 1)
+                .copied()
+                .collect::<std::vec::Vec<_>>()
         };
-        let shared: std::vec::Vec<_> =
-            on_near(&p1).into_iter().filter(|v| on_near(&p2).contains(v)).collect();
+        let shared: std::vec::Vec<_> = on_near(&p1)
+            .into_iter()
+            .filter(|v| on_near(&p2).contains(v))
+            .collect();
         assert_eq!(shared.len(), 1, "{p1:?} {p2:?}");
     }
 
     #[test]
     fn guard_band_clips_huge_triangles() {
         let vp = Viewport::<4>::new(64, 64, 1.0, 1.0, 100.0).unwrap();
-        let huge = [cv(-4000.0, -4000.0, 10.0), cv(4000.0, -4000.0, 10.0), cv(0.0, 4000.0, 10.0)];
-        let Clipped::Polygon(p) = clip_triangle(&vp, &huge) else { panic!() };
+        let huge = [
+            cv(-4000.0, -4000.0, 10.0),
+            cv(4000.0, -4000.0, 10.0),
+            cv(0.0, 4000.0, 10.0),
+        ];
+        let Clipped::Polygon(p) = clip_triangle(&vp, &huge) else {
+            panic!()
+        };
         for v in &p {
-            assert!(vp.clip_distances(&v.p).iter().all(|&d| d >= -(1 << 40) / (1 << 20)));
+            assert!(vp
+                .clip_distances(&v.p)
+                .iter()
+                .all(|&d| d >= -(1 << 40) / (1 << 20)));
             let s = vp.project(&v.p, v.color).unwrap();
             assert!(s.x.0.abs() < 1 << 22 && s.y.0.abs() < 1 << 22);
         }

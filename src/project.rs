@@ -67,7 +67,10 @@ impl Scale {
             m *= 2.0;
             shift += 1;
         }
-        Some(Scale { mantissa: m as i64, shift })
+        Some(Scale {
+            mantissa: m as i64,
+            shift,
+        })
     }
 
     /// `floor(self · v)` for `|v| <= 2^31`.
@@ -183,7 +186,11 @@ mod tests {
     use super::*;
 
     fn eye(x: f32, y: f32, w: f32) -> EyePoint {
-        EyePoint { x: I16F16::from_num(x), y: I16F16::from_num(y), w: I16F16::from_num(w) }
+        EyePoint {
+            x: I16F16::from_num(x),
+            y: I16F16::from_num(y),
+            w: I16F16::from_num(w),
+        }
     }
 
     #[test]
@@ -198,13 +205,27 @@ mod tests {
     fn projection_matches_float_formula() {
         let (w, h, focal) = (240usize, 160usize, 1.7320508f32);
         let vp = Viewport::<4>::new(w, h, focal, 0.1, 100.0).unwrap();
-        for &(x, y, z) in &[(1.0f32, 0.5f32, 3.0f32), (-2.5, 1.25, 7.0), (0.3, -0.7, 0.2)] {
+        for &(x, y, z) in &[
+            (1.0f32, 0.5f32, 3.0f32),
+            (-2.5, 1.25, 7.0),
+            (0.3, -0.7, 0.2),
+        ] {
             let s = vp.project(&eye(x, y, z), [I16F16::ZERO; 3]).unwrap();
             let aspect = w as f64 / h as f64;
             let px = w as f64 / 2.0 * (1.0 + focal as f64 / aspect * x as f64 / z as f64);
             let py = h as f64 / 2.0 * (1.0 - focal as f64 * y as f64 / z as f64);
-            assert!((s.x.to_f64() - px).abs() <= 1.0 / 32.0 + 1e-3, "{} {}", s.x.to_f64(), px);
-            assert!((s.y.to_f64() - py).abs() <= 1.0 / 32.0 + 1e-3, "{} {}", s.y.to_f64(), py);
+            assert!(
+                (s.x.to_f64() - px).abs() <= 1.0 / 32.0 + 1e-3,
+                "{} {}",
+                s.x.to_f64(),
+                px
+            );
+            assert!(
+                (s.y.to_f64() - py).abs() <= 1.0 / 32.0 + 1e-3,
+                "{} {}",
+                s.y.to_f64(),
+                py
+            );
         }
     }
 

@@ -139,7 +139,11 @@ impl TriangleWalk {
         if r0 >= r2 {
             return None;
         }
-        let (r0, r1, r2) = (r0 as i32, r1.clamp(i32::MIN as i64, i32::MAX as i64) as i32, r2 as i32);
+        let (r0, r1, r2) = (
+            r0 as i32,
+            r1.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
+            r2 as i32,
+        );
         let long = EdgeWalk::new::<S>(top, bottom, r0)?;
         let short = if r0 < r1 {
             EdgeWalk::new::<S>(top, mid, r0)?
@@ -248,8 +252,16 @@ impl PixelOrigin {
     pub fn at(&self, plane: &Plane, c: i32, r: i32) -> i64 {
         plane
             .value
-            .wrapping_add(plane.dx.wrapping_mul((c as i64).wrapping_sub(self.c as i64)))
-            .wrapping_add(plane.dy.wrapping_mul((r as i64).wrapping_sub(self.r as i64)))
+            .wrapping_add(
+                plane
+                    .dx
+                    .wrapping_mul((c as i64).wrapping_sub(self.c as i64)),
+            )
+            .wrapping_add(
+                plane
+                    .dy
+                    .wrapping_mul((r as i64).wrapping_sub(self.r as i64)),
+            )
     }
 }
 
@@ -314,7 +326,11 @@ impl PlaneSolver {
         let value = ((f[0] as i128) << extra)
             + div((num_x * self.to_ref.0 as i128 + num_y * self.to_ref.1 as i128) << extra);
         let sat = |v: i128| v.clamp(i64::MIN as i128, i64::MAX as i128) as i64;
-        Plane { value: value as i64, dx: sat(div(num_x * px)), dy: sat(div(num_y * px)) }
+        Plane {
+            value: value as i64,
+            dx: sat(div(num_x * px)),
+            dy: sat(div(num_y * px)),
+        }
     }
 }
 
@@ -331,8 +347,14 @@ const DEPTH_PLANE_EXTRA_BITS: u32 = 10;
 impl DepthPlane {
     /// Depth plane of triangle `v`; `None` for zero area.
     pub fn new<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> Self {
-        let q = solver.plane(v.each_ref().map(|s| s.q.to_bits() as i64), DEPTH_PLANE_EXTRA_BITS);
-        DepthPlane { origin: solver.origin(), q }
+        let q = solver.plane(
+            v.each_ref().map(|s| s.q.to_bits() as i64),
+            DEPTH_PLANE_EXTRA_BITS,
+        );
+        DepthPlane {
+            origin: solver.origin(),
+            q,
+        }
     }
 
     /// Start value and per-pixel step, in [`Depth`] bits, for the span starting at `(c, r)`.
@@ -343,7 +365,10 @@ impl DepthPlane {
     pub fn span_start(&self, c: i32, r: i32) -> (i32, i32) {
         let q = self.origin.at(&self.q, c, r) >> DEPTH_PLANE_EXTRA_BITS;
         let dq = self.q.dx >> DEPTH_PLANE_EXTRA_BITS;
-        (q.clamp(0, i32::MAX as i64) as i32, dq.clamp(i32::MIN as i64, i32::MAX as i64) as i32)
+        (
+            q.clamp(0, i32::MAX as i64) as i32,
+            dq.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
+        )
     }
 
     /// The reference pixel, shared with the triangle's colour planes.
@@ -369,7 +394,11 @@ pub struct ColorPlanes {
 impl ColorPlanes {
     /// Colour planes of triangle `v` over the geometry `origin`.
     pub fn new<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> Self {
-        let mut out = ColorPlanes { value: [0; 3], dx: [0; 3], dy: [0; 3] };
+        let mut out = ColorPlanes {
+            value: [0; 3],
+            dx: [0; 3],
+            dy: [0; 3],
+        };
         for k in 0..3 {
             let p = solver.plane(v.each_ref().map(|s| s.color[k].to_bits() as i64), 0);
             // Channels are within 0..=255 (2^24 bits); a gradient that does not fit i32 belongs
@@ -430,7 +459,10 @@ pub fn signed_area<const S: u32>(v: &[ScreenVertex<S>; 3]) -> i64 {
 /// walk, so nothing the walk would draw is rejected). Used by bucketing.
 pub fn first_row<const S: u32>(v: &[ScreenVertex<S>; 3], width: i32, height: i32) -> Option<i32> {
     let range = |k: fn(&ScreenVertex<S>) -> i32, limit: i32| {
-        let (lo, hi) = v.iter().map(k).fold((i32::MAX, i32::MIN), |(l, h), x| (l.min(x), h.max(x)));
+        let (lo, hi) = v
+            .iter()
+            .map(k)
+            .fold((i32::MAX, i32::MIN), |(l, h), x| (l.min(x), h.max(x)));
         let first = first_centre_at_or_after::<S>(2 * lo as i64).max(0);
         let end = first_centre_at_or_after::<S>(2 * hi as i64).min(limit as i64);
         (first < end).then_some(first as i32)
@@ -453,7 +485,11 @@ mod tests {
             return false;
         }
         for i in 0..3 {
-            let (a, b) = if area > 0 { (v[i], v[(i + 1) % 3]) } else { (v[(i + 1) % 3], v[i]) };
+            let (a, b) = if area > 0 {
+                (v[i], v[(i + 1) % 3])
+            } else {
+                (v[(i + 1) % 3], v[i])
+            };
             // With area > 0 in y-down coordinates the interior is where e > 0 for edges a→b.
             let e = (b.0 - a.0) * (py - a.1) - (b.1 - a.1) * (px - a.0);
             if e < 0 {
@@ -515,12 +551,12 @@ mod tests {
     #[test]
     fn walk_equals_edge_functions_on_tricky_triangles() {
         let cases: &[[(i32, i32); 3]] = &[
-            [(8, 8), (40, 8), (8, 40)],        // flat top, vertices on centres (S = 4)
-            [(8, 8), (40, 40), (8, 40)],       // flat bottom
-            [(3, -20), (90, 33), (-17, 71)],   // general, partly off-screen
-            [(24, 24), (25, 120), (26, 24)],   // sliver
-            [(0, 0), (100, 1), (200, 2)],      // collinear
-            [(56, 8), (8, 56), (104, 104)],    // edges through centres
+            [(8, 8), (40, 8), (8, 40)],      // flat top, vertices on centres (S = 4)
+            [(8, 8), (40, 40), (8, 40)],     // flat bottom
+            [(3, -20), (90, 33), (-17, 71)], // general, partly off-screen
+            [(24, 24), (25, 120), (26, 24)], // sliver
+            [(0, 0), (100, 1), (200, 2)],    // collinear
+            [(56, 8), (8, 56), (104, 104)],  // edges through centres
             [(-500, -500), (900, 10), (10, 900)],
         ];
         for &v in cases {

@@ -19,7 +19,9 @@
 
 use crate::clip::{clip_triangle, ClipVertex, Clipped};
 use crate::project::{Depth, ScreenVertex, Viewport};
-use crate::raster::{color_channels, first_row, signed_area, xy, DepthPlane, PlaneSolver, TriangleWalk};
+use crate::raster::{
+    color_channels, first_row, signed_area, xy, DepthPlane, PlaneSolver, TriangleWalk,
+};
 use crate::scene::{Instance, MeshColors, Scene};
 use crate::shading::{Shading, SpanDepth};
 use crate::sink::{Row, RowPixel, RowSink};
@@ -39,6 +41,8 @@ pub const MAX_INSTANCES: usize = 8;
 /// let default = RenderOptions::default(); // 4 sub-pixel bits, back faces culled
 /// let finer: RenderOptions<8> = default.with_sub_pixel_bits::<8>();
 /// assert!(finer.cull_back_faces);
+/// let both_sides = RenderOptions::default().with_back_face_culling(false);
+/// assert!(!both_sides.cull_back_faces);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RenderOptions<const SUB_BITS: u32 = 4> {
@@ -48,14 +52,26 @@ pub struct RenderOptions<const SUB_BITS: u32 = 4> {
 
 impl Default for RenderOptions<4> {
     fn default() -> Self {
-        RenderOptions { cull_back_faces: true }
+        RenderOptions {
+            cull_back_faces: true,
+        }
     }
 }
 
 impl<const SUB_BITS: u32> RenderOptions<SUB_BITS> {
+    /// The same options with back-face culling on or off. (Prefer this to a struct literal,
+    /// which cannot infer the default `SUB_BITS`.)
+    pub const fn with_back_face_culling(self, on: bool) -> Self {
+        RenderOptions {
+            cull_back_faces: on,
+        }
+    }
+
     /// The same options with another number of sub-pixel bits.
     pub const fn with_sub_pixel_bits<const N: u32>(self) -> RenderOptions<N> {
-        RenderOptions { cull_back_faces: self.cull_back_faces }
+        RenderOptions {
+            cull_back_faces: self.cull_back_faces,
+        }
     }
 }
 
@@ -140,12 +156,21 @@ pub enum RenderError<E> {
 impl<E: core::fmt::Debug> core::fmt::Display for RenderError<E> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
-            Self::InvalidTarget => write!(f, "render target size or projection outside the envelope"),
+            Self::InvalidTarget => {
+                write!(f, "render target size or projection outside the envelope")
+            }
             Self::Transform { instance, error } => {
                 write!(f, "instance {instance}: transform rejected ({error:?})")
             }
-            Self::Capacity { what, needed, capacity } => {
-                write!(f, "capacity exceeded: {what:?} needs {needed}, holds {capacity}")
+            Self::Capacity {
+                what,
+                needed,
+                capacity,
+            } => {
+                write!(
+                    f,
+                    "capacity exceeded: {what:?} needs {needed}, holds {capacity}"
+                )
             }
             Self::Sink { row, error } => write!(f, "sink failed on row {row}: {error:?}"),
         }
@@ -205,15 +230,27 @@ struct View<'a, P: RowPixel, S: Shading> {
     active: &'a mut VecView<ActiveTri<S::Payload<P>>>,
 }
 
-impl<P: RowPixel, S: Shading, const W: usize, const H: usize, const TRIS: usize, const ACTIVE: usize>
-    Workspace<P, S, W, H, TRIS, ACTIVE>
+impl<
+        P: RowPixel,
+        S: Shading,
+        const W: usize,
+        const H: usize,
+        const TRIS: usize,
+        const ACTIVE: usize,
+    > Workspace<P, S, W, H, TRIS, ACTIVE>
 {
     /// Size of this workspace in bytes.
     pub const BYTES: usize = core::mem::size_of::<Self>();
 
     const VALID: () = {
-        assert!(W >= 1 && W <= crate::project::MAX_SCREEN, "width must be 1..=2048");
-        assert!(H >= 1 && H <= crate::project::MAX_SCREEN, "height must be 1..=2048");
+        assert!(
+            W >= 1 && W <= crate::project::MAX_SCREEN,
+            "width must be 1..=2048"
+        );
+        assert!(
+            H >= 1 && H <= crate::project::MAX_SCREEN,
+            "height must be 1..=2048"
+        );
         assert!(TRIS < NO_ENTRY as usize, "TRIS must be below 65535");
     };
 
@@ -305,7 +342,12 @@ fn setup_instances<'a, E>(
         let mv = ModelView::new(&inst.transform, view, inst.mesh.max_abs_bits())
             .map_err(|error| RenderError::Transform { instance: i, error })?;
         let lighting = Lighting::new(&scene.light, &inst.transform);
-        let setup = InstanceSetup { instance: inst, mv, lighting, first_id };
+        let setup = InstanceSetup {
+            instance: inst,
+            mv,
+            lighting,
+            first_id,
+        };
         if out.push(setup).is_err() {
             return Err(RenderError::Capacity {
                 what: CapacityKind::Instances,
@@ -360,7 +402,10 @@ impl InstanceSetup<'_> {
         } else {
             [[I16F16::ZERO; 3]; 3]
         };
-        [0, 1, 2].map(|k| ClipVertex { p: self.mv.apply(v[k]), color: colors[k] })
+        [0, 1, 2].map(|k| ClipVertex {
+            p: self.mv.apply(v[k]),
+            color: colors[k],
+        })
     }
 
     /// Clips and projects triangle `tri`, calling `f` with each visible screen triangle.
@@ -424,8 +469,15 @@ impl InstanceSetup<'_> {
 }
 
 /// Finds the instance owning global triangle id `id`.
-fn locate<'s, 'a>(setups: &'s [InstanceSetup<'a>], id: u32) -> Option<(&'s InstanceSetup<'a>, usize)> {
-    setups.iter().rev().find(|s| s.first_id <= id).map(|s| (s, (id - s.first_id) as usize))
+fn locate<'s, 'a>(
+    setups: &'s [InstanceSetup<'a>],
+    id: u32,
+) -> Option<(&'s InstanceSetup<'a>, usize)> {
+    setups
+        .iter()
+        .rev()
+        .find(|s| s.first_id <= id)
+        .map(|s| (s, (id - s.first_id) as usize))
 }
 
 fn render_frame<P: RowPixel, S: Shading, const SUB: u32, K: RowSink<P>>(
@@ -457,9 +509,11 @@ fn render_frame<P: RowPixel, S: Shading, const SUB: u32, K: RowSink<P>>(
                     if filed < capacity {
                         let id = setup.first_id + tri as u32;
                         let row = first_row as usize;
-                        if let (Some(head), Some(next), Some(r)) =
-                            (ws.heads.get_mut(row), ws.next.get_mut(filed), ws.refs.get_mut(filed))
-                        {
+                        if let (Some(head), Some(next), Some(r)) = (
+                            ws.heads.get_mut(row),
+                            ws.next.get_mut(filed),
+                            ws.refs.get_mut(filed),
+                        ) {
                             *r = id as u16;
                             *next = *head;
                             *head = filed as u16;
@@ -488,14 +542,23 @@ fn render_frame<P: RowPixel, S: Shading, const SUB: u32, K: RowSink<P>>(
             let e = entry as usize;
             entry = ws.next.get(e).copied().unwrap_or(NO_ENTRY);
             let Some(&id) = ws.refs.get(e) else { continue };
-            let Some((setup, tri)) = locate(&setups, id as u32) else { continue };
-            let Some(&idx) = setup.instance.mesh.triangles().get(tri) else { continue };
-            let face = if S::PER_VERTEX { Rgb888::new(0, 0, 0) } else { setup.face_color(tri, idx) };
+            let Some((setup, tri)) = locate(&setups, id as u32) else {
+                continue;
+            };
+            let Some(&idx) = setup.instance.mesh.triangles().get(tri) else {
+                continue;
+            };
+            let face = if S::PER_VERTEX {
+                Rgb888::new(0, 0, 0)
+            } else {
+                setup.face_color(tri, idx)
+            };
             let active = &mut *ws.active;
             setup.screen_triangles(tri, vp, options.cull_back_faces, S::PER_VERTEX, |s| {
-                let (Some(walk), Some(solver)) =
-                    (TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32), PlaneSolver::new(&s))
-                else {
+                let (Some(walk), Some(solver)) = (
+                    TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32),
+                    PlaneSolver::new(&s),
+                ) else {
                     return;
                 };
                 let tri_state = ActiveTri {
@@ -535,8 +598,15 @@ fn render_frame<P: RowPixel, S: Shading, const SUB: u32, K: RowSink<P>>(
             }
             t.walk.advance::<SUB>()
         });
-        sink.write_row(Row { y: row as u16, pixels: ws.pixels, depth: ws.depth })
-            .map_err(|error| RenderError::Sink { row: row as u16, error })?;
+        sink.write_row(Row {
+            y: row as u16,
+            pixels: ws.pixels,
+            depth: ws.depth,
+        })
+        .map_err(|error| RenderError::Sink {
+            row: row as u16,
+            error,
+        })?;
         stats.rows += 1;
     }
     Ok(stats)

@@ -234,7 +234,13 @@ impl<'a> Mesh<'a> {
                 });
             }
         }
-        Ok(Mesh { vertices, triangles, colors, normals, max_abs })
+        Ok(Mesh {
+            vertices,
+            triangles,
+            colors,
+            normals,
+            max_abs,
+        })
     }
 
     /// The vertices.
@@ -276,17 +282,34 @@ impl Default for Transform {
 
 impl Transform {
     /// The identity.
-    pub const IDENTITY: Transform =
-        Transform { m: [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]] };
+    pub const IDENTITY: Transform = Transform {
+        m: [
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+        ],
+    };
 
     /// Translation by `t`.
     pub const fn translation(t: [f32; 3]) -> Self {
-        Transform { m: [[1.0, 0.0, 0.0, t[0]], [0.0, 1.0, 0.0, t[1]], [0.0, 0.0, 1.0, t[2]]] }
+        Transform {
+            m: [
+                [1.0, 0.0, 0.0, t[0]],
+                [0.0, 1.0, 0.0, t[1]],
+                [0.0, 0.0, 1.0, t[2]],
+            ],
+        }
     }
 
     /// Scaling by `s` along each axis.
     pub const fn scale(s: [f32; 3]) -> Self {
-        Transform { m: [[s[0], 0.0, 0.0, 0.0], [0.0, s[1], 0.0, 0.0], [0.0, 0.0, s[2], 0.0]] }
+        Transform {
+            m: [
+                [s[0], 0.0, 0.0, 0.0],
+                [0.0, s[1], 0.0, 0.0],
+                [0.0, 0.0, s[2], 0.0],
+            ],
+        }
     }
 
     /// Rotation by `angle` radians about the x axis (right-handed), with [`Libm`].
@@ -304,17 +327,23 @@ impl Transform {
     /// [`Transform::rotation_x`] with a chosen math backend.
     pub fn rotation_x_with<M: MathBackend>(angle: f32) -> Self {
         let (s, c) = (M::sin(angle), M::cos(angle));
-        Transform { m: [[1.0, 0.0, 0.0, 0.0], [0.0, c, -s, 0.0], [0.0, s, c, 0.0]] }
+        Transform {
+            m: [[1.0, 0.0, 0.0, 0.0], [0.0, c, -s, 0.0], [0.0, s, c, 0.0]],
+        }
     }
     /// [`Transform::rotation_y`] with a chosen math backend.
     pub fn rotation_y_with<M: MathBackend>(angle: f32) -> Self {
         let (s, c) = (M::sin(angle), M::cos(angle));
-        Transform { m: [[c, 0.0, s, 0.0], [0.0, 1.0, 0.0, 0.0], [-s, 0.0, c, 0.0]] }
+        Transform {
+            m: [[c, 0.0, s, 0.0], [0.0, 1.0, 0.0, 0.0], [-s, 0.0, c, 0.0]],
+        }
     }
     /// [`Transform::rotation_z`] with a chosen math backend.
     pub fn rotation_z_with<M: MathBackend>(angle: f32) -> Self {
         let (s, c) = (M::sin(angle), M::cos(angle));
-        Transform { m: [[c, -s, 0.0, 0.0], [s, c, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]] }
+        Transform {
+            m: [[c, -s, 0.0, 0.0], [s, c, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]],
+        }
     }
 
     /// `self ∘ inner`: applies `inner` first, then `self`.
@@ -358,7 +387,11 @@ fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
 }
 
 fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
@@ -397,7 +430,11 @@ impl View {
         near: f32,
         far: f32,
     ) -> Result<Camera, SceneError> {
-        for (v, what) in [(fovy_degrees, "field of view"), (near, "near"), (far, "far")] {
+        for (v, what) in [
+            (fovy_degrees, "field of view"),
+            (near, "near"),
+            (far, "far"),
+        ] {
             if !v.is_finite() {
                 return Err(SceneError::NonFinite { what });
             }
@@ -415,7 +452,12 @@ impl View {
         if !(tan_half > 0.0) || !tan_half.is_finite() {
             return Err(SceneError::FieldOfView);
         }
-        Ok(Camera { view: self, focal: 1.0 / tan_half, near, far })
+        Ok(Camera {
+            view: self,
+            focal: 1.0 / tan_half,
+            near,
+            far,
+        })
     }
 }
 
@@ -466,7 +508,9 @@ impl Camera {
         let back = [-forward[0], -forward[1], -forward[2]];
         let row = |a: [f32; 3]| [a[0], a[1], a[2], -dot(a, eye)];
         Ok(View {
-            world_to_eye: Transform { m: [row(side), row(true_up), row(back)] },
+            world_to_eye: Transform {
+                m: [row(side), row(true_up), row(back)],
+            },
             eye,
         })
     }
@@ -504,13 +548,19 @@ impl Light {
     pub fn new(towards_light: [f32; 3], ambient: f32, diffuse: f32) -> Result<Self, SceneError> {
         let d = finite3(towards_light, "light direction")?;
         if !ambient.is_finite() || !diffuse.is_finite() {
-            return Err(SceneError::NonFinite { what: "light intensity" });
+            return Err(SceneError::NonFinite {
+                what: "light intensity",
+            });
         }
         if !(0.0..=1.0).contains(&ambient) || !(0.0..=1.0).contains(&diffuse) {
             return Err(SceneError::Light);
         }
         let direction = normalize::<Libm>(d).ok_or(SceneError::Light)?;
-        Ok(Light { direction, ambient, diffuse })
+        Ok(Light {
+            direction,
+            ambient,
+            diffuse,
+        })
     }
     /// Unit vector towards the light.
     pub fn direction(&self) -> [f32; 3] {
@@ -550,7 +600,10 @@ pub struct Scene<'a> {
 impl Scene<'_> {
     /// Total number of triangles over all instances.
     pub fn triangle_count(&self) -> usize {
-        self.instances.iter().map(|i| i.mesh.triangles().len()).sum()
+        self.instances
+            .iter()
+            .map(|i| i.mesh.triangles().len())
+            .sum()
     }
 }
 
@@ -573,7 +626,10 @@ mod tests {
     #[test]
     fn degenerate_cameras_are_rejected() {
         let up = [0.0, 1.0, 0.0];
-        assert_eq!(Camera::look_at([0.0; 3], [0.0; 3], up), Err(SceneError::EyeEqualsTarget));
+        assert_eq!(
+            Camera::look_at([0.0; 3], [0.0; 3], up),
+            Err(SceneError::EyeEqualsTarget)
+        );
         assert_eq!(
             Camera::look_at([0.0; 3], [0.0, 5.0, 0.0], up),
             Err(SceneError::DegenerateUp)
@@ -588,10 +644,16 @@ mod tests {
         );
         let v = Camera::look_at([0.0; 3], [0.0, 0.0, -1.0], up).unwrap();
         assert_eq!(v.perspective(0.0, 0.1, 10.0), Err(SceneError::FieldOfView));
-        assert_eq!(v.perspective(180.0, 0.1, 10.0), Err(SceneError::FieldOfView));
+        assert_eq!(
+            v.perspective(180.0, 0.1, 10.0),
+            Err(SceneError::FieldOfView)
+        );
         assert_eq!(v.perspective(60.0, 0.0, 10.0), Err(SceneError::DepthRange));
         assert_eq!(v.perspective(60.0, 1.0, 1.0), Err(SceneError::DepthRange));
-        assert_eq!(v.perspective(60.0, 0.01, 16000.0), Err(SceneError::DepthRange));
+        assert_eq!(
+            v.perspective(60.0, 0.01, 16000.0),
+            Err(SceneError::DepthRange)
+        );
         assert!(v.perspective(60.0, 0.1, 100.0).is_ok());
     }
 
@@ -604,7 +666,11 @@ mod tests {
         assert!(Mesh::new(&verts, &[[0, 1, 2]], c, None).is_ok());
         assert_eq!(
             Mesh::new(&verts, &[[0, 1, 3]], c, None).unwrap_err(),
-            SceneError::IndexOutOfRange { triangle: 0, index: 3, vertex_count: 3 }
+            SceneError::IndexOutOfRange {
+                triangle: 0,
+                index: 3,
+                vertex_count: 3
+            }
         );
         assert_eq!(
             Mesh::new(&far, &[[0, 1, 2]], c, None).unwrap_err(),
@@ -613,11 +679,18 @@ mod tests {
         let faces = [Rgb888::new(0, 0, 0); 2];
         assert!(matches!(
             Mesh::new(&verts, &[[0, 1, 2]], MeshColors::PerFace(&faces), None),
-            Err(SceneError::CountMismatch { expected: 1, found: 2, .. })
+            Err(SceneError::CountMismatch {
+                expected: 1,
+                found: 2,
+                ..
+            })
         ));
         assert!(matches!(
             Mesh::new(&verts, &[[0, 1, 2]], c, Some(&verts[..2])),
-            Err(SceneError::CountMismatch { what: "normals", .. })
+            Err(SceneError::CountMismatch {
+                what: "normals",
+                ..
+            })
         ));
     }
 
@@ -626,7 +699,10 @@ mod tests {
         let l = Light::new([0.0, 3.0, 4.0], 0.2, 0.8).unwrap();
         assert!((l.direction()[1] - 0.6).abs() < 1e-6);
         assert_eq!(Light::new([0.0; 3], 0.2, 0.8), Err(SceneError::Light));
-        assert_eq!(Light::new([0.0, 1.0, 0.0], 1.5, 0.8), Err(SceneError::Light));
+        assert_eq!(
+            Light::new([0.0, 1.0, 0.0], 1.5, 0.8),
+            Err(SceneError::Light)
+        );
     }
 
     #[test]

@@ -122,7 +122,10 @@ impl Shading for Gouraud {
         solver: &PlaneSolver,
         v: &[ScreenVertex<S>; 3],
     ) -> GouraudPayload {
-        GouraudPayload { planes: ColorPlanes::new(solver, v), id }
+        GouraudPayload {
+            planes: ColorPlanes::new(solver, v),
+            id,
+        }
     }
 
     #[inline]

@@ -130,7 +130,10 @@ fn row_rect(y: u16, width: usize) -> Rectangle {
 impl<D: DrawTarget> RowSink<D::Color> for DrawTargetSink<'_, D> {
     type Error = D::Error;
     fn write_row(&mut self, row: Row<'_, D::Color>) -> Result<(), D::Error> {
-        self.target.fill_contiguous(&row_rect(row.y, row.pixels.len()), row.pixels.iter().copied())
+        self.target.fill_contiguous(
+            &row_rect(row.y, row.pixels.len()),
+            row.pixels.iter().copied(),
+        )
     }
 }
 
@@ -148,8 +151,12 @@ impl<'a, D> OrderedDither<'a, D> {
 }
 
 /// 4×4 Bayer thresholds scaled to 0..256 (centred in each step).
-const BAYER4: [[u8; 4]; 4] =
-    [[8, 136, 40, 168], [200, 72, 232, 104], [56, 184, 24, 152], [248, 120, 216, 88]];
+const BAYER4: [[u8; 4]; 4] = [
+    [8, 136, 40, 168],
+    [200, 72, 232, 104],
+    [56, 184, 24, 152],
+    [248, 120, 216, 88],
+];
 
 /// Ordered-dither decision for a grey level at `(x, y)`.
 pub fn dither(level: u8, x: usize, y: u16) -> BinaryColor {
@@ -165,8 +172,13 @@ impl<D: DrawTarget<Color = BinaryColor>> RowSink<Gray8> for OrderedDither<'_, D>
     type Error = D::Error;
     fn write_row(&mut self, row: Row<'_, Gray8>) -> Result<(), D::Error> {
         let y = row.y;
-        let pixels = row.pixels.iter().enumerate().map(|(x, g)| dither(g.luma(), x, y));
-        self.target.fill_contiguous(&row_rect(y, row.pixels.len()), pixels)
+        let pixels = row
+            .pixels
+            .iter()
+            .enumerate()
+            .map(|(x, g)| dither(g.luma(), x, y));
+        self.target
+            .fill_contiguous(&row_rect(y, row.pixels.len()), pixels)
     }
 }
 
@@ -204,7 +216,10 @@ impl<P: Copy> RowSink<P> for FrameBuffer<'_, P> {
     fn write_row(&mut self, row: Row<'_, P>) -> Result<(), FrameBufferError> {
         let start = row.y as usize * self.width;
         let n = row.pixels.len().min(self.width);
-        let dst = self.pixels.get_mut(start..start + n).ok_or(FrameBufferError::OutOfBounds)?;
+        let dst = self
+            .pixels
+            .get_mut(start..start + n)
+            .ok_or(FrameBufferError::OutOfBounds)?;
         let src = row.pixels.get(..n).ok_or(FrameBufferError::OutOfBounds)?;
         dst.copy_from_slice(src);
         Ok(())
@@ -240,7 +255,10 @@ mod tests {
         assert_eq!(Rgb565::from_shade(c, 0), Rgb565::RED);
         assert_eq!(Gray8::from_shade(Rgb888::WHITE, 0), Gray8::new(255));
         assert_eq!(BinaryColor::from_shade(Rgb888::WHITE, 0), BinaryColor::On);
-        assert_eq!(BinaryColor::from_shade(Rgb888::new(60, 60, 60), 0), BinaryColor::Off);
+        assert_eq!(
+            BinaryColor::from_shade(Rgb888::new(60, 60, 60), 0),
+            BinaryColor::Off
+        );
         assert_eq!(TriangleId::from_shade(c, 7), TriangleId(7));
     }
 
@@ -259,7 +277,11 @@ mod tests {
     fn frame_buffer_rejects_rows_outside() {
         let mut px = [0u8; 4];
         let mut fb = FrameBuffer::new(&mut px, 2);
-        let row = Row { y: 2, pixels: &[1u8, 2], depth: &[Depth::ZERO; 2] };
+        let row = Row {
+            y: 2,
+            pixels: &[1u8, 2],
+            depth: &[Depth::ZERO; 2],
+        };
         assert_eq!(fb.write_row(row), Err(FrameBufferError::OutOfBounds));
     }
 }

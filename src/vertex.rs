@@ -72,8 +72,8 @@ impl ModelView {
                 m[r][c] = v;
                 bound += (v.to_bits() as i64).abs() * max_abs_bits as i64;
             }
-            let tv = I16F16::checked_from_num(sign * mv.m[r][3])
-                .ok_or(TransformError::OutOfEnvelope)?;
+            let tv =
+                I16F16::checked_from_num(sign * mv.m[r][3]).ok_or(TransformError::OutOfEnvelope)?;
             t[r] = tv;
             bound += (tv.to_bits() as i64).abs() << 16;
             if bound > MAX_EYE_COORD_BITS << 16 {
@@ -94,7 +94,11 @@ impl ModelView {
             // I32F32 -> I16F16, rounding to nearest; the envelope proof bounds the result.
             I16F16::from_bits(((sum + (1 << 15)) >> 16) as i32)
         };
-        EyePoint { x: row(0), y: row(1), w: row(2) }
+        EyePoint {
+            x: row(0),
+            y: row(1),
+            w: row(2),
+        }
     }
 }
 
@@ -130,7 +134,11 @@ impl Lighting {
         ];
         let det = a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
         let max = c.iter().flatten().fold(0.0f32, |m, v| m.max(v.abs()));
-        let scale = if max > 0.0 && max.is_finite() { 1.0 / max } else { 0.0 };
+        let scale = if max > 0.0 && max.is_finite() {
+            1.0 / max
+        } else {
+            0.0
+        };
         let normal_matrix = c.map(|row| row.map(|v| q30(v * scale)));
         Lighting {
             normal_matrix,
@@ -152,7 +160,8 @@ impl Lighting {
     }
 
     fn to_world(&self, n: [i32; 3]) -> [i64; 3] {
-        self.normal_matrix.map(|row| (0..3).map(|k| row[k] as i64 * n[k] as i64).sum())
+        self.normal_matrix
+            .map(|row| (0..3).map(|k| row[k] as i64 * n[k] as i64).sum())
     }
 
     /// Intensity of a face with model-space vertices `v` (counter-clockwise = front).
@@ -208,8 +217,12 @@ mod tests {
             .unwrap()
             .world_to_eye;
         let p = v(0.75, -1.25, 2.0);
-        let mv = ModelView::new(&model, &view, p.iter().map(|c| c.to_bits().abs()).max().unwrap())
-            .unwrap();
+        let mv = ModelView::new(
+            &model,
+            &view,
+            p.iter().map(|c| c.to_bits().abs()).max().unwrap(),
+        )
+        .unwrap();
         let e = mv.apply(&p);
         let f = view.then_after(&model).apply([0.75, -1.25, 2.0]);
         assert!((e.x.to_num::<f32>() - f[0]).abs() < 1e-3);
@@ -256,6 +269,9 @@ mod tests {
     fn shade_scales_channels() {
         let c = shade(Rgb888::new(200, 100, 0), I2F30::from_num(0.5));
         assert_eq!(c, Rgb888::new(100, 50, 0));
-        assert_eq!(shade(Rgb888::new(255, 255, 255), I2F30::from_bits(1 << 30)), Rgb888::WHITE);
+        assert_eq!(
+            shade(Rgb888::new(255, 255, 255), I2F30::from_bits(1 << 30)),
+            Rgb888::WHITE
+        );
     }
 }

@@ -1,0 +1,529 @@
+//! End-to-end renders compared with the independent f64 ray caster in `common`, plus memory,
+//! error and degradation behaviour.
+
+mod common;
+
+use common::*;
+use embedded_graphics::pixelcolor::{Rgb565, Rgb888, RgbColor};
+use scanline3d::render::CapacityKind;
+use scanline3d::scene::{Instance, Mesh, MeshColors, Scene, Transform};
+use scanline3d::sink::{FnSink, Row, TriangleId};
+use scanline3d::{Flat, Gouraud, RenderError, RenderOptions, Workspace};
+
+/// Position error bound of the renderer in pixels for `s` sub-pixel bits: snapping moves a
+/// vertex by at most 2^-(s+1) px in each axis; the I16F16 eye transform adds under 2^-10 px for
+/// these scenes (2^-17 units at under 2^6 px per unit). An edge is a convex combination of its
+/// vertices, so it moves no more than they do.
+fn position_bound(s: u32) -> f64 {
+    std::f64::consts::SQRT_2 * 0.5f64.powi(s as i32 + 1) + 2f64.powi(-10)
+}
+
+/// Ray-casts at one sub-pixel position.
+fn cast_at(
+    tris: &[[[f64; 3]; 3]],
+    cam: &CameraSpec,
+    w: usize,
+    h: usize,
+    x: f64,
+    y: f64,
+    cull: bool,
+) -> i32 {
+    cast(tris, cam, w, h, x, y, cull).map_or(-1, |hit| hit.id)
+}
+
+/// Compares renderer ids with the ray caster. A mismatch is *explained* when the reference
+/// answer changes within the position bound of the centre (sampled on a ring of 8 points at
+/// 1.1 × the bound, which covers every direction of a straight edge); otherwise it is *real*.
+/// Returns (mismatches, real mismatches).
+fn compare(
+    data: &[&MeshData],
+    cam: &CameraSpec,
+    ids: &[i32],
+    w: usize,
+    h: usize,
+    s: u32,
+    cull: bool,
+) -> (usize, usize) {
+    let tris: Vec<[[f64; 3]; 3]> = data
+        .iter()
+        .flat_map(|d| (0..d.triangles.len()).map(|t| d.world_triangle(t)))
+        .collect();
+    let reference = raycast(&tris, cam, w, h, cull);
+    let r = 1.1 * position_bound(s);
+    let (mut mismatches, mut real) = (0, 0);
+    for (i, hit) in reference.iter().enumerate() {
+        let want = hit.map_or(-1, |h| h.id);
+        if ids[i] == want {
+            continue;
+        }
+        mismatches += 1;
+        let (cx, cy) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+        let explained = (0..8).any(|k| {
+            let a = k as f64 * std::f64::consts::FRAC_PI_4;
+            cast_at(&tris, cam, w, h, cx + r * a.cos(), cy + r * a.sin(), cull) == ids[i]
+        });
+        if !explained {
+            real += 1;
+            eprintln!(
+                "real mismatch at ({}, {}): renderer {} reference {}",
+                i % w,
+                i / w,
+                ids[i],
+                want
+            );
+        }
+    }
+    (mismatches, real)
+}
+
+#[test]
+fn interpenetrating_triangles_resolve_per_pixel() {
+    // Two triangles crossing each other along x = 0: each is in front on one side.
+    let verts = [
+        [-1.5, -1.0, -0.8],
+        [1.5, -1.0, 0.8],
+        [0.0, 1.2, 0.0],
+        [-1.5, 1.0, 0.8],
+        [0.0, -1.2, 0.0],
+        [1.5, 1.0, -0.8],
+    ];
+    let data = MeshData::from_f64(&verts, &[[0, 1, 2], [3, 4, 5]]);
+    let mesh = data.mesh();
+    let cam = CameraSpec {
+        eye: [0.3, 0.2, 4.0],
+        target: [0.0; 3],
+        up: [0.0, 1.0, 0.0],
+        fovy: 50.0,
+        near: 0.5,
+        far: 20.0,
+    };
+    let (ids, _) = render_ids::<64, 64, 4>(&[instance(&mesh)], &cam, false);
+    let (mismatches, real) = compare(&[&data], &cam, &ids, 64, 64, 4, false);
+    assert_eq!(real, 0, "{mismatches} mismatches");
+    // Both triangles win somewhere on both sides of the intersection line.
+    for id in [0, 1] {
+        let left = (0..64 * 64)
+            .filter(|&i| ids[i] == id && i % 64 < 28)
+            .count();
+        let right = (0..64 * 64)
+            .filter(|&i| ids[i] == id && i % 64 > 36)
+            .count();
+        assert!(
+            left > 50 && right > 50,
+            "triangle {id}: {left} left, {right} right"
+        );
+    }
+}
+
+/// A ground quad under a camera standing on it: some triangles have one or two vertices behind
+/// the eye and must be clipped at the near plane, not vanish or explode.
+#[test]
+fn near_plane_crossing_triangles_render() {
+    let verts = [
+        [-20.0, 0.0, 20.0],
+        [20.0, 0.0, 20.0],
+        [20.0, 0.0, -20.0],
+        [-20.0, 0.0, -20.0],
+        [0.0, 0.0, 1.0],
+    ];
+    // A fan around a vertex just in front of the camera's feet.
+    let tris = [[4, 0, 1], [4, 1, 2], [4, 2, 3], [4, 3, 0]];
+    let data = MeshData::from_f64(&verts, &tris);
+    let mesh = data.mesh();
+    let cam = CameraSpec {
+        eye: [0.0, 1.0, 2.0],
+        target: [0.0, 0.0, -3.0],
+        up: [0.0, 1.0, 0.0],
+        fovy: 70.0,
+        near: 0.2,
+        far: 60.0,
+    };
+    let (ids, stats) = render_ids::<64, 48, 4>(&[instance(&mesh)], &cam, true);
+    assert!(stats.clipped >= 2, "{stats:?}");
+    let (mismatches, real) = compare(&[&data], &cam, &ids, 64, 48, 4, true);
+    assert_eq!(real, 0, "{mismatches} mismatches");
+    assert!(ids.iter().filter(|&&i| i >= 0).count() > 64 * 20);
+    // One vertex behind the eye and two behind the eye, on a single triangle each.
+    for (tri, name) in [
+        (
+            [[-1.0, -0.5, 1.0], [1.0, -0.5, -3.0], [0.0, 1.0, -3.0]],
+            "one",
+        ),
+        (
+            [[-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [0.0, 1.0, -3.0]],
+            "two",
+        ),
+    ] {
+        let data = MeshData::from_f64(&tri, &[[0, 1, 2]]);
+        let mesh = data.mesh();
+        let cam = CameraSpec {
+            eye: [0.0, 0.0, 0.0],
+            target: [0.0, 0.0, -1.0],
+            up: [0.0, 1.0, 0.0],
+            fovy: 90.0,
+            near: 0.1,
+            far: 10.0,
+        };
+        let (ids, stats) = render_ids::<48, 48, 4>(&[instance(&mesh)], &cam, false);
+        assert_eq!(stats.clipped, 1, "{name}");
+        let (mismatches, real) = compare(&[&data], &cam, &ids, 48, 48, 4, false);
+        assert_eq!(real, 0, "{name}: {mismatches} mismatches");
+        assert!(ids.iter().filter(|&&i| i == 0).count() > 100, "{name}");
+    }
+}
+
+#[test]
+fn icosphere_matches_reference_at_several_sub_pixel_settings() {
+    let sphere = icosphere(2, 1.0);
+    let mesh = sphere.mesh();
+    let cam = CameraSpec {
+        eye: [1.2, 0.9, 2.6],
+        target: [0.0; 3],
+        up: [0.0, 1.0, 0.0],
+        fovy: 55.0,
+        near: 0.5,
+        far: 10.0,
+    };
+    let inst = [instance(&mesh)];
+    let (ids, _) = render_ids::<64, 64, 2>(&inst, &cam, true);
+    assert_eq!(compare(&[&sphere], &cam, &ids, 64, 64, 2, true).1, 0);
+    let (ids, _) = render_ids::<64, 64, 4>(&inst, &cam, true);
+    assert_eq!(compare(&[&sphere], &cam, &ids, 64, 64, 4, true).1, 0);
+    let (ids, _) = render_ids::<64, 64, 8>(&inst, &cam, true);
+    assert_eq!(compare(&[&sphere], &cam, &ids, 64, 64, 8, true).1, 0);
+}
+
+/// The RAM budget of issue 2: a 240×240 frame of a 1280-triangle, 642-vertex icosphere in at
+/// most 16 KiB of renderer memory (mesh data excluded):
+///   depth row 4·240 = 960, Rgb565 row 2·240 = 480, background 2, bucket heads 2·240 = 480,
+///   bucket lists 4·1280 = 5120, active list 64 × size_of(active triangle) + length.
+#[test]
+fn icosphere_frame_fits_16_kib() {
+    type Ws = Workspace<Rgb565, Flat, 240, 240, 1280, 64>;
+    let fixed_part = 960 + 480 + 480 + 5120;
+    println!(
+        "workspace {} bytes, active triangle ~{} bytes",
+        Ws::BYTES,
+        (Ws::BYTES - fixed_part) / 64
+    );
+    assert!(Ws::BYTES <= 16 * 1024, "{} bytes", Ws::BYTES);
+    assert_eq!(std::mem::size_of::<Ws>(), Ws::BYTES);
+
+    let sphere = icosphere(3, 1.0);
+    assert_eq!((sphere.vertices.len(), sphere.triangles.len()), (642, 1280));
+    let mesh = sphere.mesh();
+    let instances = [instance(&mesh)];
+    let cam = CameraSpec {
+        eye: [0.0, 0.5, 2.6],
+        target: [0.0; 3],
+        up: [0.0, 1.0, 0.0],
+        fovy: 60.0,
+        near: 0.5,
+        far: 10.0,
+    };
+    let scene = Scene {
+        instances: &instances,
+        camera: cam.camera(),
+        light: light(),
+    };
+    let mut ws = Box::new(Ws::new(Rgb565::BLACK));
+    let mut rows = 0;
+    let stats = ws
+        .render(
+            &scene,
+            &RenderOptions::default(),
+            &mut FnSink(|_: Row<'_, Rgb565>| -> Result<(), ()> {
+                rows += 1;
+                Ok(())
+            }),
+        )
+        .unwrap();
+    println!("{stats:?}");
+    assert!(stats.is_complete());
+    assert_eq!(rows, 240);
+    assert_eq!(stats.triangles_in, 1280);
+    assert!(stats.culled > 500 && stats.peak_active <= 64);
+}
+
+fn one_triangle() -> MeshData {
+    MeshData::from_f64(
+        &[[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]],
+        &[[0, 1, 2]],
+    )
+}
+
+fn front_camera() -> CameraSpec {
+    CameraSpec {
+        eye: [0.0, 0.0, 3.0],
+        target: [0.0; 3],
+        up: [0.0, 1.0, 0.0],
+        fovy: 60.0,
+        near: 0.5,
+        far: 10.0,
+    }
+}
+
+#[test]
+fn sink_error_stops_the_frame_at_that_row() {
+    let data = one_triangle();
+    let mesh = data.mesh();
+    let instances = [instance(&mesh)];
+    let scene = Scene {
+        instances: &instances,
+        camera: front_camera().camera(),
+        light: light(),
+    };
+    let mut ws: Workspace<Rgb565, Flat, 16, 16, 4, 4> = Workspace::new(Rgb565::BLACK);
+    let mut seen = Vec::new();
+    let mut sink = FnSink(|row: Row<'_, Rgb565>| {
+        seen.push(row.y);
+        if row.y == 5 {
+            Err("bus error")
+        } else {
+            Ok(())
+        }
+    });
+    let err = ws
+        .render(&scene, &RenderOptions::default(), &mut sink)
+        .unwrap_err();
+    assert_eq!(
+        err,
+        RenderError::Sink {
+            row: 5,
+            error: "bus error"
+        }
+    );
+    assert_eq!(seen, [0, 1, 2, 3, 4, 5]);
+}
+
+#[test]
+fn too_many_triangles_fails_before_any_row() {
+    let sphere = icosphere(1, 1.0);
+    let mesh = sphere.mesh();
+    let instances = [instance(&mesh)];
+    let scene = Scene {
+        instances: &instances,
+        camera: front_camera().camera(),
+        light: light(),
+    };
+    let mut ws: Workspace<Rgb565, Flat, 32, 32, 8, 8> = Workspace::new(Rgb565::BLACK);
+    let mut rows = 0;
+    let err = ws
+        .render(
+            &scene,
+            &RenderOptions::default(),
+            &mut FnSink(|_: Row<'_, Rgb565>| -> Result<(), ()> {
+                rows += 1;
+                Ok(())
+            }),
+        )
+        .unwrap_err();
+    let RenderError::Capacity {
+        what: CapacityKind::Triangles,
+        needed,
+        capacity: 8,
+    } = err
+    else {
+        panic!("{err:?}")
+    };
+    assert!(needed > 8 && needed < 80, "{needed}");
+    assert_eq!(rows, 0);
+}
+
+#[test]
+fn full_active_list_degrades_deterministically_and_reports() {
+    let sphere = icosphere(2, 1.0);
+    let mesh = sphere.mesh();
+    let instances = [instance(&mesh)];
+    let scene = Scene {
+        instances: &instances,
+        camera: front_camera().camera(),
+        light: light(),
+    };
+    let render = || {
+        let mut ws: Box<Workspace<TriangleId, Flat, 64, 64, 512, 6>> =
+            Box::new(Workspace::new(TriangleId::NONE));
+        let mut ids = Vec::new();
+        let stats = ws
+            .render(
+                &scene,
+                &RenderOptions::default(),
+                &mut FnSink(|row: Row<'_, TriangleId>| -> Result<(), ()> {
+                    ids.extend(row.pixels.iter().map(|p| p.0));
+                    Ok(())
+                }),
+            )
+            .unwrap();
+        (ids, stats)
+    };
+    let (a, sa) = render();
+    let (b, sb) = render();
+    assert!(!sa.is_complete() && sa.dropped > 0 && sa.first_dropped_row.is_some());
+    assert_eq!(sa.rows, 64);
+    assert_eq!((a, sa), (b, sb));
+}
+
+#[test]
+fn gouraud_interpolates_vertex_colours() {
+    let verts = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]].map(vert);
+    let tris = [[0u16, 1, 2]];
+    let colors = [Rgb888::RED, Rgb888::GREEN, Rgb888::BLUE];
+    let mesh = Mesh::new(&verts, &tris, MeshColors::PerVertex(&colors), None).unwrap();
+    let instances = [instance(&mesh)];
+    let light = scanline3d::scene::Light::new([0.0, 0.0, 1.0], 1.0, 0.0).unwrap();
+    let cam = CameraSpec {
+        eye: [0.0, 0.0, 2.0],
+        ..front_camera()
+    };
+    let scene = Scene {
+        instances: &instances,
+        camera: cam.camera(),
+        light,
+    };
+    let mut ws: Box<Workspace<Rgb888, Gouraud, 33, 33, 4, 4>> =
+        Box::new(Workspace::new(Rgb888::BLACK));
+    let mut px = vec![Rgb888::BLACK; 33 * 33];
+    ws.render(
+        &scene,
+        &RenderOptions::default(),
+        &mut FnSink(|row: Row<'_, Rgb888>| -> Result<(), ()> {
+            px[row.y as usize * 33..][..33].copy_from_slice(row.pixels);
+            Ok(())
+        }),
+    )
+    .unwrap();
+    // The triangle is parallel to the screen, so screen-linear colour is exact barycentric
+    // interpolation. Check every covered pixel against the f64 barycentric colour.
+    let p = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]]
+        .map(|v| project(&cam, 33, 33, v).unwrap());
+    let mut checked = 0;
+    for (i, c) in px.iter().enumerate() {
+        if *c == Rgb888::BLACK {
+            continue;
+        }
+        let (x, y) = ((i % 33) as f64 + 0.5, (i / 33) as f64 + 0.5);
+        let d =
+            (p[1][1] - p[2][1]) * (p[0][0] - p[2][0]) + (p[2][0] - p[1][0]) * (p[0][1] - p[2][1]);
+        let l0 = ((p[1][1] - p[2][1]) * (x - p[2][0]) + (p[2][0] - p[1][0]) * (y - p[2][1])) / d;
+        let l1 = ((p[2][1] - p[0][1]) * (x - p[2][0]) + (p[0][0] - p[2][0]) * (y - p[2][1])) / d;
+        let l2 = 1.0 - l0 - l1;
+        for (got, want) in [(c.r(), l0), (c.g(), l1), (c.b(), l2)] {
+            assert!(
+                (got as f64 - 255.0 * want).abs() <= 1.5,
+                "pixel {i}: {c:?} vs {l0} {l1} {l2}"
+            );
+        }
+        checked += 1;
+    }
+    assert!(checked > 200);
+}
+
+#[test]
+fn instances_number_triangles_consecutively() {
+    let data = one_triangle();
+    let mesh = data.mesh();
+    let instances = [
+        Instance {
+            mesh: &mesh,
+            transform: Transform::translation([-1.2, 0.0, 0.0]),
+        },
+        Instance {
+            mesh: &mesh,
+            transform: Transform::translation([1.2, 0.0, 0.0])
+                .then_after(&Transform::scale([0.5; 3])),
+        },
+    ];
+    let (ids, stats) = render_ids::<48, 32, 4>(&instances, &front_camera(), true);
+    assert_eq!(stats.triangles_in, 2);
+    assert!(
+        ids[16 * 48 + 10] == 0 && ids[16 * 48 + 37] == 1,
+        "{} {}",
+        ids[16 * 48 + 10],
+        ids[16 * 48 + 37]
+    );
+}
+
+#[test]
+fn bad_transforms_are_reported() {
+    let data = one_triangle();
+    let mesh = data.mesh();
+    let scene_with = |t: Transform| {
+        let instances = [Instance {
+            mesh: &mesh,
+            transform: t,
+        }];
+        let scene = Scene {
+            instances: &instances,
+            camera: front_camera().camera(),
+            light: light(),
+        };
+        let mut ws: Workspace<Rgb565, Flat, 8, 8, 4, 4> = Workspace::new(Rgb565::BLACK);
+        ws.render(
+            &scene,
+            &RenderOptions::default(),
+            &mut FnSink(|_: Row<'_, Rgb565>| -> Result<(), ()> { panic!("no row expected") }),
+        )
+        .map(|_| ())
+    };
+    use scanline3d::vertex::TransformError;
+    assert_eq!(
+        scene_with(Transform::translation([f32::NAN, 0.0, 0.0])),
+        Err(RenderError::Transform {
+            instance: 0,
+            error: TransformError::NonFinite
+        })
+    );
+    assert_eq!(
+        scene_with(Transform::translation([1e6, 0.0, 0.0])),
+        Err(RenderError::Transform {
+            instance: 0,
+            error: TransformError::OutOfEnvelope
+        })
+    );
+}
+
+#[test]
+fn micromath_backend_renders_nearly_the_same_image() {
+    use scanline3d::math::Micromath;
+    use scanline3d::scene::Camera;
+    let sphere = icosphere(2, 1.0);
+    let mesh = sphere.mesh();
+    let instances = [instance(&mesh)];
+    let render = |camera: Camera| {
+        let scene = Scene {
+            instances: &instances,
+            camera,
+            light: light(),
+        };
+        let mut ws: Box<Workspace<TriangleId, Flat, 64, 64, 512, 64>> =
+            Box::new(Workspace::new(TriangleId::NONE));
+        let mut ids = Vec::new();
+        ws.render(
+            &scene,
+            &RenderOptions::default(),
+            &mut FnSink(|row: Row<'_, TriangleId>| -> Result<(), ()> {
+                ids.extend(row.pixels.iter().map(|p| p.0));
+                Ok(())
+            }),
+        )
+        .unwrap();
+        ids
+    };
+    let (eye, up) = ([1.0f32, 0.8, 2.7], [0.0f32, 1.0, 0.0]);
+    let libm = render(
+        Camera::look_at(eye, [0.0; 3], up)
+            .unwrap()
+            .perspective(55.0, 0.5, 10.0)
+            .unwrap(),
+    );
+    let micro = render(
+        Camera::look_at_with::<Micromath>(eye, [0.0; 3], up)
+            .unwrap()
+            .perspective_with::<Micromath>(55.0, 0.5, 10.0)
+            .unwrap(),
+    );
+    let differ = libm.iter().zip(&micro).filter(|(a, b)| a != b).count();
+    println!("micromath vs libm: {differ} of 4096 pixels differ");
+    assert!(differ > 0, "the backends are expected to differ slightly");
+    assert!(differ < 4096 / 20, "{differ}");
+}
