@@ -30,6 +30,8 @@ pub const MAX_CLIPPED_VERTICES: usize = 9;
 pub type ClipPolygon = Vec<ClipVertex, MAX_CLIPPED_VERTICES>;
 
 /// What clipping did to a triangle.
+// The polygon is held inline (no heap) and lives only briefly on the stack.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Clipped {
     /// Entirely inside: use the triangle as it is.

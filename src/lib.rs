@@ -58,6 +58,7 @@
 extern crate std;
 
 pub mod clip;
+pub mod demo;
 pub mod math;
 pub mod project;
 pub mod raster;

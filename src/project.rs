@@ -57,7 +57,7 @@ pub struct Scale {
 impl Scale {
     /// `None` unless `0 < v < 2^25` and finite.
     pub fn new(v: f32) -> Option<Scale> {
-        if !(v > 0.0) || !(v < (1u32 << 25) as f32) {
+        if v.is_nan() || v <= 0.0 || v >= (1u32 << 25) as f32 {
             return None;
         }
         let mut m = v;
@@ -75,7 +75,7 @@ impl Scale {
 
     /// `floor(self · v)` for `|v| <= 2^31`.
     #[inline]
-    pub fn mul(self, v: i32) -> i64 {
+    pub fn apply(self, v: i32) -> i64 {
         (self.mantissa * v as i64) >> self.shift
     }
 }
@@ -134,8 +134,8 @@ impl<const S: u32> Viewport<S> {
             ay,
             near,
             far,
-            guard_x: GUARD_BAND_HALF_SCREENS * (width as i64) << S >> 1,
-            guard_y: GUARD_BAND_HALF_SCREENS * (height as i64) << S >> 1,
+            guard_x: ((GUARD_BAND_HALF_SCREENS * width as i64) << S) >> 1,
+            guard_y: ((GUARD_BAND_HALF_SCREENS * height as i64) << S) >> 1,
         })
     }
 
@@ -144,8 +144,8 @@ impl<const S: u32> Viewport<S> {
     #[inline]
     pub fn clip_distances(&self, p: &EyePoint) -> [i64; 6] {
         let w = p.w.to_bits() as i64;
-        let nx = self.ax.mul(p.x.to_bits());
-        let ny = self.ay.mul(p.y.to_bits());
+        let nx = self.ax.apply(p.x.to_bits());
+        let ny = self.ay.apply(p.y.to_bits());
         [
             w - self.near.to_bits() as i64,
             self.far.to_bits() as i64 - w,
@@ -166,8 +166,8 @@ impl<const S: u32> Viewport<S> {
         }
         let cx = (self.width as i64) << S;
         let cy = (self.height as i64) << S;
-        let nx = self.ax.mul(p.x.to_bits());
-        let ny = self.ay.mul(p.y.to_bits());
+        let nx = self.ax.apply(p.x.to_bits());
+        let ny = self.ay.apply(p.y.to_bits());
         // round(c/2 + n/w) = floor((c·w + 2n + w) / 2w)
         let x = (cx * w + 2 * nx + w).div_euclid(2 * w);
         let y = (cy * w - 2 * ny + w).div_euclid(2 * w);
@@ -247,7 +247,7 @@ mod tests {
     #[test]
     fn scale_keeps_24_significant_bits() {
         let s = Scale::new(3.0e-5).unwrap();
-        let v = s.mul(1 << 30) as f64;
+        let v = s.apply(1 << 30) as f64;
         assert!((v - 3.0e-5 * (1u64 << 30) as f64).abs() <= 1.0);
         assert!(Scale::new(0.0).is_none());
         assert!(Scale::new(f32::NAN).is_none());

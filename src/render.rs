@@ -177,6 +177,8 @@ impl<E: core::fmt::Debug> core::fmt::Display for RenderError<E> {
     }
 }
 
+impl<E: core::fmt::Debug> core::error::Error for RenderError<E> {}
+
 /// A triangle on the active list.
 #[derive(Clone, Copy, Debug)]
 struct ActiveTri<T> {

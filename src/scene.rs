@@ -116,6 +116,8 @@ impl core::fmt::Display for SceneError {
     }
 }
 
+impl core::error::Error for SceneError {}
+
 /// Where a mesh's base colours come from.
 #[derive(Clone, Copy, Debug)]
 pub enum MeshColors<'a> {
@@ -400,7 +402,7 @@ fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
 
 fn normalize<M: MathBackend>(v: [f32; 3]) -> Option<[f32; 3]> {
     let len = M::sqrt(dot(v, v));
-    if !(len > 0.0) || !len.is_finite() {
+    if len.is_nan() || len <= 0.0 || len.is_infinite() {
         return None;
     }
     Some([v[0] / len, v[1] / len, v[2] / len])
@@ -449,7 +451,7 @@ impl View {
         }
         let half = fovy_degrees * (core::f32::consts::PI / 360.0);
         let tan_half = M::tan(half);
-        if !(tan_half > 0.0) || !tan_half.is_finite() {
+        if tan_half.is_nan() || tan_half <= 0.0 || tan_half.is_infinite() {
             return Err(SceneError::FieldOfView);
         }
         Ok(Camera {
@@ -500,7 +502,8 @@ impl Camera {
         let side = cross(forward, up);
         // Reject an up vector within ~0.06° of the view direction: the basis would be noise.
         let up_len = M::sqrt(dot(up, up));
-        if !(M::sqrt(dot(side, side)) > 1e-3 * up_len) {
+        let side_len = M::sqrt(dot(side, side));
+        if side_len.is_nan() || side_len <= 1e-3 * up_len {
             return Err(SceneError::DegenerateUp);
         }
         let side = normalize::<M>(side).ok_or(SceneError::DegenerateUp)?;

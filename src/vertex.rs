@@ -66,10 +66,10 @@ impl ModelView {
         for r in 0..3 {
             let sign = if r == 2 { -1.0 } else { 1.0 };
             let mut bound: i64 = 0;
-            for c in 0..3 {
-                let v = I16F16::checked_from_num(sign * mv.m[r][c])
-                    .ok_or(TransformError::OutOfEnvelope)?;
-                m[r][c] = v;
+            for (out, &entry) in m[r].iter_mut().zip(&mv.m[r][..3]) {
+                let v =
+                    I16F16::checked_from_num(sign * entry).ok_or(TransformError::OutOfEnvelope)?;
+                *out = v;
                 bound += (v.to_bits() as i64).abs() * max_abs_bits as i64;
             }
             let tv =
@@ -159,7 +159,7 @@ impl Lighting {
         I2F30::from_bits(i.clamp(0, 1 << 30) as i32)
     }
 
-    fn to_world(&self, n: [i32; 3]) -> [i64; 3] {
+    fn normal_to_world(&self, n: [i32; 3]) -> [i64; 3] {
         self.normal_matrix
             .map(|row| (0..3).map(|k| row[k] as i64 * n[k] as i64).sum())
     }
@@ -176,7 +176,7 @@ impl Lighting {
             e1[0] * e2[1] - e1[1] * e2[0],
         ];
         match normalize_i64(n) {
-            Some(unit) => self.intensity_of_world_normal(self.to_world(unit)),
+            Some(unit) => self.intensity_of_world_normal(self.normal_to_world(unit)),
             None => self.ambient,
         }
     }
@@ -185,7 +185,7 @@ impl Lighting {
     pub fn vertex(&self, n: &Vertex) -> I2F30 {
         match normalize_i64(n.map(|c| c.to_bits() as i64)) {
             Some(unit) => {
-                let w = self.to_world(unit);
+                let w = self.normal_to_world(unit);
                 let w = if self.flip { w.map(|c| -c) } else { w };
                 self.intensity_of_world_normal(w)
             }

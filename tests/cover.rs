@@ -274,6 +274,16 @@ fn pipeline_grid<const S: u32>(
             tris.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
         }
     }
+    // Snapping moves each vertex by up to half a snap unit (2^-(S+1) px) per axis. It is
+    // monotonic per axis, so an unjittered grid can never fold; a jittered one (interior
+    // vertices moved by up to 20 % of a cell) can fold once cells are only a few snap units
+    // across, and then the *snapped* mesh is no longer a tiling (a real rasterizer draws it
+    // faithfully, overlap included). Such inputs test the premise, not the renderer: require
+    // jittered cells of at least 8 snap units.
+    let focal_px = (PH as f64 / 2.0) / (fovy.to_radians() / 2.0).tan();
+    let cell_px = (2.0 * half[0] / nx as f64).min(2.0 * half[1] / ny as f64) * focal_px / dist;
+    let jittered = jitter.iter().any(|&(u, v)| u != 0.0 || v != 0.0) && (nx > 1 || ny > 1);
+    prop_assume!(!jittered || cell_px >= 8.0 / (1u32 << S) as f64);
     let data = MeshData::from_f64(&verts, &tris);
     let mesh = data.mesh();
     let instances = [Instance {
