@@ -171,6 +171,12 @@ fn write_ground(out: &mut String, n: usize, half: f64) {
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
+    // The firmware examples link with cortex-m-rt's link.x, which includes memory.x from the
+    // linker search path.
+    let out = std::path::PathBuf::from(std::env::var("OUT_DIR").unwrap());
+    std::fs::copy("memory.x", out.join("memory.x")).unwrap();
+    println!("cargo:rustc-link-search={}", out.display());
+    println!("cargo:rerun-if-changed=memory.x");
     let (v, f) = icosphere(3);
     let mut out = String::new();
     writeln!(

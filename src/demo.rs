@@ -11,10 +11,14 @@
 //! assert_eq!(scene.triangle_count(), 1280 + 12 + 128);
 //! ```
 
+use crate::render::{FrameStats, RenderError, RenderOptions, Workspace};
 use crate::scene::{
     Camera, Instance, Light, Mesh, MeshColors, Scene, SceneError, Transform, Vertex,
 };
-use embedded_graphics::pixelcolor::Rgb888;
+use crate::shading::Flat;
+use crate::sink::HashSink;
+use core::convert::Infallible;
+use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use fixed::types::I16F16;
 
 const fn c(bits: i32) -> I16F16 {
@@ -111,3 +115,31 @@ pub fn scene<'a>(
 
 /// The demo's background colour.
 pub const BACKGROUND: Rgb888 = Rgb888::new(24, 28, 40);
+
+/// The workspace the firmware examples use for the demo: RGB565 (an SPI panel's format), flat
+/// shading, 240×240, room for 1024 triangles after culling and 72 on one row.
+pub type PanelWorkspace = Workspace<Rgb565, Flat, WIDTH, HEIGHT, 1024, 72>;
+
+/// What one demo frame produced on the hashing panel model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PanelFrame {
+    /// Hash of the row stream ([`HashSink`]).
+    pub hash: u32,
+    /// Frame statistics.
+    pub stats: FrameStats,
+}
+
+/// Renders `scene` (normally [`scene`] at some frame) into `ws`, hashing the rows as a
+/// frame-buffer-less panel would receive them. Firmware and host call this same function, so
+/// equal hashes mean bit-identical output across machines.
+pub fn render_panel_frame(
+    ws: &mut PanelWorkspace,
+    scene: &Scene<'_>,
+) -> Result<PanelFrame, RenderError<Infallible>> {
+    let mut sink = HashSink::new();
+    let stats = ws.render(scene, &RenderOptions::default(), &mut sink)?;
+    Ok(PanelFrame {
+        hash: sink.hash(),
+        stats,
+    })
+}

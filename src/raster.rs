@@ -247,6 +247,11 @@ pub struct PixelOrigin {
 }
 
 impl PixelOrigin {
+    /// The reference pixel `(c, r)`.
+    pub const fn new(c: i32, r: i32) -> Self {
+        PixelOrigin { c, r }
+    }
+
     /// Value of `plane` at pixel centre `(c, r)`, wrapping (exact when the true value fits).
     #[inline]
     pub fn at(&self, plane: &Plane, c: i32, r: i32) -> i64 {

@@ -6,7 +6,10 @@
 //! for a closure (for example a panel driver that streams the row over SPI).
 
 use crate::project::Depth;
-use embedded_graphics::pixelcolor::{BinaryColor, Gray8, GrayColor, Rgb565, Rgb888, RgbColor};
+use embedded_graphics::pixelcolor::raw::RawData;
+use embedded_graphics::pixelcolor::{
+    BinaryColor, Gray8, GrayColor, PixelColor, Rgb565, Rgb888, RgbColor,
+};
 use embedded_graphics::prelude::{DrawTarget, Point, Size};
 use embedded_graphics::primitives::Rectangle;
 
@@ -242,6 +245,70 @@ impl<P, E, F: FnMut(Row<'_, P>) -> Result<(), E>> RowSink<P> for FnSink<F> {
     type Error = E;
     fn write_row(&mut self, row: Row<'_, P>) -> Result<(), E> {
         (self.0)(row)
+    }
+}
+
+/// A frame-buffer-less panel model: hashes the row stream (32-bit FNV-1a over each pixel's raw
+/// value as 4 little-endian bytes, rows in order). Two renders give the same hash exactly when
+/// they sent the same pixels in the same order, which is how firmware and host prove
+/// bit-identical output.
+///
+/// ```
+/// use embedded_graphics::pixelcolor::Rgb565;
+/// use scanline3d::sink::{HashSink, Row, RowSink};
+/// let mut a = HashSink::new();
+/// a.write_row(Row { y: 0, pixels: &[Rgb565::new(1, 2, 3)], depth: &[Default::default()] }).unwrap();
+/// let mut b = HashSink::new();
+/// b.write_row(Row { y: 0, pixels: &[Rgb565::new(1, 2, 4)], depth: &[Default::default()] }).unwrap();
+/// assert_ne!(a.hash(), b.hash());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HashSink {
+    hash: u32,
+    rows: u32,
+}
+
+impl Default for HashSink {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl HashSink {
+    /// FNV-1a offset basis.
+    pub const fn new() -> Self {
+        HashSink {
+            hash: 0x811c_9dc5,
+            rows: 0,
+        }
+    }
+    /// The hash of everything written so far.
+    pub const fn hash(&self) -> u32 {
+        self.hash
+    }
+    /// Rows written so far.
+    pub const fn rows(&self) -> u32 {
+        self.rows
+    }
+}
+
+impl<P> RowSink<P> for HashSink
+where
+    P: PixelColor + Into<P::Raw>,
+    <P::Raw as RawData>::Storage: Into<u32>,
+{
+    type Error = core::convert::Infallible;
+    fn write_row(&mut self, row: Row<'_, P>) -> Result<(), Self::Error> {
+        let mut h = self.hash;
+        for &p in row.pixels {
+            let raw: u32 = p.into().into_inner().into();
+            for byte in raw.to_le_bytes() {
+                h = (h ^ byte as u32).wrapping_mul(0x0100_0193);
+            }
+        }
+        self.hash = h;
+        self.rows += 1;
+        Ok(())
     }
 }
 

@@ -83,7 +83,116 @@ fn cargo_test(extra: &[&str], totals: &mut (u64, u64)) -> Result<(), String> {
 fn install() -> Result<(), String> {
     step("install rustup targets and components (no-op when present)");
     run(Command::new("rustup").args(["target", "add"]).args(TARGETS))?;
-    run(Command::new("rustup").args(["component", "add", "rustfmt", "clippy"]))
+    run(Command::new("rustup").args(["component", "add", "rustfmt", "clippy"]))?;
+    step("install QEMU for the firmware runs (no-op when present)");
+    let have_qemu = Command::new("qemu-system-arm")
+        .arg("--version")
+        .stdout(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !have_qemu {
+        let root = Command::new("id")
+            .arg("-u")
+            .output()
+            .map(|o| o.stdout == b"0\n")
+            .unwrap_or(false);
+        let apt = |args: &[&str]| {
+            let mut cmd = if root {
+                Command::new("apt-get")
+            } else {
+                let mut c = Command::new("sudo");
+                c.arg("apt-get");
+                c
+            };
+            cmd.args(args).env("DEBIAN_FRONTEND", "noninteractive");
+            cmd
+        };
+        run(&mut apt(&["update", "-qq"]))?;
+        run(&mut apt(&["install", "-y", "-qq", "qemu-system-arm"]))?;
+    }
+    Ok(())
+}
+
+/// A firmware target and the QEMU machine its runner uses (see `.cargo/config.toml`).
+const FIRMWARE: [(&str, &str); 2] = [
+    ("thumbv7em-none-eabihf", "mps2-an386 (Cortex-M4F)"),
+    (
+        "thumbv6m-none-eabi",
+        "mps2-an385 (Cortex-M3 running v6-M code)",
+    ),
+];
+
+/// Runs the firmware example on one target under QEMU and returns its output.
+fn run_firmware(target: &str) -> Result<String, String> {
+    let out = cargo()
+        .args([
+            "run",
+            "--quiet",
+            "--release",
+            "--example",
+            "firmware",
+            "--target",
+            target,
+        ])
+        .current_dir(root())
+        .stderr(Stdio::inherit())
+        .output()
+        .map_err(|e| format!("firmware on {target}: {e}"))?;
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    if !out.status.success() {
+        return Err(format!(
+            "firmware on {target} failed ({}):\n{text}",
+            out.status
+        ));
+    }
+    Ok(text)
+}
+
+/// Frame hashes the host computes for the demo orbit, through the same code as the firmware.
+fn host_hashes() -> Result<Vec<u32>, String> {
+    use scanline3d::demo;
+    let mut ws = Box::new(demo::PanelWorkspace::new(demo::BACKGROUND.into()));
+    let instances = demo::instances();
+    (0..demo::ORBIT_FRAMES)
+        .map(|frame| {
+            let scene =
+                demo::scene(&instances, frame, demo::ORBIT_FRAMES).map_err(|e| e.to_string())?;
+            demo::render_panel_frame(&mut ws, &scene)
+                .map(|f| f.hash)
+                .map_err(|e| e.to_string())
+        })
+        .collect()
+}
+
+fn firmware() -> Result<(), String> {
+    let expected = host_hashes()?;
+    for (target, machine) in FIRMWARE {
+        step(&format!("firmware on QEMU {machine}, {target}"));
+        let first = run_firmware(target)?;
+        print!("{first}");
+        let second = run_firmware(target)?;
+        if first != second {
+            return Err(format!("{target}: two runs printed different output (instruction counts must be deterministic)\n{second}"));
+        }
+        println!("(second run printed identical output: counts are deterministic)");
+        let hashes: Vec<u32> = first
+            .lines()
+            .filter_map(|l| l.strip_prefix("frame "))
+            .filter_map(|l| {
+                l.split_whitespace()
+                    .nth(2)
+                    .and_then(|h| u32::from_str_radix(h, 16).ok())
+            })
+            .collect();
+        if hashes != expected {
+            return Err(format!(
+                "{target}: frame hashes {hashes:08x?} differ from the host's {expected:08x?}"
+            ));
+        }
+        println!("frame hashes equal the host's: {expected:08x?}");
+        sizes(target, &first)?;
+    }
+    Ok(())
 }
 
 fn test() -> Result<(), String> {
@@ -124,8 +233,9 @@ fn main() -> ExitCode {
     let task = std::env::args().nth(1).unwrap_or_default();
     let result = match task.as_str() {
         "test" => test(),
+        "firmware" => install().and_then(|_| firmware()),
         _ => {
-            eprintln!("usage: cargo xtask test");
+            eprintln!("usage: cargo xtask test | firmware");
             return ExitCode::from(2);
         }
     };
@@ -136,4 +246,126 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Section sizes and symbol attribution of an ELF32 little-endian file.
+struct Elf {
+    sections: Vec<(String, u32, u32)>,    // name, size, flags
+    symbols: Vec<(String, u32, u8, u16)>, // name, size, type, section index
+}
+
+fn elf(path: &std::path::Path) -> Result<Elf, String> {
+    let d = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let u16_at = |o: usize| {
+        d.get(o..o + 2)
+            .map(|b| u16::from_le_bytes([b[0], b[1]]))
+            .unwrap_or(0)
+    };
+    let u32_at = |o: usize| {
+        d.get(o..o + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .unwrap_or(0)
+    };
+    if d.get(..5) != Some(b"\x7fELF\x01") {
+        return Err(format!("{}: not an ELF32 file", path.display()));
+    }
+    let (shoff, shentsize, shnum, shstrndx) = (
+        u32_at(0x20) as usize,
+        u16_at(0x2e) as usize,
+        u16_at(0x30) as usize,
+        u16_at(0x32) as usize,
+    );
+    let sh = |i: usize| shoff + i * shentsize;
+    let str_at = |table: usize, off: usize| -> String {
+        let start = table + off;
+        let end = d[start..]
+            .iter()
+            .position(|&b| b == 0)
+            .map_or(start, |n| start + n);
+        String::from_utf8_lossy(&d[start..end]).into_owned()
+    };
+    let names = u32_at(sh(shstrndx) + 0x10) as usize;
+    let mut sections = Vec::new();
+    let mut symbols = Vec::new();
+    for i in 0..shnum {
+        let h = sh(i);
+        let (name, kind, flags, offset, size, link) = (
+            u32_at(h) as usize,
+            u32_at(h + 4),
+            u32_at(h + 8),
+            u32_at(h + 0x10) as usize,
+            u32_at(h + 0x14),
+            u32_at(h + 0x18) as usize,
+        );
+        sections.push((str_at(names, name), size, flags));
+        if kind == 2 {
+            // SHT_SYMTAB: 16-byte entries; names in the linked string table.
+            let strtab = u32_at(sh(link) + 0x10) as usize;
+            for e in (offset..offset + size as usize).step_by(16) {
+                let name = str_at(strtab, u32_at(e) as usize);
+                symbols.push((
+                    name,
+                    u32_at(e + 8),
+                    d.get(e + 12).copied().unwrap_or(0) & 0xf,
+                    u16_at(e + 14),
+                ));
+            }
+        }
+    }
+    Ok(Elf { sections, symbols })
+}
+
+/// Prints flash and RAM of the firmware for `target`, and how much of the flash is the library.
+fn sizes(target: &str, firmware_output: &str) -> Result<(), String> {
+    let path = root()
+        .join("target")
+        .join(target)
+        .join("release/examples/firmware");
+    let e = elf(&path)?;
+    let size = |n: &str| {
+        e.sections
+            .iter()
+            .filter(|s| s.0 == n)
+            .map(|s| s.1 as u64)
+            .sum::<u64>()
+    };
+    let (text, rodata, data, bss, vectors) = (
+        size(".text"),
+        size(".rodata"),
+        size(".data"),
+        size(".bss"),
+        size(".vector_table"),
+    );
+    let text_index = e
+        .sections
+        .iter()
+        .position(|s| s.0 == ".text")
+        .unwrap_or(usize::MAX) as u16;
+    let rodata_index = e
+        .sections
+        .iter()
+        .position(|s| s.0 == ".rodata")
+        .unwrap_or(usize::MAX) as u16;
+    let sum = |pred: &dyn Fn(&(String, u32, u8, u16)) -> bool| {
+        e.symbols
+            .iter()
+            .filter(|s| pred(s))
+            .map(|s| s.1 as u64)
+            .sum::<u64>()
+    };
+    let ours = |s: &(String, u32, u8, u16)| s.0.contains("scanline3d");
+    let lib_code = sum(&|s| s.3 == text_index && ours(s) && !s.0.contains("firmware"));
+    let builtins =
+        sum(&|s| s.3 == text_index && (s.0.starts_with("__") || s.0.contains("compiler_builtins")));
+    let mesh_data = sum(&|s| s.3 == rodata_index && ours(s) && s.0.contains("demo"));
+    let stack = firmware_output
+        .lines()
+        .find_map(|l| l.strip_prefix("summary peak_stack "))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|n| n.parse::<u64>().ok())
+        .unwrap_or(0);
+    println!("sizes {target}: flash {} bytes (.vector_table {vectors} + .text {text} + .rodata {rodata} + .data {data})", vectors + text + rodata + data);
+    println!("sizes {target}: of which library code {lib_code}, compiler builtins {builtins}, demo mesh data {mesh_data}");
+    println!("sizes {target}: RAM {} bytes (.data {data} + .bss {bss} + measured peak stack {stack}, workspace included)", data + bss + stack);
+    Ok(())
 }

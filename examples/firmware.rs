@@ -1,0 +1,237 @@
+//! Firmware: renders the demo scene's camera orbit on a Cortex-M, feeding each finished row to a
+//! model of a frame-buffer-less SPI panel (it hashes the row stream; there is no frame buffer).
+//!
+//! ```sh
+//! cargo run --release --example firmware --target thumbv7em-none-eabihf   # QEMU mps2-an386, Cortex-M4F
+//! cargo run --release --example firmware --target thumbv6m-none-eabi      # QEMU mps2-an385, no FPU, no divide
+//! ```
+//!
+//! The runners in `.cargo/config.toml` start QEMU with `-icount shift=0`: every instruction
+//! takes exactly 1 ns of virtual time, so the SysTick timer (25 MHz on the MPS2 boards, 40 ns a
+//! tick) counts instructions deterministically, 40 at a time. Over semihosting the firmware
+//! prints one line per frame (hash, instructions, pixels) and a summary with the stack high-water
+//! mark, then exits with status 0, or 1 on any error or panic.
+#![cfg_attr(target_os = "none", no_std)]
+#![cfg_attr(target_os = "none", no_main)]
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    println!("firmware example: run it on a target, e.g.");
+    println!("  cargo run --release --example firmware --target thumbv7em-none-eabihf");
+}
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use cortex_m::peripheral::{syst::SystClkSource, SYST};
+    use cortex_m_rt::entry;
+    use cortex_m_semihosting::{debug, hprintln};
+    use scanline3d::demo::{self, PanelWorkspace};
+
+    /// Instructions per SysTick tick: 25 MHz timer, 1 ns per instruction under `-icount shift=0`.
+    const INSTRUCTIONS_PER_TICK: u64 = 40;
+    /// Bytes of stack below the entry stack pointer painted to find the high-water mark.
+    const PAINTED: usize = 64 * 1024;
+    const PAINT: u32 = 0x5AA5_C33C;
+
+    extern "C" {
+        static _stack_start: u32;
+        static __sdata: u32;
+        static __edata: u32;
+        static __sbss: u32;
+        static __ebss: u32;
+    }
+
+    fn sp() -> usize {
+        cortex_m::register::msp::read() as usize
+    }
+
+    /// Fills the stack below the current frame with a pattern. Writes below the stack pointer
+    /// only, into memory nothing uses yet.
+    #[inline(never)]
+    fn paint_stack() {
+        let top = sp() - 256; // leave this function's own frame alone
+        let mut p = top - PAINTED;
+        while p < top {
+            // SAFETY: [top - PAINTED, top) is unused stack below the live frames (RAM is 4 MiB).
+            unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
+            p += 4;
+        }
+    }
+
+    /// Deepest stack address reached since painting, found as the lowest overwritten word.
+    fn stack_low_water() -> usize {
+        let top = sp() - 256;
+        let mut p = top - PAINTED;
+        // SAFETY: reads the same painted, word-aligned region.
+        while p < top && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
+            p += 4;
+        }
+        p
+    }
+
+    /// SysTick ticks since `start`. The counter runs down from 0xFF_FFFF and a frame is far
+    /// shorter than one wrap (671 M instructions), so the modular difference is exact.
+    fn ticks_since(start: u32) -> u64 {
+        (start.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF) as u64
+    }
+
+    /// Checks the instruction clock: a loop of exactly 3 instructions per iteration must read
+    /// as 3 · n instructions, or every figure printed would be wrong.
+    fn calibrate() -> Result<(), &'static str> {
+        let n: u32 = 100_000;
+        let start = SYST::get_current();
+        // SAFETY: a register-only countdown loop (nop, subs, bne).
+        unsafe {
+            core::arch::asm!("2:", "nop", "subs {0}, #1", "bne 2b", inout(reg) n => _, options(nomem, nostack));
+        }
+        let measured = ticks_since(start) * INSTRUCTIONS_PER_TICK;
+        hprintln!(
+            "calibration {} instructions measured for {} executed",
+            measured,
+            3 * n
+        );
+        if measured.abs_diff(3 * n as u64) > INSTRUCTIONS_PER_TICK {
+            return Err("instruction clock is not 1 ns per instruction at 25 MHz (run with -icount shift=0)");
+        }
+        Ok(())
+    }
+
+    /// The inner span loop alone: a 240-pixel flat span filled `REPS` times, every pixel passing
+    /// the depth test (then every pixel failing it). Returns instructions per pixel × 100.
+    fn span_loop_cost(pass: bool) -> u64 {
+        use embedded_graphics::pixelcolor::Rgb565;
+        use scanline3d::raster::PixelOrigin;
+        use scanline3d::shading::{Shading, SpanDepth};
+        use scanline3d::{Depth, Flat};
+        const REPS: u64 = 50;
+        let mut depth = [Depth::ZERO; demo::WIDTH];
+        let mut pixels = [Rgb565::new(0, 0, 0); demo::WIDTH];
+        let origin = PixelOrigin::new(0, 0);
+        let color = Rgb565::new(31, 0, 0);
+        let start = SYST::get_current();
+        for i in 0..REPS {
+            let base = if pass { 1 << 20 } else { 0 };
+            // Each repetition is nearer than the last, so with `pass` every pixel is written.
+            let span = SpanDepth {
+                x0: 0,
+                y: 0,
+                q: base + (i as i32) * 4096,
+                dq: 1,
+            };
+            Flat::fill(&color, &origin, span, &mut depth, &mut pixels);
+            if !pass {
+                depth.fill(Depth::MAX);
+            }
+        }
+        core::hint::black_box(&pixels);
+        ticks_since(start) * INSTRUCTIONS_PER_TICK * 100 / (REPS * demo::WIDTH as u64)
+    }
+
+    struct FrameLine {
+        hash: u32,
+        instructions: u64,
+        stats: scanline3d::FrameStats,
+    }
+
+    fn run() -> Result<(), &'static str> {
+        let mut core = cortex_m::Peripherals::take().ok_or("peripherals taken")?;
+        let syst = &mut core.SYST;
+        syst.set_clock_source(SystClkSource::Core);
+        syst.set_reload(0x00FF_FFFF);
+        syst.clear_current();
+        syst.enable_counter();
+        calibrate()?;
+
+        // Render every frame first and print afterwards, so the stack high-water mark is the
+        // renderer's (and this loop's), not the formatter's.
+        let stack_top = &raw const _stack_start as usize;
+        paint_stack();
+        let mut lines: [Option<FrameLine>; demo::ORBIT_FRAMES as usize] = Default::default();
+        {
+            let mut ws = PanelWorkspace::new(demo::BACKGROUND.into());
+            let instances = demo::instances();
+            for (frame, line) in lines.iter_mut().enumerate() {
+                let frame = frame as u32;
+                let scene =
+                    demo::scene(&instances, frame, demo::ORBIT_FRAMES).map_err(|_| "scene")?;
+                let start = SYST::get_current();
+                let out = demo::render_panel_frame(&mut ws, &scene).map_err(|_| "render")?;
+                let instructions = ticks_since(start) * INSTRUCTIONS_PER_TICK;
+                *line = Some(FrameLine {
+                    hash: out.hash,
+                    instructions,
+                    stats: out.stats,
+                });
+            }
+        }
+        let peak_stack = stack_top - stack_low_water();
+
+        let (mut max_bucketed, mut max_active) = (0, 0);
+        for (frame, line) in lines.iter().enumerate() {
+            let FrameLine {
+                hash,
+                instructions,
+                stats: s,
+            } = line.as_ref().ok_or("missing frame")?;
+            if !s.is_complete() {
+                return Err("active list overflowed");
+            }
+            max_bucketed = max_bucketed.max(s.bucketed);
+            max_active = max_active.max(s.peak_active);
+            hprintln!(
+                "frame {} hash {:08x} instructions {} pixels_written {} fragments {} triangles {} drawn {} instr_per_fragment {} instr_per_triangle {}",
+                frame,
+                hash,
+                instructions,
+                s.pixels_written,
+                s.fragments,
+                s.triangles_in,
+                s.activated,
+                instructions / s.fragments.max(1) as u64,
+                instructions / s.triangles_in.max(1) as u64
+            );
+        }
+        let (pass, fail) = (span_loop_cost(true), span_loop_cost(false));
+        hprintln!(
+            "span_loop instr_per_pixel_x100 written {} rejected {}",
+            pass,
+            fail
+        );
+        let (data, bss) = (
+            &raw const __edata as usize - &raw const __sdata as usize,
+            &raw const __ebss as usize - &raw const __sbss as usize,
+        );
+        hprintln!(
+            "summary peak_stack {} static_ram {} renderer_ram {} max_bucketed {} max_active {}",
+            peak_stack,
+            data + bss,
+            PanelWorkspace::BYTES,
+            max_bucketed,
+            max_active
+        );
+        Ok(())
+    }
+
+    #[entry]
+    fn main() -> ! {
+        match run() {
+            Ok(()) => debug::exit(debug::EXIT_SUCCESS),
+            Err(e) => {
+                hprintln!("error: {}", e);
+                debug::exit(debug::EXIT_FAILURE);
+            }
+        }
+        loop {
+            cortex_m::asm::nop();
+        }
+    }
+
+    #[panic_handler]
+    fn panic(info: &core::panic::PanicInfo) -> ! {
+        hprintln!("panic: {}", info);
+        debug::exit(debug::EXIT_FAILURE);
+        loop {
+            cortex_m::asm::nop();
+        }
+    }
+}
