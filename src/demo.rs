@@ -117,8 +117,9 @@ pub fn scene<'a>(
 pub const BACKGROUND: Rgb888 = Rgb888::new(24, 28, 40);
 
 /// The workspace the firmware examples use for the demo: RGB565 (an SPI panel's format), flat
-/// shading, 240×240, room for 1024 triangles after culling and 72 on one row.
-pub type PanelWorkspace = Workspace<Rgb565, Flat, WIDTH, HEIGHT, 1024, 72>;
+/// shading, 240×240. Capacities come from measuring the orbit (the firmware prints them): at
+/// most 583 triangles survive culling and 63 cross one row, so 640 and 64.
+pub type PanelWorkspace = Workspace<Rgb565, Flat, WIDTH, HEIGHT, 640, 64>;
 
 /// What one demo frame produced on the hashing panel model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

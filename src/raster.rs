@@ -102,9 +102,11 @@ pub struct TriangleWalk {
     short: EdgeWalk,
     /// The lower short edge, set up when the walk reaches `mid_row`.
     lower: [(i32, i32); 2],
-    row: i32,
-    mid_row: i32,
-    end_row: i32,
+    // Rows fit i16: the screen is at most 2048 rows and `mid_row` is clamped to [-1, i16::MAX],
+    // which keeps its only use (an equality test while walking from row >= 0) unchanged.
+    row: i16,
+    mid_row: i16,
+    end_row: i16,
     long_is_left: bool,
 }
 
@@ -139,16 +141,13 @@ impl TriangleWalk {
         if r0 >= r2 {
             return None;
         }
-        let (r0, r1, r2) = (
-            r0 as i32,
-            r1.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
-            r2 as i32,
-        );
-        let long = EdgeWalk::new::<S>(top, bottom, r0)?;
+        // r0, r2 are within [0, max_row] and max_row <= 2048.
+        let (r0, r1, r2) = (r0 as i16, r1.clamp(-1, i16::MAX as i64) as i16, r2 as i16);
+        let long = EdgeWalk::new::<S>(top, bottom, r0 as i32)?;
         let short = if r0 < r1 {
-            EdgeWalk::new::<S>(top, mid, r0)?
+            EdgeWalk::new::<S>(top, mid, r0 as i32)?
         } else {
-            EdgeWalk::new::<S>(mid, bottom, r0)?
+            EdgeWalk::new::<S>(mid, bottom, r0 as i32)?
         };
         Some(TriangleWalk {
             long,
@@ -164,7 +163,7 @@ impl TriangleWalk {
     /// The row the walk is on.
     #[inline]
     pub fn row(&self) -> i32 {
-        self.row
+        self.row as i32
     }
 
     /// The current row's span `[left, right)` in columns (not clipped to the screen; may be empty).
@@ -186,7 +185,7 @@ impl TriangleWalk {
         }
         self.long.step();
         if self.row == self.mid_row {
-            match EdgeWalk::new::<S>(self.lower[0], self.lower[1], self.row) {
+            match EdgeWalk::new::<S>(self.lower[0], self.lower[1], self.row as i32) {
                 Some(e) => self.short = e,
                 None => return false,
             }

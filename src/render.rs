@@ -17,7 +17,7 @@
 //! `ACTIVE · size_of` of an active triangle (about 104 for flat shading). See
 //! [`Workspace::BYTES`].
 
-use crate::clip::{clip_triangle, ClipVertex, Clipped};
+use crate::clip::{clip_triangle, ClipPolygon, ClipVertex, Clipped};
 use crate::project::{Depth, ScreenVertex, Viewport};
 use crate::raster::{
     color_channels, first_row, signed_area, xy, DepthPlane, PlaneSolver, TriangleWalk,
@@ -442,7 +442,8 @@ impl InstanceSetup<'_> {
             }
         };
         let project = |c: &ClipVertex| vp.project(&c.p, c.color);
-        let clipped = match clip_triangle(vp, &cv) {
+        let mut polygon = ClipPolygon::new();
+        let clipped = match clip_triangle(vp, &cv, &mut polygon) {
             Clipped::Outside => return Fate::Rejected,
             Clipped::Inside => {
                 if let [Some(a), Some(b), Some(c)] = cv.each_ref().map(project) {
@@ -450,13 +451,13 @@ impl InstanceSetup<'_> {
                 }
                 false
             }
-            Clipped::Polygon(poly) => {
-                let projected: Vec<ScreenVertex<S>, 9> = poly.iter().filter_map(project).collect();
-                if let Some((&a, rest)) = projected.split_first() {
-                    for pair in rest.windows(2) {
-                        if let [b, c] = pair {
-                            emit([a, *b, *c]);
-                        }
+            Clipped::Polygon => {
+                // Fan from the first vertex, projecting each vertex once as the fan reaches it.
+                let mut fan = polygon.iter().filter_map(project);
+                if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
+                    for c in fan {
+                        emit([a, b, c]);
+                        b = c;
                     }
                 }
                 true

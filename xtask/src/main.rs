@@ -248,10 +248,13 @@ fn main() -> ExitCode {
     }
 }
 
+/// An ELF symbol: name, size, type, section index.
+type Symbol = (String, u32, u8, u16);
+
 /// Section sizes and symbol attribution of an ELF32 little-endian file.
 struct Elf {
-    sections: Vec<(String, u32, u32)>,    // name, size, flags
-    symbols: Vec<(String, u32, u8, u16)>, // name, size, type, section index
+    sections: Vec<(String, u32, u32)>, // name, size, flags
+    symbols: Vec<Symbol>,
 }
 
 fn elf(path: &std::path::Path) -> Result<Elf, String> {
@@ -346,14 +349,14 @@ fn sizes(target: &str, firmware_output: &str) -> Result<(), String> {
         .iter()
         .position(|s| s.0 == ".rodata")
         .unwrap_or(usize::MAX) as u16;
-    let sum = |pred: &dyn Fn(&(String, u32, u8, u16)) -> bool| {
+    let sum = |pred: &dyn Fn(&Symbol) -> bool| {
         e.symbols
             .iter()
             .filter(|s| pred(s))
             .map(|s| s.1 as u64)
             .sum::<u64>()
     };
-    let ours = |s: &(String, u32, u8, u16)| s.0.contains("scanline3d");
+    let ours = |s: &Symbol| s.0.contains("scanline3d");
     let lib_code = sum(&|s| s.3 == text_index && ours(s) && !s.0.contains("firmware"));
     let builtins =
         sum(&|s| s.3 == text_index && (s.0.starts_with("__") || s.0.contains("compiler_builtins")));
