@@ -169,12 +169,24 @@ fn write_ground(out: &mut String, n: usize, half: f64) {
     writeln!(out, "];").unwrap();
 }
 
+/// QEMU `virt` (RV32): 16 MiB of RAM at 0x8000_0000, loaded there with `-bios none -kernel`.
+const RISCV_VIRT_MEMORY: &str = "MEMORY\n{\n  RAM : ORIGIN = 0x80000000, LENGTH = 16M\n}\n\
+REGION_ALIAS(\"REGION_TEXT\", RAM);\nREGION_ALIAS(\"REGION_RODATA\", RAM);\n\
+REGION_ALIAS(\"REGION_DATA\", RAM);\nREGION_ALIAS(\"REGION_BSS\", RAM);\n\
+REGION_ALIAS(\"REGION_HEAP\", RAM);\nREGION_ALIAS(\"REGION_STACK\", RAM);\n";
+
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
-    // The firmware examples link with cortex-m-rt's link.x, which includes memory.x from the
-    // linker search path.
+    // The firmware example links with the runtime's link.x. On Arm, cortex-m-rt's link.x
+    // includes memory.x from the linker search path (the top-level one). On RISC-V,
+    // `.cargo/config.toml` passes memory-riscv-virt.x (QEMU virt's RAM, with the region
+    // aliases riscv-rt places sections through) ahead of link.x.
     let out = std::path::PathBuf::from(std::env::var("OUT_DIR").unwrap());
-    std::fs::copy("memory.x", out.join("memory.x")).unwrap();
+    if std::env::var("CARGO_CFG_TARGET_ARCH").as_deref() == Ok("riscv32") {
+        std::fs::write(out.join("memory-riscv-virt.x"), RISCV_VIRT_MEMORY).unwrap();
+    } else {
+        std::fs::copy("memory.x", out.join("memory.x")).unwrap();
+    }
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=memory.x");
     let (v, f) = icosphere(3);

@@ -1,16 +1,20 @@
-//! Firmware: renders the demo scene's camera orbit on a Cortex-M, feeding each finished row to a
-//! model of a frame-buffer-less SPI panel (it hashes the row stream; there is no frame buffer).
+//! Firmware: renders the demo scene's camera orbit on a microcontroller, feeding each finished
+//! row to a model of a frame-buffer-less SPI panel (it hashes the row stream; there is no frame
+//! buffer anywhere).
 //!
 //! ```sh
-//! cargo run --release --example firmware --target thumbv7em-none-eabihf   # QEMU mps2-an386, Cortex-M4F
-//! cargo run --release --example firmware --target thumbv6m-none-eabi      # QEMU mps2-an385, no FPU, no divide
+//! cargo run --release --example firmware --target thumbv7em-none-eabihf        # QEMU mps2-an386, Cortex-M4F
+//! cargo run --release --example firmware --target thumbv6m-none-eabi           # QEMU mps2-an385, no FPU, no divide
+//! cargo run --release --example firmware --target riscv32imc-unknown-none-elf  # QEMU virt, RV32IMC
 //! ```
 //!
-//! The runners in `.cargo/config.toml` start QEMU with `-icount shift=0`: every instruction
-//! takes exactly 1 ns of virtual time, so the SysTick timer (25 MHz on the MPS2 boards, 40 ns a
-//! tick) counts instructions deterministically, 40 at a time. Over semihosting the firmware
-//! prints one line per frame (hash, instructions, pixels) and a summary with the stack high-water
-//! mark, then exits with status 0, or 1 on any error or panic.
+//! The runners in `.cargo/config.toml` start QEMU with `-icount shift=0`, which makes time
+//! proportional to instructions executed, so counts are deterministic. On Arm the SysTick timer
+//! (25 MHz on the MPS2 boards, 1 ns per instruction) counts 40 instructions per tick; on RISC-V
+//! the `minstret` counter counts every instruction. A calibration loop of known length checks
+//! the counter before anything is measured. Over semihosting the firmware prints one line per
+//! frame (hash, instructions, pixels), the inner span loop's cost and a summary with the stack
+//! high-water mark, then exits with status 0, or 1 on any error or panic.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -20,23 +24,103 @@ fn main() {
     println!("  cargo run --release --example firmware --target thumbv7em-none-eabihf");
 }
 
+/// Cortex-M: SysTick as the instruction counter, cortex-m-rt start-up.
+#[cfg(all(target_os = "none", target_arch = "arm"))]
+mod arch {
+    use cortex_m::peripheral::{syst::SystClkSource, SYST};
+
+    /// 25 MHz SysTick, 1 ns per instruction under `-icount shift=0`.
+    const INSTRUCTIONS_PER_TICK: u64 = 40;
+    /// Resolution of [`instructions`].
+    pub const GRANULARITY: u64 = INSTRUCTIONS_PER_TICK;
+
+    pub fn start_counter() -> Result<(), &'static str> {
+        let mut core = cortex_m::Peripherals::take().ok_or("peripherals taken")?;
+        core.SYST.set_clock_source(SystClkSource::Core);
+        core.SYST.set_reload(0x00FF_FFFF);
+        core.SYST.clear_current();
+        core.SYST.enable_counter();
+        Ok(())
+    }
+
+    /// Instructions executed since `start()`. The counter runs down from 0xFF_FFFF and every
+    /// measured interval is far shorter than one wrap (671 M instructions).
+    pub struct Mark(u32);
+    pub fn start() -> Mark {
+        Mark(SYST::get_current())
+    }
+    pub fn instructions(since: &Mark) -> u64 {
+        (since.0.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF) as u64 * INSTRUCTIONS_PER_TICK
+    }
+
+    /// Runs exactly `3 n` instructions.
+    pub fn known_loop(n: u32) {
+        // SAFETY: a register-only countdown loop (nop, subs, bne).
+        unsafe {
+            core::arch::asm!("2:", "nop", "subs {0}, #1", "bne 2b", inout(reg) n => _, options(nomem, nostack));
+        }
+    }
+
+    pub fn sp() -> usize {
+        cortex_m::register::msp::read() as usize
+    }
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        super::firmware::main()
+    }
+}
+
+/// RISC-V: `minstret` as the instruction counter, riscv-rt start-up (machine mode).
+#[cfg(all(target_os = "none", target_arch = "riscv32"))]
+mod arch {
+    /// `minstret` counts single instructions.
+    pub const GRANULARITY: u64 = 1;
+
+    pub fn start_counter() -> Result<(), &'static str> {
+        Ok(())
+    }
+
+    pub struct Mark(u64);
+    pub fn start() -> Mark {
+        Mark(riscv::register::minstret::read64())
+    }
+    pub fn instructions(since: &Mark) -> u64 {
+        riscv::register::minstret::read64().wrapping_sub(since.0)
+    }
+
+    /// Runs exactly `3 n` instructions.
+    pub fn known_loop(n: u32) {
+        // SAFETY: a register-only countdown loop (nop, addi, bnez).
+        unsafe {
+            core::arch::asm!("2:", "nop", "addi {0}, {0}, -1", "bnez {0}, 2b", inout(reg) n => _, options(nomem, nostack));
+        }
+    }
+
+    pub fn sp() -> usize {
+        let sp: usize;
+        // SAFETY: reads the stack pointer register.
+        unsafe { core::arch::asm!("mv {0}, sp", out(reg) sp, options(nomem, nostack)) };
+        sp
+    }
+
+    #[riscv_rt::entry]
+    fn main() -> ! {
+        super::firmware::main()
+    }
+}
+
 #[cfg(target_os = "none")]
 mod firmware {
-    use cortex_m::peripheral::{syst::SystClkSource, SYST};
-    use cortex_m_rt::entry;
-    use cortex_m_semihosting::{debug, hprintln};
+    use super::arch;
     use embedded_graphics::pixelcolor::Rgb565;
     use scanline3d::demo::{self, PanelWorkspace};
     use scanline3d::raster::PixelOrigin;
     use scanline3d::shading::{Shading, SpanDepth};
     use scanline3d::{Depth, Flat};
+    use semihosting::println;
 
-    /// Instructions per SysTick tick: 25 MHz timer, 1 ns per instruction under `-icount shift=0`.
-    const INSTRUCTIONS_PER_TICK: u64 = 40;
-    /// Bytes of stack below the entry stack pointer painted to find the high-water mark.
-    const PAINTED: usize = 64 * 1024;
-    const PAINT: u32 = 0x5AA5_C33C;
-
+    // Defined by both cortex-m-rt's and riscv-rt's linker scripts.
     extern "C" {
         static _stack_start: u32;
         static __sdata: u32;
@@ -45,18 +129,24 @@ mod firmware {
         static __ebss: u32;
     }
 
-    fn sp() -> usize {
-        cortex_m::register::msp::read() as usize
+    fn static_ram() -> usize {
+        (&raw const __edata as usize - &raw const __sdata as usize)
+            + (&raw const __ebss as usize - &raw const __sbss as usize)
     }
+
+    /// Bytes of stack below the entry stack pointer painted to find the high-water mark.
+    const PAINTED: usize = 64 * 1024;
+    const PAINT: u32 = 0x5AA5_C33C;
 
     /// Fills the stack below the current frame with a pattern. Writes below the stack pointer
     /// only, into memory nothing uses yet.
     #[inline(never)]
     fn paint_stack() {
-        let top = sp() - 256; // leave this function's own frame alone
+        let top = arch::sp() - 256; // leave this function's own frame alone
         let mut p = top - PAINTED;
         while p < top {
-            // SAFETY: [top - PAINTED, top) is unused stack below the live frames (RAM is 4 MiB).
+            // SAFETY: [top - PAINTED, top) is unused stack below the live frames (RAM is 4 MiB
+            // on the MPS2 boards, 16 MiB on virt).
             unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
             p += 4;
         }
@@ -64,7 +154,7 @@ mod firmware {
 
     /// Deepest stack address reached since painting, found as the lowest overwritten word.
     fn stack_low_water() -> usize {
-        let top = sp() - 256;
+        let top = arch::sp() - 256;
         let mut p = top - PAINTED;
         // SAFETY: reads the same painted, word-aligned region.
         while p < top && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
@@ -73,29 +163,23 @@ mod firmware {
         p
     }
 
-    /// SysTick ticks since `start`. The counter runs down from 0xFF_FFFF and a frame is far
-    /// shorter than one wrap (671 M instructions), so the modular difference is exact.
-    fn ticks_since(start: u32) -> u64 {
-        (start.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF) as u64
-    }
-
-    /// Checks the instruction clock: a loop of exactly 3 instructions per iteration must read
+    /// Checks the instruction counter: a loop of exactly 3 instructions per iteration must read
     /// as 3 · n instructions, or every figure printed would be wrong.
     fn calibrate() -> Result<(), &'static str> {
         let n: u32 = 100_000;
-        let start = SYST::get_current();
-        // SAFETY: a register-only countdown loop (nop, subs, bne).
-        unsafe {
-            core::arch::asm!("2:", "nop", "subs {0}, #1", "bne 2b", inout(reg) n => _, options(nomem, nostack));
-        }
-        let measured = ticks_since(start) * INSTRUCTIONS_PER_TICK;
-        hprintln!(
+        let mark = arch::start();
+        arch::known_loop(n);
+        let measured = arch::instructions(&mark);
+        println!(
             "calibration {} instructions measured for {} executed",
             measured,
             3 * n
         );
-        if measured.abs_diff(3 * n as u64) > INSTRUCTIONS_PER_TICK {
-            return Err("instruction clock is not 1 ns per instruction at 25 MHz (run with -icount shift=0)");
+        // The counter's own reads add a handful of instructions (RISC-V counts them exactly).
+        if measured.abs_diff(3 * n as u64) > arch::GRANULARITY.max(16) {
+            return Err(
+                "instruction counter is not 1 per instruction (run QEMU with -icount shift=0)",
+            );
         }
         Ok(())
     }
@@ -120,7 +204,7 @@ mod firmware {
         const REPS: u64 = 50;
         depth.fill(if pass { Depth::ZERO } else { Depth::MAX });
         let mut written = 0;
-        let start = SYST::get_current();
+        let mark = arch::start();
         for i in 0..REPS {
             // Each repetition is nearer than the last, so with `pass` every pixel is written.
             let span = SpanDepth {
@@ -131,7 +215,7 @@ mod firmware {
             };
             written += fill_span(span, depth, pixels);
         }
-        let cost = ticks_since(start) * INSTRUCTIONS_PER_TICK * 100 / (REPS * depth.len() as u64);
+        let cost = arch::instructions(&mark) * 100 / (REPS * depth.len() as u64);
         core::hint::black_box(written);
         cost
     }
@@ -162,12 +246,7 @@ mod firmware {
     }
 
     fn run() -> Result<(), &'static str> {
-        let mut core = cortex_m::Peripherals::take().ok_or("peripherals taken")?;
-        let syst = &mut core.SYST;
-        syst.set_clock_source(SystClkSource::Core);
-        syst.set_reload(0x00FF_FFFF);
-        syst.clear_current();
-        syst.enable_counter();
+        arch::start_counter()?;
         calibrate()?;
 
         // Render every frame first and print afterwards, so the stack high-water mark is the
@@ -182,9 +261,9 @@ mod firmware {
                 let frame = frame as u32;
                 let scene =
                     demo::scene(&instances, frame, demo::ORBIT_FRAMES).map_err(|_| "scene")?;
-                let start = SYST::get_current();
+                let mark = arch::start();
                 let out = demo::render_panel_frame(&mut ws, &scene).map_err(|_| "render")?;
-                let instructions = (ticks_since(start) * INSTRUCTIONS_PER_TICK) as u32;
+                let instructions = arch::instructions(&mark) as u32;
                 let s = out.stats;
                 *line = Some(FrameLine {
                     hash: out.hash,
@@ -209,7 +288,7 @@ mod firmware {
             }
             max_bucketed = max_bucketed.max(l.bucketed);
             max_active = max_active.max(l.peak_active);
-            hprintln!(
+            println!(
                 "frame {} hash {:08x} instructions {} pixels_written {} fragments {} triangles {} drawn {} instr_per_fragment {} instr_per_triangle {}",
                 frame,
                 l.hash,
@@ -223,19 +302,14 @@ mod firmware {
             );
         }
         let (pass, fail) = benchmark_span_loop();
-        hprintln!(
+        println!(
             "span_loop instr_per_pixel_x100 written {} rejected {}",
-            pass,
-            fail
+            pass, fail
         );
-        let (data, bss) = (
-            &raw const __edata as usize - &raw const __sdata as usize,
-            &raw const __ebss as usize - &raw const __sbss as usize,
-        );
-        hprintln!(
+        println!(
             "summary peak_stack {} static_ram {} renderer_ram {} max_bucketed {} max_active {}",
             peak_stack,
-            data + bss,
+            static_ram(),
             PanelWorkspace::BYTES,
             max_bucketed,
             max_active
@@ -243,26 +317,19 @@ mod firmware {
         Ok(())
     }
 
-    #[entry]
-    fn main() -> ! {
+    pub fn main() -> ! {
         match run() {
-            Ok(()) => debug::exit(debug::EXIT_SUCCESS),
+            Ok(()) => semihosting::process::exit(0),
             Err(e) => {
-                hprintln!("error: {}", e);
-                debug::exit(debug::EXIT_FAILURE);
+                println!("error: {}", e);
+                semihosting::process::exit(1)
             }
-        }
-        loop {
-            cortex_m::asm::nop();
         }
     }
 
     #[panic_handler]
     fn panic(info: &core::panic::PanicInfo) -> ! {
-        hprintln!("panic: {}", info);
-        debug::exit(debug::EXIT_FAILURE);
-        loop {
-            cortex_m::asm::nop();
-        }
+        println!("panic: {}", info);
+        semihosting::process::exit(1)
     }
 }

@@ -108,18 +108,25 @@ fn install() -> Result<(), String> {
             cmd
         };
         run(&mut apt(&["update", "-qq"]))?;
-        run(&mut apt(&["install", "-y", "-qq", "qemu-system-arm"]))?;
+        run(&mut apt(&[
+            "install",
+            "-y",
+            "-qq",
+            "qemu-system-arm",
+            "qemu-system-misc",
+        ]))?;
     }
     Ok(())
 }
 
 /// A firmware target and the QEMU machine its runner uses (see `.cargo/config.toml`).
-const FIRMWARE: [(&str, &str); 2] = [
+const FIRMWARE: [(&str, &str); 3] = [
     ("thumbv7em-none-eabihf", "mps2-an386 (Cortex-M4F)"),
     (
         "thumbv6m-none-eabi",
         "mps2-an385 (Cortex-M3 running v6-M code)",
     ),
+    ("riscv32imc-unknown-none-elf", "virt (RV32IMC)"),
 ];
 
 /// Runs the firmware example on one target under QEMU and returns its output.
