@@ -310,14 +310,57 @@ impl<
         options: &RenderOptions<SUB_BITS>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
+        self.render_sized(W, H, scene, options, sink)
+    }
+
+    /// Renders a `width × height` target (at most `W × H`) with this workspace: rows are
+    /// `width` pixels long and there are `height` of them. One workspace can serve several
+    /// viewport sizes; a size of zero or beyond `W × H` is [`RenderError::InvalidTarget`].
+    ///
+    /// ```
+    /// use embedded_graphics::pixelcolor::Gray8;
+    /// use scanline3d::{demo, sink::FnSink, Flat, RenderOptions, Workspace};
+    /// let mut ws: Box<Workspace<Gray8, Flat, 320, 240, 1536, 96>> = Box::new(Workspace::new(Gray8::new(0)));
+    /// let instances = demo::instances();
+    /// let scene = demo::scene(&instances, 0, demo::ORBIT_FRAMES)?;
+    /// let mut rows = 0;
+    /// let mut sink = FnSink(|row: scanline3d::sink::Row<'_, Gray8>| -> Result<(), ()> {
+    ///     assert_eq!(row.pixels.len(), 100);
+    ///     rows += 1;
+    ///     Ok(())
+    /// });
+    /// let stats = ws.render_sized(100, 80, &scene, &RenderOptions::default(), &mut sink).unwrap();
+    /// assert!(ws.render_sized(321, 80, &scene, &RenderOptions::default(), &mut sink).is_err());
+    /// assert_eq!((rows, stats.rows), (80, 80));
+    /// # Ok::<(), scanline3d::scene::SceneError>(())
+    /// ```
+    pub fn render_sized<const SUB_BITS: u32, K: RowSink<P>>(
+        &mut self,
+        width: usize,
+        height: usize,
+        scene: &Scene<'_>,
+        options: &RenderOptions<SUB_BITS>,
+        sink: &mut K,
+    ) -> Result<FrameStats, RenderError<K::Error>> {
+        if width == 0 || height == 0 || width > W || height > H {
+            return Err(RenderError::InvalidTarget);
+        }
         let camera = &scene.camera;
-        let vp = Viewport::<SUB_BITS>::new(W, H, camera.focal(), camera.near(), camera.far())
-            .ok_or(RenderError::InvalidTarget)?;
+        let vp =
+            Viewport::<SUB_BITS>::new(width, height, camera.focal(), camera.near(), camera.far())
+                .ok_or(RenderError::InvalidTarget)?;
+        let (Some(depth), Some(pixels), Some(heads)) = (
+            self.depth.get_mut(..width),
+            self.pixels.get_mut(..width),
+            self.heads.get_mut(..height),
+        ) else {
+            return Err(RenderError::InvalidTarget);
+        };
         let view = View::<P, S> {
-            depth: &mut self.depth,
-            pixels: &mut self.pixels,
+            depth,
+            pixels,
             background: self.background,
-            heads: &mut self.heads,
+            heads,
             next: &mut self.next,
             refs: &mut self.refs,
             active: self.active.as_mut_view(),

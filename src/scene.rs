@@ -526,6 +526,23 @@ impl Camera {
     pub fn near(&self) -> f32 {
         self.near
     }
+
+    /// Eye distance (along the view axis) of a stored depth `q`, or `None` for background
+    /// (`q <= 0`). Depth is `q = near / w` with `near` rounded to I16F16, as the renderer uses
+    /// it, so this inverts it exactly up to the format's resolution.
+    ///
+    /// ```
+    /// use scanline3d::{scene::Camera, Depth};
+    /// let cam = Camera::look_at([0.0, 0.0, 5.0], [0.0; 3], [0.0, 1.0, 0.0])?.perspective(60.0, 0.5, 50.0)?;
+    /// assert_eq!(cam.eye_distance(Depth::from_num(0.25)), Some(2.0));
+    /// assert_eq!(cam.eye_distance(Depth::ZERO), None);
+    /// # Ok::<(), scanline3d::scene::SceneError>(())
+    /// ```
+    pub fn eye_distance(&self, q: crate::project::Depth) -> Option<f32> {
+        let near = I16F16::saturating_from_num(self.near).to_num::<f64>();
+        let q = q.to_num::<f64>();
+        (q > 0.0).then(|| (near / q) as f32)
+    }
     /// Far-plane eye distance.
     pub fn far(&self) -> f32 {
         self.far

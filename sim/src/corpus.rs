@@ -1,0 +1,386 @@
+//! The scene corpus: generated meshes with the cameras the accuracy tests use.
+//!
+//! `sim corpus --out DIR` writes every mesh as OBJ for use with `sim render`; the committed copies
+//! under `sim/corpus/` are checked against this generator by a test.
+
+use crate::scene::{CameraSpec, MeshData};
+use embedded_graphics::pixelcolor::Rgb888;
+use std::f64::consts::TAU;
+
+/// One corpus scene.
+#[derive(Clone, Debug)]
+pub struct CorpusScene {
+    /// Short name (also the OBJ file name).
+    pub name: &'static str,
+    /// What it exercises.
+    pub about: &'static str,
+    /// The mesh.
+    pub mesh: MeshData,
+    /// Cameras to render it from.
+    pub cameras: Vec<CameraSpec>,
+    /// Whether back faces are culled (closed meshes) or drawn (open surfaces).
+    pub cull_back_faces: bool,
+}
+
+fn cam(eye: [f64; 3], target: [f64; 3], fovy: f64, near: f64, far: f64) -> CameraSpec {
+    CameraSpec {
+        eye,
+        target,
+        up: [0.0, 1.0, 0.0],
+        fovy,
+        near,
+        far,
+    }
+}
+
+/// Distinct, readable colours per triangle.
+fn palette(n: usize) -> Vec<Rgb888> {
+    (0..n)
+        .map(|i| {
+            let h = (i as f64 * 0.618_033_988_75).fract();
+            let c = |o: f64| (140.0 + 100.0 * (TAU * (h + o)).cos()).clamp(0.0, 255.0) as u8;
+            Rgb888::new(c(0.0), c(1.0 / 3.0), c(2.0 / 3.0))
+        })
+        .collect()
+}
+
+fn mesh(positions: &[[f64; 3]], triangles: Vec<[u16; 3]>) -> MeshData {
+    let n = triangles.len();
+    let mut m = MeshData::new(positions, triangles, Rgb888::new(200, 200, 200))
+        .expect("corpus meshes are valid");
+    m.colors = palette(n);
+    m
+}
+
+fn cube() -> MeshData {
+    let v: Vec<[f64; 3]> = (0..8)
+        .map(|i: usize| {
+            let (x, y) = ([-1.0, 1.0, 1.0, -1.0][i % 4], [-1.0, -1.0, 1.0, 1.0][i % 4]);
+            [x, y, if i < 4 { -1.0 } else { 1.0 }]
+        })
+        .collect();
+    let f = vec![
+        [4, 5, 6],
+        [4, 6, 7],
+        [1, 0, 3],
+        [1, 3, 2],
+        [5, 1, 2],
+        [5, 2, 6],
+        [0, 4, 7],
+        [0, 7, 3],
+        [7, 6, 2],
+        [7, 2, 3],
+        [0, 1, 5],
+        [0, 5, 4],
+    ];
+    mesh(&v, f)
+}
+
+fn normalize(p: [f64; 3]) -> [f64; 3] {
+    let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+    p.map(|c| c / l)
+}
+
+/// Unit icosphere with `20 · 4^n` triangles.
+pub fn icosphere(n: u32) -> MeshData {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut v: Vec<[f64; 3]> = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ]
+    .into_iter()
+    .map(normalize)
+    .collect();
+    let mut f: Vec<[u16; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..n {
+        let mut cache = std::collections::HashMap::new();
+        let mut next = Vec::new();
+        for [a, b, c] in f {
+            let mut mid = |x: u16, y: u16| {
+                *cache.entry((x.min(y), x.max(y))).or_insert_with(|| {
+                    let (p, q) = (v[x as usize], v[y as usize]);
+                    v.push(normalize([0, 1, 2].map(|k| (p[k] + q[k]) / 2.0)));
+                    (v.len() - 1) as u16
+                })
+            };
+            let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        f = next;
+    }
+    mesh(&v, f)
+}
+
+/// An `n × n` grid of quads over [-4, 4]² with smooth hills, facing +y.
+fn heightfield(n: usize) -> MeshData {
+    let mut v = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, z) = (
+                -4.0 + 8.0 * i as f64 / n as f64,
+                -4.0 + 8.0 * j as f64 / n as f64,
+            );
+            let y = 0.6 * (0.9 * x).sin() * (0.7 * z).cos() + 0.25 * (2.3 * x + 1.1 * z).sin();
+            v.push([x, y, z]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u16;
+    let mut f = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            f.push([id(i, j), id(i, j + 1), id(i + 1, j + 1)]);
+            f.push([id(i, j), id(i + 1, j + 1), id(i + 1, j)]);
+        }
+    }
+    mesh(&v, f)
+}
+
+/// A chess pawn, modelled by revolving a profile (radius, height) around the y axis.
+fn pawn() -> MeshData {
+    let profile = [
+        (0.0, 0.0),
+        (0.9, 0.0),
+        (0.9, 0.12),
+        (0.75, 0.2),
+        (0.78, 0.32),
+        (0.55, 0.4),
+        (0.42, 0.6),
+        (0.32, 1.0),
+        (0.26, 1.35),
+        (0.5, 1.42),
+        (0.5, 1.5),
+        (0.24, 1.56),
+        (0.34, 1.68),
+        (0.42, 1.85),
+        (0.4, 2.0),
+        (0.32, 2.14),
+        (0.18, 2.24),
+        (0.0, 2.28),
+    ];
+    let segments = 28;
+    let mut v = Vec::new();
+    for &(r, y) in &profile {
+        for s in 0..segments {
+            let a = TAU * s as f64 / segments as f64;
+            v.push([r * a.cos(), y - 1.1, -r * a.sin()]);
+        }
+    }
+    let id = |ring: usize, s: usize| (ring * segments + s % segments) as u16;
+    let mut f = Vec::new();
+    for ring in 0..profile.len() - 1 {
+        for s in 0..segments {
+            let (a, b, c, d) = (
+                id(ring, s),
+                id(ring, s + 1),
+                id(ring + 1, s + 1),
+                id(ring + 1, s),
+            );
+            // Counter-clockwise from outside; skip the degenerate halves at the poles.
+            if profile[ring].0 > 0.0 {
+                f.push([a, b, c]);
+            }
+            if profile[ring + 1].0 > 0.0 {
+                f.push([a, c, d]);
+            }
+        }
+    }
+    mesh(&v, f)
+}
+
+/// Every corpus scene with its cameras.
+pub fn all() -> Vec<CorpusScene> {
+    let orbit = |r: f64, y: f64, n: usize, fovy: f64| -> Vec<CameraSpec> {
+        (0..n)
+            .map(|k| {
+                let a = 0.4 + TAU * k as f64 / n as f64;
+                cam([r * a.sin(), y, r * a.cos()], [0.0; 3], fovy, 0.1, 50.0)
+            })
+            .collect()
+    };
+    // Two triangles crossing each other along x = 0.
+    let crossing = mesh(
+        &[
+            [-1.5, -1.0, -0.8],
+            [1.5, -1.0, 0.8],
+            [0.0, 1.2, 0.0],
+            [-1.5, 1.0, 0.8],
+            [0.0, -1.2, 0.0],
+            [1.5, 1.0, -0.8],
+        ],
+        vec![[0, 1, 2], [3, 4, 5]],
+    );
+    // A ground fan the camera stands on, and a wall triangle with vertices behind the eye.
+    let near_plane = mesh(
+        &[
+            [-20.0, 0.0, 20.0],
+            [20.0, 0.0, 20.0],
+            [20.0, 0.0, -20.0],
+            [-20.0, 0.0, -20.0],
+            [0.0, 0.0, 1.0],
+            [-3.0, -0.5, 4.0],
+            [3.0, -0.5, 4.0],
+            [0.0, 3.0, -6.0],
+        ],
+        vec![[4, 0, 1], [4, 1, 2], [4, 2, 3], [4, 3, 0], [5, 6, 7]],
+    );
+    // 240 slivers fanning out from the centre (aspect ratio about 60).
+    let n = 240;
+    let mut fan = vec![[0.0, 0.0, 0.0]];
+    fan.extend((0..n).map(|k| {
+        let a = TAU * k as f64 / n as f64;
+        [2.0 * a.cos(), 2.0 * a.sin(), 0.0]
+    }));
+    let slivers = mesh(
+        &fan,
+        (0..n)
+            .map(|k| [0, 1 + k as u16, 1 + ((k + 1) % n) as u16])
+            .collect(),
+    );
+    // Overlapping coplanar triangles in z = 0 (z-fighting by construction).
+    let coplanar = mesh(
+        &[
+            [-1.5, -1.0, 0.0],
+            [1.0, -1.2, 0.0],
+            [0.2, 1.4, 0.0],
+            [-1.0, 0.8, 0.0],
+            [-0.6, -1.4, 0.0],
+            [1.6, 0.4, 0.0],
+        ],
+        vec![[0, 1, 2], [3, 4, 5]],
+    );
+    vec![
+        CorpusScene {
+            name: "cube",
+            about: "closed box, 12 triangles",
+            mesh: cube(),
+            cameras: orbit(4.5, 2.0, 3, 50.0),
+            cull_back_faces: true,
+        },
+        CorpusScene {
+            name: "icosphere",
+            about: "1280-triangle sphere",
+            mesh: icosphere(3),
+            cameras: orbit(3.2, 1.0, 3, 55.0),
+            cull_back_faces: true,
+        },
+        CorpusScene {
+            name: "interpenetrating",
+            about: "two triangles crossing each other",
+            mesh: crossing,
+            cameras: vec![
+                cam([0.3, 0.2, 4.0], [0.0; 3], 50.0, 0.5, 20.0),
+                cam([-2.5, 1.5, 3.0], [0.0; 3], 45.0, 0.5, 20.0),
+            ],
+            cull_back_faces: false,
+        },
+        CorpusScene {
+            name: "heightfield",
+            about: "10,082-triangle terrain",
+            mesh: heightfield(71),
+            cameras: vec![
+                cam([0.0, 4.0, 7.0], [0.0, -0.5, 0.0], 55.0, 0.2, 40.0),
+                cam([6.0, 1.5, 3.0], [-1.0, 0.0, -1.0], 60.0, 0.2, 40.0),
+            ],
+            cull_back_faces: true,
+        },
+        CorpusScene {
+            name: "near-plane",
+            about: "triangles crossing the near plane, vertices behind the eye",
+            mesh: near_plane,
+            cameras: vec![
+                cam([0.0, 1.0, 2.0], [0.0, 0.0, -3.0], 70.0, 0.2, 60.0),
+                cam([0.5, 0.6, 0.5], [0.0, 0.4, -5.0], 80.0, 0.1, 60.0),
+            ],
+            cull_back_faces: false,
+        },
+        CorpusScene {
+            name: "slivers",
+            about: "240 slivers meeting at one vertex",
+            mesh: slivers,
+            cameras: vec![
+                cam([0.0, 0.0, 4.0], [0.0; 3], 60.0, 0.5, 20.0),
+                cam([1.0, 1.5, 3.5], [0.0; 3], 50.0, 0.5, 20.0),
+            ],
+            cull_back_faces: false,
+        },
+        CorpusScene {
+            name: "coplanar",
+            about: "overlapping triangles in one plane (exact depth ties)",
+            mesh: coplanar,
+            // Squarely facing cameras (rolled and moved): every vertex has the same depth, so
+            // the tie is exact in both renderers and the documented rule decides.
+            cameras: vec![
+                cam([0.0, 0.0, 4.0], [0.0; 3], 60.0, 0.5, 20.0),
+                CameraSpec {
+                    eye: [0.4, -0.2, 3.0],
+                    target: [0.4, -0.2, 0.0],
+                    up: [0.5, 1.0, 0.0],
+                    fovy: 70.0,
+                    near: 0.5,
+                    far: 20.0,
+                },
+            ],
+            cull_back_faces: false,
+        },
+        CorpusScene {
+            name: "pawn",
+            about: "modelled chess pawn (surface of revolution)",
+            mesh: pawn(),
+            cameras: orbit(4.0, 1.2, 3, 50.0),
+            cull_back_faces: true,
+        },
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn corpus_sizes() {
+        let all = all();
+        let count = |name: &str| {
+            all.iter()
+                .find(|s| s.name == name)
+                .unwrap()
+                .mesh
+                .triangles
+                .len()
+        };
+        assert_eq!(count("icosphere"), 1280);
+        assert!(count("heightfield") >= 10_000);
+        assert_eq!(count("slivers"), 240);
+        assert!(all.iter().all(|s| s.cameras.len() >= 2));
+    }
+}

@@ -1,0 +1,416 @@
+//! Scene specifications shared by the fixed-point renderer and the float reference: owned mesh
+//! data, camera and light parameters, OBJ loading, and rendering to id/depth/colour images.
+
+use crate::reference::{self, Image};
+use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
+use fixed::types::I16F16;
+use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
+use scanline3d::sink::{FnSink, Row, TriangleId};
+use scanline3d::{Depth, Flat, FrameStats, RenderOptions, Workspace};
+use std::path::Path;
+
+/// Camera parameters (`gluLookAt` + `gluPerspective`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraSpec {
+    /// Eye position.
+    pub eye: [f64; 3],
+    /// Point looked at.
+    pub target: [f64; 3],
+    /// Up direction.
+    pub up: [f64; 3],
+    /// Vertical field of view in degrees.
+    pub fovy: f64,
+    /// Near plane.
+    pub near: f64,
+    /// Far plane.
+    pub far: f64,
+}
+
+/// Light parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSpec {
+    /// Towards the light (any length).
+    pub direction: [f64; 3],
+    /// Ambient intensity.
+    pub ambient: f64,
+    /// Diffuse intensity.
+    pub diffuse: f64,
+}
+
+impl Default for LightSpec {
+    fn default() -> Self {
+        LightSpec {
+            direction: [-0.45, 0.8, 0.55],
+            ambient: 0.25,
+            diffuse: 0.75,
+        }
+    }
+}
+
+/// Owned mesh data in the renderer's input format.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshData {
+    /// I16F16 model coordinates.
+    pub vertices: Vec<Vertex>,
+    /// Triangles.
+    pub triangles: Vec<[u16; 3]>,
+    /// One colour per triangle.
+    pub colors: Vec<Rgb888>,
+}
+
+impl MeshData {
+    /// Mesh from f64 positions (rounded to I16F16) and triangles, with a uniform colour.
+    pub fn new(
+        positions: &[[f64; 3]],
+        triangles: Vec<[u16; 3]>,
+        color: Rgb888,
+    ) -> Result<Self, String> {
+        let vertices = positions
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let c = |v: f64| {
+                    I16F16::checked_from_num(v).ok_or_else(|| {
+                        format!("vertex {i} coordinate {v} is not a finite number in range")
+                    })
+                };
+                Ok([c(p[0])?, c(p[1])?, c(p[2])?])
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        let colors = vec![color; triangles.len()];
+        let data = MeshData {
+            vertices,
+            triangles,
+            colors,
+        };
+        data.mesh()?;
+        Ok(data)
+    }
+
+    /// The library's view of this data (validated).
+    pub fn mesh(&self) -> Result<Mesh<'_>, String> {
+        Mesh::new(
+            &self.vertices,
+            &self.triangles,
+            MeshColors::PerFace(&self.colors),
+            None,
+        )
+        .map_err(|e| e.to_string())
+    }
+
+    /// World-space f64 triangles (identity model transform).
+    pub fn world_triangles(&self) -> Vec<reference::Triangle> {
+        let p = |i: u16| self.vertices[i as usize].map(|c| c.to_num::<f64>());
+        self.triangles
+            .iter()
+            .zip(&self.colors)
+            .map(|(t, c)| reference::Triangle {
+                v: t.map(p),
+                color: [c.r(), c.g(), c.b()].map(f64::from),
+            })
+            .collect()
+    }
+
+    /// Loads an OBJ file: all objects in file order, polygons fan-triangulated
+    /// (a b c d -> (a,b,c), (a,c,d)), so triangle ids follow the file's face order.
+    pub fn load_obj(path: &Path) -> Result<Self, String> {
+        let opts = tobj::LoadOptions {
+            triangulate: true,
+            single_index: false,
+            ..Default::default()
+        };
+        let (models, _) =
+            tobj::load_obj(path, &opts).map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        for m in &models {
+            let base = positions.len();
+            let mesh = &m.mesh;
+            if mesh.positions.len() % 3 != 0 || mesh.indices.len() % 3 != 0 {
+                return Err(format!("{}: malformed mesh '{}'", path.display(), m.name));
+            }
+            positions.extend(
+                mesh.positions
+                    .chunks(3)
+                    .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64]),
+            );
+            for t in mesh.indices.chunks(3) {
+                let idx = |k: usize| -> Result<u16, String> {
+                    let i = base + t[k] as usize;
+                    if i >= positions.len() {
+                        return Err(format!(
+                            "{}: face index {} out of range",
+                            path.display(),
+                            t[k] + 1
+                        ));
+                    }
+                    u16::try_from(i)
+                        .map_err(|_| format!("{}: more than 65535 vertices", path.display()))
+                };
+                triangles.push([idx(0)?, idx(1)?, idx(2)?]);
+            }
+        }
+        if triangles.is_empty() {
+            return Err(format!("{}: no faces", path.display()));
+        }
+        MeshData::new(&positions, triangles, Rgb888::new(205, 200, 190))
+            .map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    /// Writes the mesh as OBJ (one `v` per vertex, one `f` per triangle).
+    pub fn to_obj(&self) -> String {
+        let mut s = String::new();
+        for v in &self.vertices {
+            s += &format!("v {} {} {}\n", v[0], v[1], v[2]);
+        }
+        for t in &self.triangles {
+            s += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+        }
+        s
+    }
+}
+
+/// A mesh, a camera and a light: what `sim render` takes.
+#[derive(Clone, Debug)]
+pub struct SceneSpec {
+    /// The mesh (identity transform).
+    pub mesh: MeshData,
+    /// The camera.
+    pub camera: CameraSpec,
+    /// The light.
+    pub light: LightSpec,
+    /// Back-face culling.
+    pub cull_back_faces: bool,
+}
+
+fn f32s(v: [f64; 3]) -> [f32; 3] {
+    v.map(|c| c as f32)
+}
+
+impl CameraSpec {
+    /// The library camera.
+    pub fn fixed(&self) -> Result<Camera, String> {
+        Camera::look_at(f32s(self.eye), f32s(self.target), f32s(self.up))
+            .and_then(|v| v.perspective(self.fovy as f32, self.near as f32, self.far as f32))
+            .map_err(|e| e.to_string())
+    }
+    /// The reference camera.
+    pub fn reference(&self) -> Result<reference::Camera, String> {
+        reference::Camera::new(
+            self.eye,
+            self.target,
+            self.up,
+            self.fovy,
+            self.near,
+            self.far,
+        )
+        .ok_or_else(|| "degenerate camera".to_string())
+    }
+}
+
+impl LightSpec {
+    fn fixed(&self) -> Result<Light, String> {
+        Light::new(
+            f32s(self.direction),
+            self.ambient as f32,
+            self.diffuse as f32,
+        )
+        .map_err(|e| e.to_string())
+    }
+    fn reference(&self) -> Result<reference::Light, String> {
+        let direction = reference::normalize(self.direction).ok_or("light direction is zero")?;
+        Ok(reference::Light {
+            direction,
+            ambient: self.ambient,
+            diffuse: self.diffuse,
+        })
+    }
+}
+
+/// Sub-pixel precision choices `sim` offers (the library takes them as a const generic).
+pub const SUB_PIXEL_CHOICES: [u32; 4] = [0, 2, 4, 8];
+
+/// A fixed-point render: images plus frame statistics.
+#[derive(Clone, Debug)]
+pub struct FixedRender {
+    /// ids, eye depth and colour.
+    pub image: Image,
+    /// Statistics of the colour pass.
+    pub stats: FrameStats,
+}
+
+/// Largest target `sim` renders (the library's limit).
+pub const MAX_SIZE: usize = 2048;
+type ColorWs = Workspace<Rgb888, Flat, MAX_SIZE, MAX_SIZE, 65534, 4096>;
+type IdWs = Workspace<TriangleId, Flat, MAX_SIZE, MAX_SIZE, 65534, 4096>;
+
+fn render_pass<P: scanline3d::sink::RowPixel, const S: u32, const T: usize, const A: usize>(
+    ws: &mut Workspace<P, Flat, MAX_SIZE, MAX_SIZE, T, A>,
+    scene: &Scene<'_>,
+    cull: bool,
+    w: usize,
+    h: usize,
+    mut f: impl FnMut(usize, &[P], &[Depth]),
+) -> Result<FrameStats, String> {
+    let options = RenderOptions::default()
+        .with_back_face_culling(cull)
+        .with_sub_pixel_bits::<S>();
+    let mut sink = FnSink(|row: Row<'_, P>| -> Result<(), std::convert::Infallible> {
+        f(row.y as usize, row.pixels, row.depth);
+        Ok(())
+    });
+    ws.render_sized(w, h, scene, &options, &mut sink)
+        .map_err(|e| e.to_string())
+}
+
+impl SceneSpec {
+    /// The float reference for this scene.
+    pub fn reference(&self) -> Result<reference::Scene, String> {
+        Ok(reference::Scene::new(
+            self.mesh.world_triangles(),
+            self.light.reference()?,
+            self.camera.reference()?,
+            self.cull_back_faces,
+        ))
+    }
+
+    /// Renders with the fixed-point renderer at `sub_bits` (0, 2, 4 or 8) into id, depth and
+    /// colour images (an id pass and a colour pass through the same pipeline).
+    pub fn render_fixed(&self, w: usize, h: usize, sub_bits: u32) -> Result<FixedRender, String> {
+        // The host workspaces are large (capacity for 2048×2048 and 65534 triangles) and the
+        // library builds them by value, which in debug builds goes through the stack: render on
+        // a thread with room for that.
+        std::thread::scope(|scope| {
+            std::thread::Builder::new()
+                .stack_size(64 << 20)
+                .spawn_scoped(scope, || self.render_fixed_on_this_thread(w, h, sub_bits))
+                .map_err(|e| format!("cannot start render thread: {e}"))?
+                .join()
+                .map_err(|_| "render thread panicked".to_string())?
+        })
+    }
+
+    fn render_fixed_on_this_thread(
+        &self,
+        w: usize,
+        h: usize,
+        sub_bits: u32,
+    ) -> Result<FixedRender, String> {
+        match sub_bits {
+            0 => self.render_fixed_s::<0>(w, h),
+            2 => self.render_fixed_s::<2>(w, h),
+            4 => self.render_fixed_s::<4>(w, h),
+            8 => self.render_fixed_s::<8>(w, h),
+            _ => Err(format!(
+                "sub-pixel bits must be one of {SUB_PIXEL_CHOICES:?}"
+            )),
+        }
+    }
+
+    fn render_fixed_s<const S: u32>(&self, w: usize, h: usize) -> Result<FixedRender, String> {
+        if w == 0 || h == 0 || w > MAX_SIZE || h > MAX_SIZE {
+            return Err(format!("size {w}x{h} outside 1x1..{MAX_SIZE}x{MAX_SIZE}"));
+        }
+        let mesh = self.mesh.mesh()?;
+        let instances = [Instance {
+            mesh: &mesh,
+            transform: Transform::IDENTITY,
+        }];
+        let camera = self.camera.fixed()?;
+        let scene = Scene {
+            instances: &instances,
+            camera,
+            light: self.light.fixed()?,
+        };
+        let mut image = Image {
+            width: w,
+            height: h,
+            ids: vec![-1; w * h],
+            depth: vec![f32::INFINITY; w * h],
+            color: vec![[0; 3]; w * h],
+        };
+        let mut ws: Box<ColorWs> = Box::new(Workspace::new(Rgb888::BLACK));
+        let stats = render_pass::<_, S, 65534, 4096>(
+            &mut ws,
+            &scene,
+            self.cull_back_faces,
+            w,
+            h,
+            |y, px, depth| {
+                for (x, (p, q)) in px.iter().zip(depth).enumerate() {
+                    image.color[y * w + x] = [p.r(), p.g(), p.b()];
+                    image.depth[y * w + x] = camera.eye_distance(*q).unwrap_or(f32::INFINITY);
+                }
+            },
+        )?;
+        drop(ws);
+        let mut ws: Box<IdWs> = Box::new(Workspace::new(TriangleId::NONE));
+        render_pass::<_, S, 65534, 4096>(
+            &mut ws,
+            &scene,
+            self.cull_back_faces,
+            w,
+            h,
+            |y, px, _| {
+                for (x, id) in px.iter().enumerate() {
+                    image.ids[y * w + x] = id.0;
+                }
+            },
+        )?;
+        Ok(FixedRender { image, stats })
+    }
+}
+
+/// Writes an RGB image as PNG.
+pub fn write_png(path: &Path, w: usize, h: usize, rgb: &[[u8; 3]]) -> Result<(), String> {
+    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), w as u32, h as u32);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let data: Vec<u8> = rgb.iter().flatten().copied().collect();
+    encoder
+        .write_header()
+        .and_then(|mut wr| wr.write_image_data(&data))
+        .map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Writes an id image: W×H little-endian i32, row-major from the top, −1 = background.
+pub fn write_ids(path: &Path, ids: &[i32]) -> Result<(), String> {
+    let bytes: Vec<u8> = ids.iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Writes a depth image: W×H little-endian f32 eye depth, +inf = background.
+pub fn write_depth(path: &Path, depth: &[f32]) -> Result<(), String> {
+    let bytes: Vec<u8> = depth.iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+fn read_words(path: &Path, n: usize) -> Result<Vec<[u8; 4]>, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if bytes.len() != 4 * n {
+        return Err(format!(
+            "{}: expected {} bytes for the given size, found {}",
+            path.display(),
+            4 * n,
+            bytes.len()
+        ));
+    }
+    Ok(bytes.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect())
+}
+
+/// Reads an id image of `n` pixels.
+pub fn read_ids(path: &Path, n: usize) -> Result<Vec<i32>, String> {
+    Ok(read_words(path, n)?
+        .into_iter()
+        .map(i32::from_le_bytes)
+        .collect())
+}
+
+/// Reads a depth image of `n` pixels.
+pub fn read_depth(path: &Path, n: usize) -> Result<Vec<f32>, String> {
+    Ok(read_words(path, n)?
+        .into_iter()
+        .map(f32::from_le_bytes)
+        .collect())
+}
