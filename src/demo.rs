@@ -86,18 +86,35 @@ pub fn instances() -> [Instance<'static>; 3] {
     ]
 }
 
-/// The camera of frame `frame` of an orbit of `frames` frames (frame 0 is the README picture).
-pub fn camera(frame: u32, frames: u32) -> Result<Camera, SceneError> {
+/// The camera parameters of frame `frame` of an orbit of `frames` frames: eye, target, up,
+/// vertical field of view in degrees, near, far. (Tools that render the demo another way, such
+/// as the float reference, start from these values.)
+pub fn camera_parameters(frame: u32, frames: u32) -> ([f32; 3], [f32; 3], [f32; 3], f32, f32, f32) {
     let angle =
         0.6 + core::f32::consts::TAU * (frame % frames.max(1)) as f32 / frames.max(1) as f32;
     let (s, c) = (libm::sinf(angle), libm::cosf(angle));
-    Camera::look_at([4.2 * s, 1.5, 4.2 * c], [0.3, -0.25, 0.0], [0.0, 1.0, 0.0])?
-        .perspective(50.0, 0.5, 20.0)
+    (
+        [4.2 * s, 1.5, 4.2 * c],
+        [0.3, -0.25, 0.0],
+        [0.0, 1.0, 0.0],
+        50.0,
+        0.5,
+        20.0,
+    )
 }
+
+/// The camera of frame `frame` of an orbit of `frames` frames (frame 0 is the README picture).
+pub fn camera(frame: u32, frames: u32) -> Result<Camera, SceneError> {
+    let (eye, target, up, fovy, near, far) = camera_parameters(frame, frames);
+    Camera::look_at(eye, target, up)?.perspective(fovy, near, far)
+}
+
+/// The demo light's parameters: towards the light, ambient, diffuse.
+pub const LIGHT: ([f32; 3], f32, f32) = ([-0.45, 0.8, 0.55], 0.25, 0.75);
 
 /// The demo light: from the upper left front, 25 % ambient.
 pub fn light() -> Result<Light, SceneError> {
-    Light::new([-0.45, 0.8, 0.55], 0.25, 0.75)
+    Light::new(LIGHT.0, LIGHT.1, LIGHT.2)
 }
 
 /// The demo scene at `frame` of an orbit of `frames` frames.

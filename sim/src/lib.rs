@@ -20,16 +20,9 @@ pub fn accuracy(
     let fixed = spec.render_fixed(w, h, sub_bits)?;
     let reference = spec.reference()?;
     let ref_image = reference.render(w, h);
-    let max_model_coord = spec
-        .mesh
-        .vertices
-        .iter()
-        .flatten()
-        .map(|c| c.to_num::<f64>().abs())
-        .fold(0.0, f64::max);
     let bound = ErrorBound {
         sub_bits,
-        max_model_coord,
+        max_model_coord: spec.max_model_coord(),
         focal_px: reference.camera.focal_px(h),
     };
     let m = metrics::compare(&fixed.image, &ref_image, &reference, &bound);

@@ -1,161 +1,410 @@
-//! `sim`: renders scenes on the host exactly as the firmware does and writes the result to PNG.
+//! `sim`: renders scenes on the host exactly as the firmware does, compares with the float
+//! reference, and writes PNG, id and depth images.
 //!
-//! With no arguments it renders frame 0 of the built-in demo scene (the same data and camera the
-//! firmware uses) to `frame.png` and prints the frame statistics.
+//! With no subcommand it renders frame 0 of the built-in demo scene (the firmware's data and
+//! camera) to `frame.png`, compares it with the reference and prints a short report.
 
-use clap::{Parser, ValueEnum};
-use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
-use embedded_graphics::prelude::*;
-use scanline3d::sink::DrawTargetSink;
-use scanline3d::{demo, FrameStats, RenderOptions, Workspace};
-use std::path::PathBuf;
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use scanline3d_sim::metrics::{self, ErrorBound};
+use scanline3d_sim::reference::Image;
+use scanline3d_sim::scene::{self, CameraSpec, LightSpec, MeshData, SceneSpec};
+use scanline3d_sim::{accuracy, corpus};
+use std::io::Write;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
-enum ShadingArg {
-    Flat,
-    Gouraud,
+/// Prints a line to stdout, ignoring write errors (a closed pipe, as in `sim corpus | head`,
+/// must not turn into a panic).
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
 }
 
-/// Render the built-in demo scene to a PNG, exactly as the firmware renders it.
 #[derive(Parser, Debug)]
-#[command(name = "sim", version)]
-struct Args {
+#[command(
+    name = "sim",
+    version,
+    about = "Render scenes as the scanline3d firmware does; compare with the f64 reference"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Output PNG of the default demo render.
+    #[arg(long, default_value = "frame.png")]
+    out: PathBuf,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render an OBJ scene to PNG (and optionally id, depth and statistics files).
+    Render(RenderArgs),
+    /// Compare two id/depth image pairs, or re-render a scene with both renderers and compare.
+    Compare(CompareArgs),
+    /// Write the scene corpus as OBJ files (and list its cameras).
+    Corpus {
+        /// Output directory.
+        #[arg(long, default_value = "corpus")]
+        out: PathBuf,
+    },
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq)]
+enum Renderer {
+    Fixed,
+    Reference,
+}
+
+fn vec3(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != 3 {
+        return Err(format!("expected X,Y,Z, got '{s}'"));
+    }
+    let mut v = [0.0; 3];
+    for (out, p) in v.iter_mut().zip(parts) {
+        *out = p
+            .trim()
+            .parse::<f64>()
+            .map_err(|_| format!("'{p}' is not a number"))?;
+        if !out.is_finite() {
+            return Err(format!("'{p}' is not a finite number"));
+        }
+    }
+    Ok(v)
+}
+
+fn finite(s: &str) -> Result<f64, String> {
+    let v = s
+        .parse::<f64>()
+        .map_err(|_| format!("'{s}' is not a number"))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("'{s}' is not a finite number"))
+    }
+}
+
+fn size(s: &str) -> Result<(usize, usize), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WxH, got '{s}'"))?;
+    let parse = |v: &str| {
+        v.parse::<usize>()
+            .map_err(|_| format!("'{v}' is not a size"))
+    };
+    let (w, h) = (parse(w)?, parse(h)?);
+    if w == 0 || h == 0 || w > scene::MAX_SIZE || h > scene::MAX_SIZE {
+        return Err(format!(
+            "size {w}x{h} must be between 1x1 and {0}x{0}",
+            scene::MAX_SIZE
+        ));
+    }
+    Ok((w, h))
+}
+
+/// Camera, size and render settings shared by `render` and `compare --scene`.
+#[derive(Args, Debug, Clone)]
+struct View {
+    /// Eye position X,Y,Z (negative numbers are fine: --eye -3,2,1).
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true, default_value = "3,2,4")]
+    eye: [f64; 3],
+    /// Point looked at.
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true, default_value = "0,0,0")]
+    target: [f64; 3],
+    /// Up direction.
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true, default_value = "0,1,0")]
+    up: [f64; 3],
+    /// Vertical field of view in degrees.
+    #[arg(long, value_parser = finite, default_value = "50")]
+    fov: f64,
+    /// Near plane distance.
+    #[arg(long, value_parser = finite, default_value = "0.1")]
+    near: f64,
+    /// Far plane distance.
+    #[arg(long, value_parser = finite, default_value = "100")]
+    far: f64,
+    /// Image size WxH.
+    #[arg(long, value_parser = size, default_value = "240x240")]
+    size: (usize, usize),
+    /// Sub-pixel bits of the fixed-point renderer: 0, 2, 4 (default) or 8.
+    #[arg(long, default_value_t = 4)]
+    sub_pixel_bits: u32,
+    /// Draw back faces too (open surfaces).
+    #[arg(long)]
+    no_cull: bool,
+}
+
+#[derive(Args, Debug)]
+struct RenderArgs {
+    /// The OBJ scene (polygons fan-triangulated in file order).
+    scene: PathBuf,
+    #[command(flatten)]
+    view: View,
     /// Output PNG.
     #[arg(long, default_value = "frame.png")]
     out: PathBuf,
-    /// Frame of the camera orbit to render (0 = the README picture).
-    #[arg(long, default_value_t = 0)]
-    frame: u32,
-    /// Shading model.
-    #[arg(long, value_enum, default_value = "flat")]
-    shading: ShadingArg,
+    /// Triangle id image (W×H little-endian i32, −1 = background).
+    #[arg(long)]
+    ids: Option<PathBuf>,
+    /// Depth image (W×H little-endian f32 eye depth, +inf = background).
+    #[arg(long)]
+    depth: Option<PathBuf>,
+    /// Statistics as JSON.
+    #[arg(long)]
+    stats: Option<PathBuf>,
+    /// Which renderer.
+    #[arg(long, value_enum, default_value = "fixed")]
+    renderer: Renderer,
 }
 
-/// An RGB image as an embedded-graphics draw target: the same `DrawTarget` path a display uses.
-struct Image {
-    width: usize,
-    height: usize,
-    pixels: Vec<Rgb888>,
+#[derive(Args, Debug)]
+struct CompareArgs {
+    /// Id and depth files of render A, then of render B: A.ids A.depth B.ids B.depth.
+    files: Vec<PathBuf>,
+    /// Instead of files: render this OBJ scene with both renderers and compare, classifying
+    /// every mismatch.
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    #[command(flatten)]
+    view: View,
+    /// With --scene: write fixed | reference | mismatches side by side to this PNG.
+    #[arg(long)]
+    side_by_side: Option<PathBuf>,
 }
 
-impl Image {
-    fn new(width: usize, height: usize) -> Self {
-        Image {
-            width,
-            height,
-            pixels: vec![Rgb888::BLACK; width * height],
-        }
-    }
-
-    fn write_png(&self, path: &std::path::Path) -> Result<(), String> {
-        let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let mut encoder = png::Encoder::new(
-            std::io::BufWriter::new(file),
-            self.width as u32,
-            self.height as u32,
-        );
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        let data: Vec<u8> = self
-            .pixels
-            .iter()
-            .flat_map(|p| [p.r(), p.g(), p.b()])
-            .collect();
-        encoder
-            .write_header()
-            .and_then(|mut w| w.write_image_data(&data))
-            .map_err(|e| format!("{}: {e}", path.display()))
-    }
-}
-
-impl OriginDimensions for Image {
-    fn size(&self) -> Size {
-        Size::new(self.width as u32, self.height as u32)
-    }
-}
-
-impl DrawTarget for Image {
-    type Color = Rgb888;
-    type Error = std::convert::Infallible;
-    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(
-        &mut self,
-        pixels: I,
-    ) -> Result<(), Self::Error> {
-        for Pixel(p, c) in pixels {
-            if p.x >= 0 && p.y >= 0 && (p.x as usize) < self.width && (p.y as usize) < self.height {
-                self.pixels[p.y as usize * self.width + p.x as usize] = c;
-            }
-        }
-        Ok(())
-    }
-}
-
-const W: usize = demo::WIDTH;
-const H: usize = demo::HEIGHT;
-/// Capacities for the demo scene (1420 triangles in, about 600 survive culling).
-const TRIS: usize = 1536;
-const ACTIVE: usize = 96;
-
-fn render<S: scanline3d::Shading>(
-    frame: u32,
-    image: &mut Image,
-) -> Result<(FrameStats, usize), String> {
-    let instances = demo::instances();
-    let scene = demo::scene(&instances, frame, demo::ORBIT_FRAMES).map_err(|e| e.to_string())?;
-    let mut ws: Box<Workspace<Rgb888, S, W, H, TRIS, ACTIVE>> =
-        Box::new(Workspace::new(demo::BACKGROUND));
-    let stats = ws
-        .render(
-            &scene,
-            &RenderOptions::default(),
-            &mut DrawTargetSink::new(image),
-        )
-        .map_err(|e| e.to_string())?;
-    Ok((stats, Workspace::<Rgb888, S, W, H, TRIS, ACTIVE>::BYTES))
-}
-
-fn run(args: Args) -> Result<(), String> {
-    let mut image = Image::new(W, H);
-    let (stats, bytes) = match args.shading {
-        ShadingArg::Flat => render::<scanline3d::Flat>(args.frame, &mut image)?,
-        ShadingArg::Gouraud => render::<scanline3d::Gouraud>(args.frame, &mut image)?,
+fn spec_from(path: &Path, v: &View) -> Result<SceneSpec, String> {
+    let mesh = MeshData::load_obj(path)?;
+    let camera = CameraSpec {
+        eye: v.eye,
+        target: v.target,
+        up: v.up,
+        fovy: v.fov,
+        near: v.near,
+        far: v.far,
     };
-    image.write_png(&args.out)?;
-    println!(
-        "wrote {} ({W}x{H}, demo frame {}, {:?} shading)",
-        args.out.display(),
-        args.frame,
-        args.shading
-    );
-    println!(
-        "triangles: {} in, {} culled, {} clipped, {} rejected, {} drawn (peak {} active per row)",
-        stats.triangles_in,
-        stats.culled,
-        stats.clipped,
-        stats.rejected,
-        stats.activated,
-        stats.peak_active
-    );
-    println!(
-        "pixels: {} spans, {} fragments, {} written; renderer RAM {bytes} bytes{}",
-        stats.spans,
-        stats.fragments,
-        stats.pixels_written,
-        if stats.is_complete() {
-            ""
-        } else {
-            " (INCOMPLETE: active list overflowed)"
+    // Validate the camera with the library's rules (one clear message instead of a bad image).
+    camera.fixed()?;
+    Ok(SceneSpec::single(
+        mesh,
+        camera,
+        LightSpec::default(),
+        !v.no_cull,
+    ))
+}
+
+fn render(a: RenderArgs) -> Result<(), String> {
+    let spec = spec_from(&a.scene, &a.view)?;
+    let (w, h) = a.view.size;
+    let (image, stats_json) = match a.renderer {
+        Renderer::Fixed => {
+            let r = spec.render_fixed(w, h, a.view.sub_pixel_bits)?;
+            let s = r.stats;
+            let json = format!(
+                "{{\"renderer\": \"fixed\", \"sub_pixel_bits\": {}, \"width\": {w}, \"height\": {h}, \"triangles_in\": {}, \"culled\": {}, \"clipped\": {}, \"rejected\": {}, \"drawn\": {}, \"spans\": {}, \"fragments\": {}, \"pixels_written\": {}, \"peak_active\": {}, \"dropped\": {}}}\n",
+                a.view.sub_pixel_bits, s.triangles_in, s.culled, s.clipped, s.rejected, s.activated, s.spans, s.fragments, s.pixels_written, s.peak_active, s.dropped
+            );
+            (r.image, json)
         }
+        Renderer::Reference => {
+            let start = std::time::Instant::now();
+            let img = spec.reference()?.render(w, h);
+            let covered = img.ids.iter().filter(|&&i| i >= 0).count();
+            let json = format!(
+                "{{\"renderer\": \"reference\", \"width\": {w}, \"height\": {h}, \"triangles_in\": {}, \"covered_pixels\": {covered}, \"seconds\": {:.3}}}\n",
+                spec.instances.iter().map(|i| i.mesh.triangles.len()).sum::<usize>(),
+                start.elapsed().as_secs_f64()
+            );
+            (img, json)
+        }
+    };
+    scene::write_png(&a.out, w, h, &image.color)?;
+    say!("wrote {}", a.out.display());
+    if let Some(p) = &a.ids {
+        scene::write_ids(p, &image.ids)?;
+        say!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.depth {
+        scene::write_depth(p, &image.depth)?;
+        say!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.stats {
+        std::fs::write(p, &stats_json).map_err(|e| format!("{}: {e}", p.display()))?;
+        say!("wrote {}", p.display());
+    }
+    let _ = std::io::stdout().write_all(stats_json.as_bytes());
+    Ok(())
+}
+
+/// fixed | reference | mismatch map (red: real, yellow: explained) as one PNG.
+fn side_by_side(path: &Path, fixed: &Image, reference: &Image) -> Result<(), String> {
+    let (w, h) = (fixed.width, fixed.height);
+    let mut out = vec![[255u8; 3]; (3 * w + 8) * h];
+    let stride = 3 * w + 8;
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            out[y * stride + x] = fixed.color[i];
+            out[y * stride + w + 4 + x] = reference.color[i];
+            let grey = (reference.color[i].iter().map(|&c| c as u32).sum::<u32>() / 6) as u8;
+            out[y * stride + 2 * w + 8 + x] = if fixed.ids[i] != reference.ids[i] {
+                [255, 200, 0]
+            } else {
+                [grey; 3]
+            };
+        }
+    }
+    scene::write_png(path, stride, h, &out)
+}
+
+fn compare(a: CompareArgs) -> Result<(), String> {
+    let (w, h) = a.view.size;
+    if let Some(path) = &a.scene {
+        let spec = spec_from(path, &a.view)?;
+        let (m, fixed, reference) = accuracy(&spec, w, h, a.view.sub_pixel_bits)?;
+        say!(
+            "{} at {w}x{h}, {} sub-pixel bits, fixed-point vs f64 reference:",
+            path.display(),
+            a.view.sub_pixel_bits
+        );
+        say!("{m}");
+        if let Some(p) = &a.side_by_side {
+            side_by_side(p, &fixed.image, &reference)?;
+            say!("wrote {}", p.display());
+        }
+        return Ok(());
+    }
+    let [a_ids, a_depth, b_ids, b_depth] = a.files.as_slice() else {
+        return Err("compare needs A.ids A.depth B.ids B.depth (or --scene SCENE.obj)".into());
+    };
+    let n = w * h;
+    let load = |ids: &Path, depth: &Path| -> Result<Image, String> {
+        Ok(Image {
+            width: w,
+            height: h,
+            ids: scene::read_ids(ids, n)?,
+            depth: scene::read_depth(depth, n)?,
+            color: vec![[0; 3]; n],
+        })
+    };
+    let (ia, ib) = (load(a_ids, a_depth)?, load(b_ids, b_depth)?);
+    let m = metrics::compare_images(&ia, &ib);
+    say!(
+        "{w}x{h} pixels: {} id mismatches ({:.3} %), {} coverage mismatches",
+        m.id_mismatches,
+        m.id_mismatch_percent(),
+        m.coverage_mismatches
     );
+    say!(
+        "depth error where ids agree: max {:.3e}, mean {:.3e} (relative)",
+        m.depth_max_rel,
+        m.depth_mean_rel
+    );
+    say!("(classifying mismatches needs the scene: use --scene SCENE.obj with the same camera)");
+    Ok(())
+}
+
+fn write_corpus(out: &Path) -> Result<(), String> {
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    for s in corpus::all() {
+        let path = out.join(format!("{}.obj", s.name));
+        std::fs::write(&path, s.mesh.to_obj()).map_err(|e| format!("{}: {e}", path.display()))?;
+        say!(
+            "{} ({} triangles): {}",
+            path.display(),
+            s.mesh.triangles.len(),
+            s.about
+        );
+        for c in &s.cameras {
+            let v = |p: [f64; 3]| format!("{},{},{}", p[0], p[1], p[2]);
+            say!(
+                "  sim render {} --eye {} --target {} --up {} --fov {} --near {} --far {}{}",
+                path.display(),
+                v(c.eye),
+                v(c.target),
+                v(c.up),
+                c.fovy,
+                c.near,
+                c.far,
+                if s.cull_back_faces { "" } else { " --no-cull" }
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The default job: the demo frame, as the firmware renders it, and its accuracy.
+fn demo(out: &Path) -> Result<(), String> {
+    let spec = SceneSpec::demo(0)?;
+    let (w, h) = (scanline3d::demo::WIDTH, scanline3d::demo::HEIGHT);
+    let (m, fixed, _) = accuracy(&spec, w, h, 4)?;
+    scene::write_png(out, w, h, &fixed.image.color)?;
+    let s = fixed.stats;
+    say!(
+        "wrote {} ({w}x{h}, demo frame 0, flat shading, 4 sub-pixel bits)",
+        out.display()
+    );
+    say!(
+        "triangles: {} in, {} culled, {} clipped, {} rejected, {} drawn (peak {} active per row)",
+        s.triangles_in,
+        s.culled,
+        s.clipped,
+        s.rejected,
+        s.activated,
+        s.peak_active
+    );
+    say!(
+        "pixels: {} spans, {} fragments, {} written",
+        s.spans,
+        s.fragments,
+        s.pixels_written
+    );
+    say!(
+        "against the f64 reference (position bound at depth 4: {:.4} px):",
+        ErrorBound {
+            sub_bits: 4,
+            max_model_coord: spec.max_model_coord(),
+            focal_px: spec.reference()?.camera.focal_px(h)
+        }
+        .position_px(4.0)
+    );
+    say!("{m}");
     Ok(())
 }
 
 fn main() -> ExitCode {
-    match run(Args::parse()) {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e)
+            if matches!(
+                e.kind(),
+                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion
+            ) =>
+        {
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            // One line naming the problem (clap's first line), status 2.
+            let text = e.render().to_string();
+            let line = text
+                .lines()
+                .next()
+                .unwrap_or("invalid arguments")
+                .trim_start_matches("error: ");
+            let _ = writeln!(std::io::stderr(), "sim: {line}");
+            return ExitCode::from(2);
+        }
+    };
+    let result = match cli.command {
+        None => demo(&cli.out),
+        Some(Command::Render(a)) => render(a),
+        Some(Command::Compare(a)) => compare(a),
+        Some(Command::Corpus { out }) => write_corpus(&out),
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("sim: {e}");
+            let _ = writeln!(std::io::stderr(), "sim: {e}");
             ExitCode::from(2)
         }
     }

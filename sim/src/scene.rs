@@ -98,7 +98,7 @@ impl MeshData {
         .map_err(|e| e.to_string())
     }
 
-    /// World-space f64 triangles (identity model transform).
+    /// Model-space f64 triangles.
     pub fn world_triangles(&self) -> Vec<reference::Triangle> {
         let p = |i: u16| self.vertices[i as usize].map(|c| c.to_num::<f64>());
         self.triangles
@@ -129,11 +129,8 @@ impl MeshData {
             if mesh.positions.len() % 3 != 0 || mesh.indices.len() % 3 != 0 {
                 return Err(format!("{}: malformed mesh '{}'", path.display(), m.name));
             }
-            positions.extend(
-                mesh.positions
-                    .chunks(3)
-                    .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64]),
-            );
+            // Parsed as f64 (tobj's use_f64 feature), so every I16F16 coordinate round-trips.
+            positions.extend(mesh.positions.chunks(3).map(|p| [p[0], p[1], p[2]]));
             for t in mesh.indices.chunks(3) {
                 let idx = |k: usize| -> Result<u16, String> {
                     let i = base + t[k] as usize;
@@ -170,11 +167,20 @@ impl MeshData {
     }
 }
 
-/// A mesh, a camera and a light: what `sim render` takes.
+/// A mesh placed in the world.
+#[derive(Clone, Debug)]
+pub struct MeshInstance {
+    /// The mesh.
+    pub mesh: MeshData,
+    /// Model → world (the renderer composes it in f32; the reference applies it in f64).
+    pub transform: Transform,
+}
+
+/// Meshes, a camera and a light: what `sim render` takes.
 #[derive(Clone, Debug)]
 pub struct SceneSpec {
-    /// The mesh (identity transform).
-    pub mesh: MeshData,
+    /// The meshes; triangle ids number them consecutively in this order.
+    pub instances: Vec<MeshInstance>,
     /// The camera.
     pub camera: CameraSpec,
     /// The light.
@@ -264,10 +270,99 @@ fn render_pass<P: scanline3d::sink::RowPixel, const S: u32, const T: usize, cons
 }
 
 impl SceneSpec {
-    /// The float reference for this scene.
+    /// One mesh with the identity transform.
+    pub fn single(
+        mesh: MeshData,
+        camera: CameraSpec,
+        light: LightSpec,
+        cull_back_faces: bool,
+    ) -> Self {
+        SceneSpec {
+            instances: vec![MeshInstance {
+                mesh,
+                transform: Transform::IDENTITY,
+            }],
+            camera,
+            light,
+            cull_back_faces,
+        }
+    }
+
+    /// The built-in demo scene at frame `frame` of its orbit, as the firmware renders it.
+    pub fn demo(frame: u32) -> Result<Self, String> {
+        use scanline3d::demo;
+        let instances = demo::instances()
+            .iter()
+            .map(|inst| {
+                let m = inst.mesh;
+                let colors = match m.colors() {
+                    MeshColors::PerFace(c) => c.to_vec(),
+                    MeshColors::Uniform(c) => vec![c; m.triangles().len()],
+                    MeshColors::PerVertex(c) => {
+                        m.triangles().iter().map(|t| c[t[0] as usize]).collect()
+                    }
+                };
+                MeshInstance {
+                    mesh: MeshData {
+                        vertices: m.vertices().to_vec(),
+                        triangles: m.triangles().to_vec(),
+                        colors,
+                    },
+                    transform: inst.transform,
+                }
+            })
+            .collect();
+        let (eye, target, up, fovy, near, far) = demo::camera_parameters(frame, demo::ORBIT_FRAMES);
+        let f = |v: [f32; 3]| v.map(f64::from);
+        let (dir, ambient, diffuse) = demo::LIGHT;
+        Ok(SceneSpec {
+            instances,
+            camera: CameraSpec {
+                eye: f(eye),
+                target: f(target),
+                up: f(up),
+                fovy: fovy as f64,
+                near: near as f64,
+                far: far as f64,
+            },
+            light: LightSpec {
+                direction: f(dir),
+                ambient: ambient as f64,
+                diffuse: diffuse as f64,
+            },
+            cull_back_faces: true,
+        })
+    }
+
+    /// Largest |model coordinate| over all meshes.
+    pub fn max_model_coord(&self) -> f64 {
+        self.instances
+            .iter()
+            .flat_map(|i| i.mesh.vertices.iter().flatten())
+            .map(|c| c.to_num::<f64>().abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// The float reference for this scene (transforms applied in f64).
     pub fn reference(&self) -> Result<reference::Scene, String> {
+        let mut tris = Vec::new();
+        for inst in &self.instances {
+            let m = inst.transform.m.map(|row| row.map(f64::from));
+            let apply = |p: [f64; 3]| {
+                [0, 1, 2].map(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
+            };
+            tris.extend(
+                inst.mesh
+                    .world_triangles()
+                    .into_iter()
+                    .map(|t| reference::Triangle {
+                        v: t.v.map(apply),
+                        ..t
+                    }),
+            );
+        }
         Ok(reference::Scene::new(
-            self.mesh.world_triangles(),
+            tris,
             self.light.reference()?,
             self.camera.reference()?,
             self.cull_back_faces,
@@ -311,11 +406,19 @@ impl SceneSpec {
         if w == 0 || h == 0 || w > MAX_SIZE || h > MAX_SIZE {
             return Err(format!("size {w}x{h} outside 1x1..{MAX_SIZE}x{MAX_SIZE}"));
         }
-        let mesh = self.mesh.mesh()?;
-        let instances = [Instance {
-            mesh: &mesh,
-            transform: Transform::IDENTITY,
-        }];
+        let meshes = self
+            .instances
+            .iter()
+            .map(|i| i.mesh.mesh())
+            .collect::<Result<Vec<_>, _>>()?;
+        let instances: Vec<Instance<'_>> = meshes
+            .iter()
+            .zip(&self.instances)
+            .map(|(mesh, i)| Instance {
+                mesh,
+                transform: i.transform,
+            })
+            .collect();
         let camera = self.camera.fixed()?;
         let scene = Scene {
             instances: &instances,
@@ -330,19 +433,28 @@ impl SceneSpec {
             color: vec![[0; 3]; w * h],
         };
         let mut ws: Box<ColorWs> = Box::new(Workspace::new(Rgb888::BLACK));
-        let stats = render_pass::<_, S, 65534, 4096>(
-            &mut ws,
-            &scene,
-            self.cull_back_faces,
-            w,
-            h,
-            |y, px, depth| {
-                for (x, (p, q)) in px.iter().zip(depth).enumerate() {
-                    image.color[y * w + x] = [p.r(), p.g(), p.b()];
-                    image.depth[y * w + x] = camera.eye_distance(*q).unwrap_or(f32::INFINITY);
+        let mut target = RgbImage {
+            width: w,
+            height: h,
+            pixels: vec![[0; 3]; w * h],
+        };
+        let stats = {
+            let mut display = scanline3d::sink::DrawTargetSink::new(&mut target);
+            let options = RenderOptions::default()
+                .with_back_face_culling(self.cull_back_faces)
+                .with_sub_pixel_bits::<S>();
+            // Record each row's depth, then hand the row to the draw target.
+            let mut sink = FnSink(|row: Row<'_, Rgb888>| {
+                for (x, q) in row.depth.iter().enumerate() {
+                    image.depth[row.y as usize * w + x] =
+                        camera.eye_distance(*q).unwrap_or(f32::INFINITY);
                 }
-            },
-        )?;
+                scanline3d::sink::RowSink::write_row(&mut display, row)
+            });
+            ws.render_sized(w, h, &scene, &options, &mut sink)
+                .map_err(|e| e.to_string())?
+        };
+        image.color = target.pixels;
         drop(ws);
         let mut ws: Box<IdWs> = Box::new(Workspace::new(TriangleId::NONE));
         render_pass::<_, S, 65534, 4096>(
@@ -358,6 +470,39 @@ impl SceneSpec {
             },
         )?;
         Ok(FixedRender { image, stats })
+    }
+}
+
+/// An RGB image as an embedded-graphics `DrawTarget`: the colour pass reaches it through
+/// [`scanline3d::sink::DrawTargetSink`], the same path a display takes on firmware.
+pub struct RgbImage {
+    /// Width.
+    pub width: usize,
+    /// Height.
+    pub height: usize,
+    /// Pixels, row-major from the top.
+    pub pixels: Vec<[u8; 3]>,
+}
+
+impl embedded_graphics::geometry::OriginDimensions for RgbImage {
+    fn size(&self) -> embedded_graphics::geometry::Size {
+        embedded_graphics::geometry::Size::new(self.width as u32, self.height as u32)
+    }
+}
+
+impl embedded_graphics::draw_target::DrawTarget for RgbImage {
+    type Color = Rgb888;
+    type Error = std::convert::Infallible;
+    fn draw_iter<I: IntoIterator<Item = embedded_graphics::Pixel<Rgb888>>>(
+        &mut self,
+        pixels: I,
+    ) -> Result<(), Self::Error> {
+        for embedded_graphics::Pixel(p, c) in pixels {
+            if p.x >= 0 && p.y >= 0 && (p.x as usize) < self.width && (p.y as usize) < self.height {
+                self.pixels[p.y as usize * self.width + p.x as usize] = [c.r(), c.g(), c.b()];
+            }
+        }
+        Ok(())
     }
 }
 

@@ -20,12 +20,12 @@ fn corpus_matches_reference() {
     let mut failures = Vec::new();
     for scene in corpus::all() {
         for (k, camera) in scene.cameras.iter().enumerate() {
-            let spec = SceneSpec {
-                mesh: scene.mesh.clone(),
-                camera: *camera,
-                light: LightSpec::default(),
-                cull_back_faces: scene.cull_back_faces,
-            };
+            let spec = SceneSpec::single(
+                scene.mesh.clone(),
+                *camera,
+                LightSpec::default(),
+                scene.cull_back_faces,
+            );
             for sub_bits in [4, 8] {
                 let (m, fixed, _) = accuracy(&spec, W, H, sub_bits).unwrap();
                 println!(

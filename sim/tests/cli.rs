@@ -1,0 +1,175 @@
+//! The `sim` binary end to end: outputs in the documented formats, and one-line errors with exit
+//! status 2 on bad input.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn sim(args: &[&str], dir: &std::path::Path) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_sim"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("scanline3d-sim-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn corpus(name: &str) -> String {
+    format!("{}/corpus/{name}.obj", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn render_writes_png_ids_depth_and_stats_in_the_documented_formats() {
+    let dir = scratch("render");
+    let (code, stdout, stderr) = sim(
+        &[
+            "render",
+            &corpus("cube"),
+            "--eye",
+            "-3,2,4",
+            "--size",
+            "64x48",
+            "--out",
+            "c.png",
+            "--ids",
+            "c.ids",
+            "--depth",
+            "c.depth",
+            "--stats",
+            "c.json",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("\"triangles_in\": 12"), "{stdout}");
+    let ids = std::fs::read(dir.join("c.ids")).unwrap();
+    let depth = std::fs::read(dir.join("c.depth")).unwrap();
+    assert_eq!((ids.len(), depth.len()), (64 * 48 * 4, 64 * 48 * 4));
+    let ids: Vec<i32> = ids
+        .chunks(4)
+        .map(|c| i32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    let depth: Vec<f32> = depth
+        .chunks(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    // Background is -1 with +inf depth; the cube (half-size 1 at distance ~5.4) is in between.
+    assert_eq!(ids[0], -1);
+    assert!(depth[0].is_infinite());
+    let centre = 24 * 64 + 32;
+    assert!((0..12).contains(&ids[centre]) && depth[centre] > 3.0 && depth[centre] < 6.0);
+    assert_eq!(&std::fs::read(dir.join("c.png")).unwrap()[1..4], b"PNG");
+    // The reference renderer writes the same formats, and `compare` reads both.
+    let (code, _, stderr) = sim(
+        &[
+            "render",
+            &corpus("cube"),
+            "--eye",
+            "-3,2,4",
+            "--size",
+            "64x48",
+            "--renderer",
+            "reference",
+            "--out",
+            "r.png",
+            "--ids",
+            "r.ids",
+            "--depth",
+            "r.depth",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 0, "{stderr}");
+    let (code, stdout, _) = sim(
+        &[
+            "compare", "c.ids", "c.depth", "r.ids", "r.depth", "--size", "64x48",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 0);
+    assert!(stdout.contains("id mismatches"), "{stdout}");
+    let (code, stdout, _) = sim(
+        &[
+            "compare",
+            "--scene",
+            &corpus("cube"),
+            "--eye",
+            "-3,2,4",
+            "--size",
+            "64x48",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 0);
+    assert!(stdout.contains("real            0"), "{stdout}");
+}
+
+#[test]
+fn bad_input_gives_one_line_and_status_2() {
+    let dir = scratch("errors");
+    std::fs::write(dir.join("badidx.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 7\n").unwrap();
+    std::fs::write(
+        dir.join("nan.obj"),
+        "v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("junk.obj"), "v 1 2\nf x y z\n").unwrap();
+    let cube = corpus("cube");
+    let cases: [(&[&str], &str); 8] = [
+        (&["render", "missing.obj"], "missing.obj"),
+        (&["render", "badidx.obj"], "index"),
+        (&["render", "nan.obj"], "NaN"),
+        (&["render", "junk.obj"], "junk.obj"),
+        (&["render", &cube, "--size", "0x10"], "size"),
+        (&["render", &cube, "--eye", "nan,1,2"], "finite"),
+        (
+            &["render", &cube, "--eye", "0,0,0", "--target", "0,0,0"],
+            "eye and target",
+        ),
+        (&["compare", "a.ids"], "compare needs"),
+    ];
+    for (args, needle) in cases {
+        let (code, _, stderr) = sim(args, &dir);
+        assert_eq!(code, 2, "{args:?}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{args:?}: {stderr}");
+        assert!(
+            stderr.starts_with("sim: ") && stderr.contains(needle),
+            "{args:?}: {stderr}"
+        );
+        assert!(!stderr.contains("panicked"));
+    }
+}
+
+#[test]
+fn committed_corpus_files_match_the_generator() {
+    for scene in scanline3d_sim::corpus::all() {
+        let committed = std::fs::read_to_string(corpus(scene.name)).unwrap();
+        assert_eq!(
+            committed,
+            scene.mesh.to_obj(),
+            "sim/corpus/{}.obj is stale: run `sim corpus --out sim/corpus`",
+            scene.name
+        );
+        // Loading renumbers vertices (in order of first use) but keeps triangle order, which is
+        // what triangle ids follow, and every coordinate exactly.
+        let loaded =
+            scanline3d_sim::scene::MeshData::load_obj(std::path::Path::new(&corpus(scene.name)))
+                .unwrap();
+        let corners = |m: &scanline3d_sim::scene::MeshData| -> Vec<_> {
+            m.triangles
+                .iter()
+                .map(|t| t.map(|i| m.vertices[i as usize]))
+                .collect()
+        };
+        assert_eq!(corners(&loaded), corners(&scene.mesh), "{}", scene.name);
+    }
+}
