@@ -232,6 +232,7 @@ fn test() -> Result<(), String> {
             target,
         ]))?;
     }
+    firmware()?;
     println!("\nxtask: {} passed, {} failed", totals.0, totals.1);
     Ok(())
 }
