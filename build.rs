@@ -1,73 +1,16 @@
 //! Generates the demo scene's meshes as static fixed-point arrays (`OUT_DIR/demo_meshes.rs`),
 //! so firmware and host render identical data without parsing anything at run time.
 
-use std::collections::HashMap;
 use std::fmt::Write;
+
+// The shape generators are shared with the host tools (sim) and the tests.
+#[path = "sim/src/meshgen.rs"]
+#[allow(dead_code)]
+mod meshgen;
 
 fn normalize(p: [f64; 3]) -> [f64; 3] {
     let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
     p.map(|c| c / l)
-}
-
-/// Unit icosphere: 12 vertices and 20 faces, each face split in four `subdivisions` times.
-fn icosphere(subdivisions: u32) -> (Vec<[f64; 3]>, Vec<[u16; 3]>) {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut v: Vec<[f64; 3]> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .into_iter()
-    .map(normalize)
-    .collect();
-    let mut f: Vec<[u16; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..subdivisions {
-        let mut cache: HashMap<(u16, u16), u16> = HashMap::new();
-        let mut next = Vec::with_capacity(f.len() * 4);
-        for [a, b, c] in f {
-            let mut mid = |x: u16, y: u16| {
-                *cache.entry((x.min(y), x.max(y))).or_insert_with(|| {
-                    let (p, q) = (v[x as usize], v[y as usize]);
-                    v.push(normalize([0, 1, 2].map(|k| (p[k] + q[k]) / 2.0)));
-                    (v.len() - 1) as u16
-                })
-            };
-            let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        f = next;
-    }
-    (v, f)
 }
 
 fn fixed(v: f64) -> i32 {
@@ -99,26 +42,7 @@ fn write_triangles(out: &mut String, name: &str, f: &[[u16; 3]]) {
 
 /// A cube of half-size 1, counter-clockwise from outside, two triangles per face.
 fn write_cube(out: &mut String) {
-    let v: Vec<[f64; 3]> = (0..8)
-        .map(|i: usize| {
-            let (x, y) = ([-1.0, 1.0, 1.0, -1.0][i % 4], [-1.0, -1.0, 1.0, 1.0][i % 4]);
-            [x, y, if i < 4 { -1.0 } else { 1.0 }]
-        })
-        .collect();
-    let f: [[u16; 3]; 12] = [
-        [4, 5, 6],
-        [4, 6, 7], // +z
-        [1, 0, 3],
-        [1, 3, 2], // -z
-        [5, 1, 2],
-        [5, 2, 6], // +x
-        [0, 4, 7],
-        [0, 7, 3], // -x
-        [7, 6, 2],
-        [7, 2, 3], // +y
-        [0, 1, 5],
-        [0, 5, 4], // -y
-    ];
+    let (v, f) = meshgen::cube();
     write_vertices(out, "CUBE_VERTICES", &v);
     write_triangles(out, "CUBE_TRIANGLES", &f);
     let faces = [
@@ -138,28 +62,17 @@ fn write_cube(out: &mut String) {
 
 /// An `n × n` checkerboard in the plane y = 0 spanning ±`half`, facing +y.
 fn write_ground(out: &mut String, n: usize, half: f64) {
-    let mut v = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let s = |k: usize| -half + 2.0 * half * k as f64 / n as f64;
-            v.push([s(i), 0.0, s(j)]);
-        }
-    }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u16;
-    let mut f = Vec::new();
-    let mut colors = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            f.push([id(i, j), id(i, j + 1), id(i + 1, j + 1)]);
-            f.push([id(i, j), id(i + 1, j + 1), id(i + 1, j)]);
-            let c = if (i + j) % 2 == 0 {
+    let (v, f) = meshgen::grid(n, half, |_, _| 0.0);
+    let colors: Vec<&str> = (0..f.len())
+        .map(|t| {
+            let (i, j) = ((t / 2) % n, (t / 2) / n);
+            if (i + j) % 2 == 0 {
                 "(200, 200, 190)"
             } else {
                 "(70, 80, 90)"
-            };
-            colors.extend([c, c]);
-        }
-    }
+            }
+        })
+        .collect();
     write_vertices(out, "GROUND_VERTICES", &v);
     write_triangles(out, "GROUND_TRIANGLES", &f);
     writeln!(out, "static GROUND_COLORS: [Rgb888; {}] = [", colors.len()).unwrap();
@@ -177,6 +90,7 @@ REGION_ALIAS(\"REGION_HEAP\", RAM);\nREGION_ALIAS(\"REGION_STACK\", RAM);\n";
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed=sim/src/meshgen.rs");
     // The firmware example links with the runtime's link.x. On Arm, cortex-m-rt's link.x
     // includes memory.x from the linker search path (the top-level one). On RISC-V,
     // `.cargo/config.toml` passes memory-riscv-virt.x (QEMU virt's RAM, with the region
@@ -189,7 +103,7 @@ fn main() {
     }
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=memory.x");
-    let (v, f) = icosphere(3);
+    let (v, f) = meshgen::icosphere(3);
     let mut out = String::new();
     writeln!(
         out,

@@ -284,8 +284,8 @@ fn pipeline_grid<const S: u32>(
     let cell_px = (2.0 * half[0] / nx as f64).min(2.0 * half[1] / ny as f64) * focal_px / dist;
     let jittered = jitter.iter().any(|&(u, v)| u != 0.0 || v != 0.0) && (nx > 1 || ny > 1);
     prop_assume!(!jittered || cell_px >= 8.0 / (1u32 << S) as f64);
-    let data = MeshData::from_f64(&verts, &tris);
-    let mesh = data.mesh();
+    let data = mesh_data(&verts, &tris);
+    let mesh = data.mesh().unwrap();
     let instances = [Instance {
         mesh: &mesh,
         transform: scanline3d::scene::Transform::IDENTITY,

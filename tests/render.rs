@@ -10,72 +10,6 @@ use scanline3d::scene::{Instance, Mesh, MeshColors, Scene, Transform};
 use scanline3d::sink::{FnSink, Row, TriangleId};
 use scanline3d::{Flat, Gouraud, RenderError, RenderOptions, Workspace};
 
-/// Position error bound of the renderer in pixels for `s` sub-pixel bits: snapping moves a
-/// vertex by at most 2^-(s+1) px in each axis; the I16F16 eye transform adds under 2^-10 px for
-/// these scenes (2^-17 units at under 2^6 px per unit). An edge is a convex combination of its
-/// vertices, so it moves no more than they do.
-fn position_bound(s: u32) -> f64 {
-    std::f64::consts::SQRT_2 * 0.5f64.powi(s as i32 + 1) + 2f64.powi(-10)
-}
-
-/// Ray-casts at one sub-pixel position.
-fn cast_at(
-    tris: &[[[f64; 3]; 3]],
-    cam: &CameraSpec,
-    w: usize,
-    h: usize,
-    x: f64,
-    y: f64,
-    cull: bool,
-) -> i32 {
-    cast(tris, cam, w, h, x, y, cull).map_or(-1, |hit| hit.id)
-}
-
-/// Compares renderer ids with the ray caster. A mismatch is *explained* when the reference
-/// answer changes within the position bound of the centre (sampled on a ring of 8 points at
-/// 1.1 × the bound, which covers every direction of a straight edge); otherwise it is *real*.
-/// Returns (mismatches, real mismatches).
-fn compare(
-    data: &[&MeshData],
-    cam: &CameraSpec,
-    ids: &[i32],
-    w: usize,
-    h: usize,
-    s: u32,
-    cull: bool,
-) -> (usize, usize) {
-    let tris: Vec<[[f64; 3]; 3]> = data
-        .iter()
-        .flat_map(|d| (0..d.triangles.len()).map(|t| d.world_triangle(t)))
-        .collect();
-    let reference = raycast(&tris, cam, w, h, cull);
-    let r = 1.1 * position_bound(s);
-    let (mut mismatches, mut real) = (0, 0);
-    for (i, hit) in reference.iter().enumerate() {
-        let want = hit.map_or(-1, |h| h.id);
-        if ids[i] == want {
-            continue;
-        }
-        mismatches += 1;
-        let (cx, cy) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
-        let explained = (0..8).any(|k| {
-            let a = k as f64 * std::f64::consts::FRAC_PI_4;
-            cast_at(&tris, cam, w, h, cx + r * a.cos(), cy + r * a.sin(), cull) == ids[i]
-        });
-        if !explained {
-            real += 1;
-            eprintln!(
-                "real mismatch at ({}, {}): renderer {} reference {}",
-                i % w,
-                i / w,
-                ids[i],
-                want
-            );
-        }
-    }
-    (mismatches, real)
-}
-
 #[test]
 fn interpenetrating_triangles_resolve_per_pixel() {
     // Two triangles crossing each other along x = 0: each is in front on one side.
@@ -87,8 +21,8 @@ fn interpenetrating_triangles_resolve_per_pixel() {
         [0.0, -1.2, 0.0],
         [1.5, 1.0, -0.8],
     ];
-    let data = MeshData::from_f64(&verts, &[[0, 1, 2], [3, 4, 5]]);
-    let mesh = data.mesh();
+    let data = mesh_data(&verts, &[[0, 1, 2], [3, 4, 5]]);
+    let mesh = data.mesh().unwrap();
     let cam = CameraSpec {
         eye: [0.3, 0.2, 4.0],
         target: [0.0; 3],
@@ -128,8 +62,8 @@ fn near_plane_crossing_triangles_render() {
     ];
     // A fan around a vertex just in front of the camera's feet.
     let tris = [[4, 0, 1], [4, 1, 2], [4, 2, 3], [4, 3, 0]];
-    let data = MeshData::from_f64(&verts, &tris);
-    let mesh = data.mesh();
+    let data = mesh_data(&verts, &tris);
+    let mesh = data.mesh().unwrap();
     let cam = CameraSpec {
         eye: [0.0, 1.0, 2.0],
         target: [0.0, 0.0, -3.0],
@@ -154,8 +88,8 @@ fn near_plane_crossing_triangles_render() {
             "two",
         ),
     ] {
-        let data = MeshData::from_f64(&tri, &[[0, 1, 2]]);
-        let mesh = data.mesh();
+        let data = mesh_data(&tri, &[[0, 1, 2]]);
+        let mesh = data.mesh().unwrap();
         let cam = CameraSpec {
             eye: [0.0, 0.0, 0.0],
             target: [0.0, 0.0, -1.0],
@@ -175,7 +109,7 @@ fn near_plane_crossing_triangles_render() {
 #[test]
 fn icosphere_matches_reference_at_several_sub_pixel_settings() {
     let sphere = icosphere(2, 1.0);
-    let mesh = sphere.mesh();
+    let mesh = sphere.mesh().unwrap();
     let cam = CameraSpec {
         eye: [1.2, 0.9, 2.6],
         target: [0.0; 3],
@@ -211,7 +145,7 @@ fn icosphere_frame_fits_16_kib() {
 
     let sphere = icosphere(3, 1.0);
     assert_eq!((sphere.vertices.len(), sphere.triangles.len()), (642, 1280));
-    let mesh = sphere.mesh();
+    let mesh = sphere.mesh().unwrap();
     let instances = [instance(&mesh)];
     let cam = CameraSpec {
         eye: [0.0, 0.5, 2.6],
@@ -223,7 +157,7 @@ fn icosphere_frame_fits_16_kib() {
     };
     let scene = Scene {
         instances: &instances,
-        camera: cam.camera(),
+        camera: cam.fixed().unwrap(),
         light: light(),
     };
     let mut ws = Box::new(Ws::new(Rgb565::BLACK));
@@ -246,7 +180,7 @@ fn icosphere_frame_fits_16_kib() {
 }
 
 fn one_triangle() -> MeshData {
-    MeshData::from_f64(
+    mesh_data(
         &[[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]],
         &[[0, 1, 2]],
     )
@@ -266,11 +200,11 @@ fn front_camera() -> CameraSpec {
 #[test]
 fn sink_error_stops_the_frame_at_that_row() {
     let data = one_triangle();
-    let mesh = data.mesh();
+    let mesh = data.mesh().unwrap();
     let instances = [instance(&mesh)];
     let scene = Scene {
         instances: &instances,
-        camera: front_camera().camera(),
+        camera: front_camera().fixed().unwrap(),
         light: light(),
     };
     let mut ws: Workspace<Rgb565, Flat, 16, 16, 4, 4> = Workspace::new(Rgb565::BLACK);
@@ -299,11 +233,11 @@ fn sink_error_stops_the_frame_at_that_row() {
 #[test]
 fn too_many_triangles_fails_before_any_row() {
     let sphere = icosphere(1, 1.0);
-    let mesh = sphere.mesh();
+    let mesh = sphere.mesh().unwrap();
     let instances = [instance(&mesh)];
     let scene = Scene {
         instances: &instances,
-        camera: front_camera().camera(),
+        camera: front_camera().fixed().unwrap(),
         light: light(),
     };
     let mut ws: Workspace<Rgb565, Flat, 32, 32, 8, 8> = Workspace::new(Rgb565::BLACK);
@@ -333,11 +267,11 @@ fn too_many_triangles_fails_before_any_row() {
 #[test]
 fn full_active_list_degrades_deterministically_and_reports() {
     let sphere = icosphere(2, 1.0);
-    let mesh = sphere.mesh();
+    let mesh = sphere.mesh().unwrap();
     let instances = [instance(&mesh)];
     let scene = Scene {
         instances: &instances,
-        camera: front_camera().camera(),
+        camera: front_camera().fixed().unwrap(),
         light: light(),
     };
     let render = || {
@@ -377,7 +311,7 @@ fn gouraud_interpolates_vertex_colours() {
     };
     let scene = Scene {
         instances: &instances,
-        camera: cam.camera(),
+        camera: cam.fixed().unwrap(),
         light,
     };
     let mut ws: Box<Workspace<Rgb888, Gouraud, 33, 33, 4, 4>> =
@@ -421,7 +355,7 @@ fn gouraud_interpolates_vertex_colours() {
 #[test]
 fn instances_number_triangles_consecutively() {
     let data = one_triangle();
-    let mesh = data.mesh();
+    let mesh = data.mesh().unwrap();
     let instances = [
         Instance {
             mesh: &mesh,
@@ -446,7 +380,7 @@ fn instances_number_triangles_consecutively() {
 #[test]
 fn bad_transforms_are_reported() {
     let data = one_triangle();
-    let mesh = data.mesh();
+    let mesh = data.mesh().unwrap();
     let scene_with = |t: Transform| {
         let instances = [Instance {
             mesh: &mesh,
@@ -454,7 +388,7 @@ fn bad_transforms_are_reported() {
         }];
         let scene = Scene {
             instances: &instances,
-            camera: front_camera().camera(),
+            camera: front_camera().fixed().unwrap(),
             light: light(),
         };
         let mut ws: Workspace<Rgb565, Flat, 8, 8, 4, 4> = Workspace::new(Rgb565::BLACK);
@@ -487,7 +421,7 @@ fn micromath_backend_renders_nearly_the_same_image() {
     use scanline3d::math::Micromath;
     use scanline3d::scene::Camera;
     let sphere = icosphere(2, 1.0);
-    let mesh = sphere.mesh();
+    let mesh = sphere.mesh().unwrap();
     let instances = [instance(&mesh)];
     let render = |camera: Camera| {
         let scene = Scene {

@@ -3,6 +3,7 @@
 //! `sim corpus --out DIR` writes every mesh as OBJ for use with `sim render`; the committed copies
 //! under `sim/corpus/` are checked against this generator by a test.
 
+use crate::meshgen;
 use crate::scene::{CameraSpec, MeshData};
 use embedded_graphics::pixelcolor::Rgb888;
 use std::f64::consts::TAU;
@@ -52,118 +53,20 @@ fn mesh(positions: &[[f64; 3]], triangles: Vec<[u16; 3]>) -> MeshData {
     m
 }
 
-fn cube() -> MeshData {
-    let v: Vec<[f64; 3]> = (0..8)
-        .map(|i: usize| {
-            let (x, y) = ([-1.0, 1.0, 1.0, -1.0][i % 4], [-1.0, -1.0, 1.0, 1.0][i % 4]);
-            [x, y, if i < 4 { -1.0 } else { 1.0 }]
-        })
-        .collect();
-    let f = vec![
-        [4, 5, 6],
-        [4, 6, 7],
-        [1, 0, 3],
-        [1, 3, 2],
-        [5, 1, 2],
-        [5, 2, 6],
-        [0, 4, 7],
-        [0, 7, 3],
-        [7, 6, 2],
-        [7, 2, 3],
-        [0, 1, 5],
-        [0, 5, 4],
-    ];
+fn from_shape((v, f): meshgen::Shape) -> MeshData {
     mesh(&v, f)
-}
-
-fn normalize(p: [f64; 3]) -> [f64; 3] {
-    let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-    p.map(|c| c / l)
 }
 
 /// Unit icosphere with `20 · 4^n` triangles.
 pub fn icosphere(n: u32) -> MeshData {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut v: Vec<[f64; 3]> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .into_iter()
-    .map(normalize)
-    .collect();
-    let mut f: Vec<[u16; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..n {
-        let mut cache = std::collections::HashMap::new();
-        let mut next = Vec::new();
-        for [a, b, c] in f {
-            let mut mid = |x: u16, y: u16| {
-                *cache.entry((x.min(y), x.max(y))).or_insert_with(|| {
-                    let (p, q) = (v[x as usize], v[y as usize]);
-                    v.push(normalize([0, 1, 2].map(|k| (p[k] + q[k]) / 2.0)));
-                    (v.len() - 1) as u16
-                })
-            };
-            let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        f = next;
-    }
-    mesh(&v, f)
+    from_shape(meshgen::icosphere(n))
 }
 
 /// An `n × n` grid of quads over [-4, 4]² with smooth hills, facing +y.
 fn heightfield(n: usize) -> MeshData {
-    let mut v = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, z) = (
-                -4.0 + 8.0 * i as f64 / n as f64,
-                -4.0 + 8.0 * j as f64 / n as f64,
-            );
-            let y = 0.6 * (0.9 * x).sin() * (0.7 * z).cos() + 0.25 * (2.3 * x + 1.1 * z).sin();
-            v.push([x, y, z]);
-        }
-    }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u16;
-    let mut f = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            f.push([id(i, j), id(i, j + 1), id(i + 1, j + 1)]);
-            f.push([id(i, j), id(i + 1, j + 1), id(i + 1, j)]);
-        }
-    }
-    mesh(&v, f)
+    from_shape(meshgen::grid(n, 4.0, |x, z| {
+        0.6 * (0.9 * x).sin() * (0.7 * z).cos() + 0.25 * (2.3 * x + 1.1 * z).sin()
+    }))
 }
 
 /// A chess pawn, modelled by revolving a profile (radius, height) around the y axis.
@@ -283,7 +186,7 @@ pub fn all() -> Vec<CorpusScene> {
         CorpusScene {
             name: "cube",
             about: "closed box, 12 triangles",
-            mesh: cube(),
+            mesh: from_shape(meshgen::cube()),
             cameras: orbit(4.5, 2.0, 3, 50.0),
             cull_back_faces: true,
         },
