@@ -365,6 +365,43 @@ impl Transform {
         Transform { m }
     }
 
+    /// The nearest rigid transform (rotation + the same translation), by Gram–Schmidt on the
+    /// linear part's rows, with [`Libm`].
+    ///
+    /// Animation that accumulates small rotations frame after frame (`r = step.then_after(&r)`)
+    /// drifts: every product adds rounding, and an approximate backend adds more, so after
+    /// thousands of frames the mesh grows or shears. Re-orthonormalising each frame keeps it rigid.
+    ///
+    /// ```
+    /// use scanline3d::scene::Transform;
+    /// let skewed = Transform { m: [[1.1, 0.2, 0.0, 5.0], [0.0, 0.9, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]] };
+    /// let r = skewed.orthonormalized();
+    /// let p = r.apply([1.0, 0.0, 0.0]);
+    /// assert!(((p[0] - 5.0).powi(2) + p[1] * p[1] + p[2] * p[2] - 1.0).abs() < 1e-6);
+    /// ```
+    pub fn orthonormalized(&self) -> Transform {
+        self.orthonormalized_with::<Libm>()
+    }
+
+    /// [`Transform::orthonormalized`] with a chosen math backend.
+    pub fn orthonormalized_with<M: MathBackend>(&self) -> Transform {
+        let row = |r: usize| [self.m[r][0], self.m[r][1], self.m[r][2]];
+        let x = normalize::<M>(row(0)).unwrap_or([1.0, 0.0, 0.0]);
+        let y0 = row(1);
+        let d = dot(x, y0);
+        let y = normalize::<M>([y0[0] - d * x[0], y0[1] - d * x[1], y0[2] - d * x[2]])
+            .unwrap_or([0.0, 1.0, 0.0]);
+        let z = cross(x, y);
+        let t = [self.m[0][3], self.m[1][3], self.m[2][3]];
+        Transform {
+            m: [
+                [x[0], x[1], x[2], t[0]],
+                [y[0], y[1], y[2], t[1]],
+                [z[0], z[1], z[2], t[2]],
+            ],
+        }
+    }
+
     /// Applies the transform to a point.
     pub fn apply(&self, p: [f32; 3]) -> [f32; 3] {
         let m = &self.m;
