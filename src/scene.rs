@@ -576,7 +576,7 @@ impl Camera {
     /// # Ok::<(), scanline3d::scene::SceneError>(())
     /// ```
     pub fn eye_distance(&self, q: crate::project::Depth) -> Option<f32> {
-        let near = I16F16::saturating_from_num(self.near).to_num::<f64>();
+        let near = I16F16::checked_from_num(self.near)?.to_num::<f64>();
         let q = q.to_num::<f64>();
         (q > 0.0).then(|| (near / q) as f32)
     }

@@ -116,8 +116,12 @@ pub struct Lighting {
     diffuse: I2F30,
 }
 
+/// `v` in I2F30 bits, rounded to nearest (ties to even, as `fixed` rounds) and saturated; NaN
+/// gives 0. Written out because `fixed`'s saturating conversion panics on NaN, and the render
+/// path must not contain a panic (`examples/panic_never.rs` checks that at link time).
 fn q30(v: f32) -> i32 {
-    I2F30::saturating_from_num(v).to_bits()
+    // f32 → f64 and the scaling by 2^30 are exact; `as` saturates and maps NaN to 0.
+    libm::rint(v as f64 * (1u64 << 30) as f64) as i32
 }
 
 impl Lighting {
@@ -144,8 +148,8 @@ impl Lighting {
             normal_matrix,
             flip: det < 0.0,
             direction: light.direction().map(q30),
-            ambient: I2F30::saturating_from_num(light.ambient()),
-            diffuse: I2F30::saturating_from_num(light.diffuse()),
+            ambient: I2F30::from_bits(q30(light.ambient())),
+            diffuse: I2F30::from_bits(q30(light.diffuse())),
         }
     }
 

@@ -232,6 +232,21 @@ fn test() -> Result<(), String> {
             target,
         ]))?;
     }
+    for target in TARGETS {
+        // Link-time proof that the render path cannot panic: the example's panic handler calls
+        // an undefined symbol, so the link fails if any panic is reachable.
+        step(&format!("panic-never link check for {target}"));
+        run(cargo().args([
+            "build",
+            "--release",
+            "--package",
+            "scanline3d",
+            "--example",
+            "panic_never",
+            "--target",
+            target,
+        ]))?;
+    }
     firmware()?;
     println!("\nxtask: {} passed, {} failed", totals.0, totals.1);
     Ok(())

@@ -1,0 +1,51 @@
+//! Link-time proof that the render path cannot panic: this firmware renders the demo scene, and
+//! its panic handler calls a function that does not exist. If any panic remains reachable after
+//! optimisation, linking fails with an undefined symbol.
+//!
+//! ```sh
+//! cargo build --release --example panic_never --target thumbv7em-none-eabihf
+//! cargo build --release --example panic_never --target thumbv6m-none-eabi
+//! cargo build --release --example panic_never --target riscv32imc-unknown-none-elf
+//! ```
+//!
+//! `cargo xtask test` builds it for all three targets. It covers what a firmware frame runs:
+//! scene and camera set-up, the vertex stage, clipping, projection, bucketing, the edge walk, the
+//! span z-buffer and the row sink.
+#![cfg_attr(target_os = "none", no_std)]
+#![cfg_attr(target_os = "none", no_main)]
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    println!("panic_never is a link-time check: build it for a bare-metal target, e.g.");
+    println!("  cargo build --release --example panic_never --target thumbv6m-none-eabi");
+}
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use scanline3d::demo::{self, PanelWorkspace};
+
+    #[cfg_attr(target_arch = "arm", cortex_m_rt::entry)]
+    #[cfg_attr(target_arch = "riscv32", riscv_rt::entry)]
+    fn main() -> ! {
+        let mut ws = PanelWorkspace::new(demo::BACKGROUND.into());
+        let instances = demo::instances();
+        let mut frame = 0;
+        loop {
+            if let Ok(scene) = demo::scene(&instances, frame, demo::ORBIT_FRAMES) {
+                let out = demo::render_panel_frame(&mut ws, &scene);
+                core::hint::black_box(&out);
+            }
+            frame = frame.wrapping_add(1);
+        }
+    }
+
+    #[panic_handler]
+    fn panic(_: &core::panic::PanicInfo) -> ! {
+        extern "C" {
+            /// Deliberately undefined: referencing it makes any reachable panic a link error.
+            fn scanline3d_render_path_can_panic() -> !;
+        }
+        // SAFETY: never called when linking succeeds; the symbol does not exist.
+        unsafe { scanline3d_render_path_can_panic() }
+    }
+}
