@@ -2,6 +2,7 @@
 //! scene/image formats the `sim` binary reads and writes.
 
 pub mod corpus;
+pub mod fuzz;
 pub mod meshgen;
 pub mod metrics;
 pub mod reference;

@@ -114,13 +114,23 @@ impl MeshData {
     /// Loads an OBJ file: all objects in file order, polygons fan-triangulated
     /// (a b c d -> (a,b,c), (a,c,d)), so triangle ids follow the file's face order.
     pub fn load_obj(path: &Path) -> Result<Self, String> {
+        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        Self::load_obj_bytes(&bytes, &path.display().to_string())
+    }
+
+    /// [`MeshData::load_obj`] from OBJ text in memory; `name` labels error messages. Materials
+    /// are ignored.
+    pub fn load_obj_bytes(bytes: &[u8], name: &str) -> Result<Self, String> {
         let opts = tobj::LoadOptions {
             triangulate: true,
             single_index: false,
             ..Default::default()
         };
+        let mut reader = std::io::BufReader::new(bytes);
         let (models, _) =
-            tobj::load_obj(path, &opts).map_err(|e| format!("{}: {e}", path.display()))?;
+            tobj::load_obj_buf(&mut reader, &opts, |_| Err(tobj::LoadError::OpenFileFailed))
+                .map_err(|e| format!("{name}: {e}"))?;
+        let path = Path::new(name);
         let mut positions = Vec::new();
         let mut triangles = Vec::new();
         for m in &models {
