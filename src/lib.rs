@@ -49,7 +49,31 @@
 //!
 //! Pixel centres at `(c + ½, r + ½)`, top-left fill rule, exact edge walking: see [`raster`].
 //! Every fixed-point format is named in its type and each stage documents its bit budget.
-//! Nothing on the render path allocates, panics or uses `unsafe`.
+//! Nothing on the render path allocates, panics or uses `unsafe`: `examples/panic_never.rs`
+//! links only if no panic is reachable from it.
+//!
+//! ## Operating envelope
+//!
+//! Input outside these limits is rejected with a specific error where it enters (mesh and camera
+//! construction, or the frame's transform set-up), never clamped silently:
+//!
+//! | limit | value | reason (bit budget) |
+//! |---|---|---|
+//! | model coordinates | ±[`MAX_MODEL_COORD`](scene::MAX_MODEL_COORD) = 4096 | I16F16 products stay far below the eye-space limit ([`vertex`]) |
+//! | eye coordinates | ±2^14, checked per instance and frame | I16F16 with 2× headroom for clip interpolation ([`vertex`]) |
+//! | target size | 1 to [`MAX_SCREEN`](project::MAX_SCREEN) = 2048 per side | with the guard band, sub-pixel coordinates stay below 2^22 ([`project`], [`raster`]) |
+//! | sub-pixel bits | 0 to 8 | same |
+//! | near plane | ≥ [`MIN_NEAR`](scene::MIN_NEAR) = 1/256 | `near` keeps 8 significant bits in I16F16 |
+//! | far plane | ≤ [`MAX_EYE_DISTANCE`](scene::MAX_EYE_DISTANCE) = 16384 | eye-space envelope |
+//! | far/near | ≤ [`MAX_FAR_NEAR_RATIO`](scene::MAX_FAR_NEAR_RATIO) = 2^20 | `q = near/w` keeps ≥ 2^10 steps of I2F30 at the far plane: relative depth resolution 2^-30 · far/near ≤ 2^-10 there |
+//! | instances | [`MAX_INSTANCES`](render::MAX_INSTANCES) = 8 | per-frame set-up on the stack |
+//! | triangles per frame | `TRIS` ≤ 65534 | 16-bit bucket links |
+//!
+//! Any triangle size works: triangles far larger than the screen are clipped to a guard band of
+//! 8 half-screens; triangles smaller than a pixel cover exactly the centres they contain (often
+//! none). Exactly coplanar overlapping surfaces resolve deterministically: the triangle that
+//! becomes active first (earlier first row, then lower id) keeps the pixel. Each limit has a test
+//! at the limit and just past it (`tests/envelope.rs`).
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]

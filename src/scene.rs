@@ -34,7 +34,7 @@ pub const MAX_EYE_DISTANCE: f32 = 16384.0;
 pub const MIN_NEAR: f32 = 1.0 / 256.0;
 
 /// Largest far/near ratio: 2^20. At the far plane 1/w then still has 10 significant bits in the
-/// I2F30 depth format (see [`crate::raster::Depth`]).
+/// I2F30 depth format (see [`crate::project::Depth`]).
 pub const MAX_FAR_NEAR_RATIO: f32 = 1048576.0;
 
 /// Why a scene part was rejected. Every variant names what was wrong.
