@@ -1,16 +1,29 @@
 //! Host tools for scanline3d: the float reference, accuracy metrics, the scene corpus and the
 //! scene/image formats the `sim` binary reads and writes.
 
+// Host-only. On a bare-metal target (where a plain `cargo build --lib --target ...` at the
+// workspace root also builds this default member) the crate is empty.
+#![cfg_attr(target_os = "none", no_std)]
+
+#[cfg(not(target_os = "none"))]
 pub mod corpus;
+#[cfg(not(target_os = "none"))]
 pub mod fuzz;
+#[cfg(not(target_os = "none"))]
 pub mod meshgen;
+#[cfg(not(target_os = "none"))]
 pub mod metrics;
+#[cfg(not(target_os = "none"))]
 pub mod reference;
+#[cfg(not(target_os = "none"))]
 pub mod scene;
 
+#[cfg(not(target_os = "none"))]
 use metrics::{ErrorBound, Metrics};
+#[cfg(not(target_os = "none"))]
 use scene::SceneSpec;
 
+#[cfg(not(target_os = "none"))]
 /// Renders `spec` with the fixed-point renderer (at `sub_bits`) and the reference, and compares
 /// them with the documented error bound.
 pub fn accuracy(

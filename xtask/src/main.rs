@@ -226,8 +226,6 @@ fn test() -> Result<(), String> {
             "build",
             "--release",
             "--lib",
-            "--package",
-            "scanline3d",
             "--target",
             target,
         ]))?;
