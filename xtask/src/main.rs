@@ -222,13 +222,7 @@ fn test() -> Result<(), String> {
     cargo_test(&["--release"], &mut totals)?;
     for target in TARGETS {
         step(&format!("library for {target} (no_std, no allocator)"));
-        run(cargo().args([
-            "build",
-            "--release",
-            "--lib",
-            "--target",
-            target,
-        ]))?;
+        run(cargo().args(["build", "--release", "--lib", "--target", target]))?;
     }
     for target in TARGETS {
         // Link-time proof that the render path cannot panic: the example's panic handler calls
