@@ -93,14 +93,7 @@ fn near_and_far_limits() {
 fn up_to_eight_instances() {
     let data = icosphere(0, 0.2);
     let mesh = data.mesh().unwrap();
-    let cam = CameraSpec {
-        eye: [0.0, 0.0, 3.0],
-        target: [0.0; 3],
-        up: [0.0, 1.0, 0.0],
-        fovy: 60.0,
-        near: 0.5,
-        far: 10.0,
-    };
+    let cam = CameraSpec::looking_at([0.0, 0.0, 3.0], [0.0; 3], 60.0, 0.5, 10.0);
     let render = |n: usize| {
         let instances: Vec<Instance<'_>> = (0..n)
             .map(|k| Instance {

@@ -103,14 +103,7 @@ fn count_rows<P: scanline3d::sink::RowPixel>(
 #[test]
 fn empty_meshes_and_scenes_render_background_rows() {
     let empty = Mesh::new(&[], &[], MeshColors::Uniform(Rgb888::new(0, 0, 0)), None).unwrap();
-    let cam = CameraSpec {
-        eye: [0.0, 0.0, 3.0],
-        target: [0.0; 3],
-        up: [0.0, 1.0, 0.0],
-        fovy: 60.0,
-        near: 0.5,
-        far: 10.0,
-    };
+    let cam = CameraSpec::looking_at([0.0, 0.0, 3.0], [0.0; 3], 60.0, 0.5, 10.0);
     for instances in [
         &[][..],
         &[Instance {
@@ -142,14 +135,7 @@ fn empty_meshes_and_scenes_render_background_rows() {
 fn capacity_and_instance_overflow_fail_before_any_row() {
     let data = icosphere(1, 1.0);
     let mesh = data.mesh().unwrap();
-    let cam = CameraSpec {
-        eye: [0.0, 0.0, 3.0],
-        target: [0.0; 3],
-        up: [0.0, 1.0, 0.0],
-        fovy: 60.0,
-        near: 0.5,
-        far: 10.0,
-    };
+    let cam = CameraSpec::looking_at([0.0, 0.0, 3.0], [0.0; 3], 60.0, 0.5, 10.0);
     let nine: Vec<Instance<'_>> = (0..9).map(|_| instance(&mesh)).collect();
     let scene = Scene {
         instances: &nine,
@@ -201,14 +187,7 @@ fn accumulated_micromath_rotation_stays_rigid_when_reorthonormalised() {
     assert!((scale(&rigid) - 1.0).abs() < 1e-3, "{}", scale(&rigid));
     let data = icosphere(2, 1.0);
     let mesh = data.mesh().unwrap();
-    let cam = CameraSpec {
-        eye: [0.0, 0.0, 3.0],
-        target: [0.0; 3],
-        up: [0.0, 1.0, 0.0],
-        fovy: 60.0,
-        near: 0.5,
-        far: 10.0,
-    };
+    let cam = CameraSpec::looking_at([0.0, 0.0, 3.0], [0.0; 3], 60.0, 0.5, 10.0);
     let instances = [Instance {
         mesh: &mesh,
         transform: rigid,

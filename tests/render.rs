@@ -23,14 +23,7 @@ fn interpenetrating_triangles_resolve_per_pixel() {
     ];
     let data = mesh_data(&verts, &[[0, 1, 2], [3, 4, 5]]);
     let mesh = data.mesh().unwrap();
-    let cam = CameraSpec {
-        eye: [0.3, 0.2, 4.0],
-        target: [0.0; 3],
-        up: [0.0, 1.0, 0.0],
-        fovy: 50.0,
-        near: 0.5,
-        far: 20.0,
-    };
+    let cam = CameraSpec::looking_at([0.3, 0.2, 4.0], [0.0; 3], 50.0, 0.5, 20.0);
     let (ids, _) = render_ids::<64, 64, 4>(&[instance(&mesh)], &cam, false);
     let (mismatches, real) = compare(&[&data], &cam, &ids, 64, 64, 4, false);
     assert_eq!(real, 0, "{mismatches} mismatches");
@@ -64,14 +57,7 @@ fn near_plane_crossing_triangles_render() {
     let tris = [[4, 0, 1], [4, 1, 2], [4, 2, 3], [4, 3, 0]];
     let data = mesh_data(&verts, &tris);
     let mesh = data.mesh().unwrap();
-    let cam = CameraSpec {
-        eye: [0.0, 1.0, 2.0],
-        target: [0.0, 0.0, -3.0],
-        up: [0.0, 1.0, 0.0],
-        fovy: 70.0,
-        near: 0.2,
-        far: 60.0,
-    };
+    let cam = CameraSpec::looking_at([0.0, 1.0, 2.0], [0.0, 0.0, -3.0], 70.0, 0.2, 60.0);
     let (ids, stats) = render_ids::<64, 48, 4>(&[instance(&mesh)], &cam, true);
     assert!(stats.clipped >= 2, "{stats:?}");
     let (mismatches, real) = compare(&[&data], &cam, &ids, 64, 48, 4, true);
@@ -90,14 +76,7 @@ fn near_plane_crossing_triangles_render() {
     ] {
         let data = mesh_data(&tri, &[[0, 1, 2]]);
         let mesh = data.mesh().unwrap();
-        let cam = CameraSpec {
-            eye: [0.0, 0.0, 0.0],
-            target: [0.0, 0.0, -1.0],
-            up: [0.0, 1.0, 0.0],
-            fovy: 90.0,
-            near: 0.1,
-            far: 10.0,
-        };
+        let cam = CameraSpec::looking_at([0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 90.0, 0.1, 10.0);
         let (ids, stats) = render_ids::<48, 48, 4>(&[instance(&mesh)], &cam, false);
         assert_eq!(stats.clipped, 1, "{name}");
         let (mismatches, real) = compare(&[&data], &cam, &ids, 48, 48, 4, false);
@@ -110,14 +89,7 @@ fn near_plane_crossing_triangles_render() {
 fn icosphere_matches_reference_at_several_sub_pixel_settings() {
     let sphere = icosphere(2, 1.0);
     let mesh = sphere.mesh().unwrap();
-    let cam = CameraSpec {
-        eye: [1.2, 0.9, 2.6],
-        target: [0.0; 3],
-        up: [0.0, 1.0, 0.0],
-        fovy: 55.0,
-        near: 0.5,
-        far: 10.0,
-    };
+    let cam = CameraSpec::looking_at([1.2, 0.9, 2.6], [0.0; 3], 55.0, 0.5, 10.0);
     let inst = [instance(&mesh)];
     let (ids, _) = render_ids::<64, 64, 2>(&inst, &cam, true);
     assert_eq!(compare(&[&sphere], &cam, &ids, 64, 64, 2, true).1, 0);
@@ -147,14 +119,7 @@ fn icosphere_frame_fits_16_kib() {
     assert_eq!((sphere.vertices.len(), sphere.triangles.len()), (642, 1280));
     let mesh = sphere.mesh().unwrap();
     let instances = [instance(&mesh)];
-    let cam = CameraSpec {
-        eye: [0.0, 0.5, 2.6],
-        target: [0.0; 3],
-        up: [0.0, 1.0, 0.0],
-        fovy: 60.0,
-        near: 0.5,
-        far: 10.0,
-    };
+    let cam = CameraSpec::looking_at([0.0, 0.5, 2.6], [0.0; 3], 60.0, 0.5, 10.0);
     let scene = Scene {
         instances: &instances,
         camera: cam.fixed().unwrap(),
@@ -187,14 +152,7 @@ fn one_triangle() -> MeshData {
 }
 
 fn front_camera() -> CameraSpec {
-    CameraSpec {
-        eye: [0.0, 0.0, 3.0],
-        target: [0.0; 3],
-        up: [0.0, 1.0, 0.0],
-        fovy: 60.0,
-        near: 0.5,
-        far: 10.0,
-    }
+    CameraSpec::looking_at([0.0, 0.0, 3.0], [0.0; 3], 60.0, 0.5, 10.0)
 }
 
 #[test]

@@ -23,17 +23,6 @@ pub struct CorpusScene {
     pub cull_back_faces: bool,
 }
 
-fn cam(eye: [f64; 3], target: [f64; 3], fovy: f64, near: f64, far: f64) -> CameraSpec {
-    CameraSpec {
-        eye,
-        target,
-        up: [0.0, 1.0, 0.0],
-        fovy,
-        near,
-        far,
-    }
-}
-
 /// Distinct, readable colours per triangle.
 fn palette(n: usize) -> Vec<Rgb888> {
     (0..n)
@@ -127,7 +116,7 @@ pub fn all() -> Vec<CorpusScene> {
         (0..n)
             .map(|k| {
                 let a = 0.4 + TAU * k as f64 / n as f64;
-                cam([r * a.sin(), y, r * a.cos()], [0.0; 3], fovy, 0.1, 50.0)
+                CameraSpec::looking_at([r * a.sin(), y, r * a.cos()], [0.0; 3], fovy, 0.1, 50.0)
             })
             .collect()
     };
@@ -202,8 +191,8 @@ pub fn all() -> Vec<CorpusScene> {
             about: "two triangles crossing each other",
             mesh: crossing,
             cameras: vec![
-                cam([0.3, 0.2, 4.0], [0.0; 3], 50.0, 0.5, 20.0),
-                cam([-2.5, 1.5, 3.0], [0.0; 3], 45.0, 0.5, 20.0),
+                CameraSpec::looking_at([0.3, 0.2, 4.0], [0.0; 3], 50.0, 0.5, 20.0),
+                CameraSpec::looking_at([-2.5, 1.5, 3.0], [0.0; 3], 45.0, 0.5, 20.0),
             ],
             cull_back_faces: false,
         },
@@ -212,8 +201,8 @@ pub fn all() -> Vec<CorpusScene> {
             about: "10,082-triangle terrain",
             mesh: heightfield(71),
             cameras: vec![
-                cam([0.0, 4.0, 7.0], [0.0, -0.5, 0.0], 55.0, 0.2, 40.0),
-                cam([6.0, 1.5, 3.0], [-1.0, 0.0, -1.0], 60.0, 0.2, 40.0),
+                CameraSpec::looking_at([0.0, 4.0, 7.0], [0.0, -0.5, 0.0], 55.0, 0.2, 40.0),
+                CameraSpec::looking_at([6.0, 1.5, 3.0], [-1.0, 0.0, -1.0], 60.0, 0.2, 40.0),
             ],
             cull_back_faces: true,
         },
@@ -222,8 +211,8 @@ pub fn all() -> Vec<CorpusScene> {
             about: "triangles crossing the near plane, vertices behind the eye",
             mesh: near_plane,
             cameras: vec![
-                cam([0.0, 1.0, 2.0], [0.0, 0.0, -3.0], 70.0, 0.2, 60.0),
-                cam([0.5, 0.6, 0.5], [0.0, 0.4, -5.0], 80.0, 0.1, 60.0),
+                CameraSpec::looking_at([0.0, 1.0, 2.0], [0.0, 0.0, -3.0], 70.0, 0.2, 60.0),
+                CameraSpec::looking_at([0.5, 0.6, 0.5], [0.0, 0.4, -5.0], 80.0, 0.1, 60.0),
             ],
             cull_back_faces: false,
         },
@@ -232,8 +221,8 @@ pub fn all() -> Vec<CorpusScene> {
             about: "240 slivers meeting at one vertex",
             mesh: slivers,
             cameras: vec![
-                cam([0.0, 0.0, 4.0], [0.0; 3], 60.0, 0.5, 20.0),
-                cam([1.0, 1.5, 3.5], [0.0; 3], 50.0, 0.5, 20.0),
+                CameraSpec::looking_at([0.0, 0.0, 4.0], [0.0; 3], 60.0, 0.5, 20.0),
+                CameraSpec::looking_at([1.0, 1.5, 3.5], [0.0; 3], 50.0, 0.5, 20.0),
             ],
             cull_back_faces: false,
         },
@@ -244,7 +233,7 @@ pub fn all() -> Vec<CorpusScene> {
             // Squarely facing cameras (rolled and moved): every vertex has the same depth, so
             // the tie is exact in both renderers and the documented rule decides.
             cameras: vec![
-                cam([0.0, 0.0, 4.0], [0.0; 3], 60.0, 0.5, 20.0),
+                CameraSpec::looking_at([0.0, 0.0, 4.0], [0.0; 3], 60.0, 0.5, 20.0),
                 CameraSpec {
                     eye: [0.4, -0.2, 3.0],
                     target: [0.4, -0.2, 0.0],

@@ -204,6 +204,18 @@ fn f32s(v: [f64; 3]) -> [f32; 3] {
 }
 
 impl CameraSpec {
+    /// A camera at `eye` looking at `target` with +y up.
+    pub fn looking_at(eye: [f64; 3], target: [f64; 3], fovy: f64, near: f64, far: f64) -> Self {
+        CameraSpec {
+            eye,
+            target,
+            up: [0.0, 1.0, 0.0],
+            fovy,
+            near,
+            far,
+        }
+    }
+
     /// The library camera.
     pub fn fixed(&self) -> Result<Camera, String> {
         Camera::look_at(f32s(self.eye), f32s(self.target), f32s(self.up))

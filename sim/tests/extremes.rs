@@ -5,17 +5,6 @@ use embedded_graphics::pixelcolor::Rgb888;
 use scanline3d_sim::scene::{CameraSpec, LightSpec, MeshData, SceneSpec};
 use scanline3d_sim::{accuracy, metrics::Metrics};
 
-fn cam(eye: [f64; 3], target: [f64; 3], fovy: f64, near: f64, far: f64) -> CameraSpec {
-    CameraSpec {
-        eye,
-        target,
-        up: [0.0, 1.0, 0.0],
-        fovy,
-        near,
-        far,
-    }
-}
-
 fn mesh(v: &[[f64; 3]], f: &[[u16; 3]]) -> MeshData {
     MeshData::new(v, f.to_vec(), Rgb888::new(200, 180, 160)).unwrap()
 }
@@ -56,7 +45,7 @@ fn vertices_at_the_model_envelope_limit() {
     let (m, _) = check(
         "envelope-limit triangle",
         mesh(&[[-l, -l, 0.0], [l, -l, 0.0], [0.0, l, 0.0]], &[[0, 1, 2]]),
-        cam([0.0, 0.0, 9000.0], [0.0; 3], 60.0, 10.0, 16000.0),
+        CameraSpec::looking_at([0.0, 0.0, 9000.0], [0.0; 3], 60.0, 10.0, 16000.0),
         true,
         64,
         64,
@@ -84,7 +73,7 @@ fn triangles_far_larger_than_the_screen() {
             ],
             &[[0, 1, 2]],
         ),
-        cam([0.0, 2.0, 0.0], [0.0, 0.0, -10.0], 70.0, 0.1, 10000.0),
+        CameraSpec::looking_at([0.0, 2.0, 0.0], [0.0, 0.0, -10.0], 70.0, 0.1, 10000.0),
         false,
         96,
         64,
@@ -111,7 +100,7 @@ fn sub_pixel_triangles_cover_only_the_centres_they_contain() {
     let (m, stats) = check(
         "sub-pixel triangles",
         mesh(&v, &f),
-        cam([0.0, 0.0, 2.5], [0.0; 3], 60.0, 0.5, 10.0),
+        CameraSpec::looking_at([0.0, 0.0, 2.5], [0.0; 3], 60.0, 0.5, 10.0),
         true,
         96,
         96,
@@ -137,7 +126,7 @@ fn slivers_of_aspect_ratio_ten_thousand() {
     check(
         "slivers 1:10^4",
         mesh(&v, &f),
-        cam([0.1, 0.05, 3.0], [0.0; 3], 50.0, 0.5, 10.0),
+        CameraSpec::looking_at([0.1, 0.05, 3.0], [0.0; 3], 50.0, 0.5, 10.0),
         false,
         128,
         96,
@@ -157,7 +146,7 @@ fn collinear_and_coincident_vertices_draw_nothing() {
             ],
             &[[0, 1, 2], [0, 0, 1], [3, 3, 3]],
         ),
-        cam([0.0, 0.0, 4.0], [0.0; 3], 60.0, 0.5, 10.0),
+        CameraSpec::looking_at([0.0, 0.0, 4.0], [0.0; 3], 60.0, 0.5, 10.0),
         false,
         64,
         64,
@@ -172,7 +161,7 @@ fn eye_inside_a_closed_mesh_and_on_a_triangle_plane() {
     let (_, culled) = check(
         "eye inside cube, culled",
         mesh(&v, &f),
-        cam([0.2, 0.1, 0.3], [0.0, 0.0, -1.0], 90.0, 0.05, 10.0),
+        CameraSpec::looking_at([0.2, 0.1, 0.3], [0.0, 0.0, -1.0], 90.0, 0.05, 10.0),
         true,
         64,
         64,
@@ -181,7 +170,7 @@ fn eye_inside_a_closed_mesh_and_on_a_triangle_plane() {
     let (_, open) = check(
         "eye inside cube, no culling",
         mesh(&v, &f),
-        cam([0.2, 0.1, 0.3], [0.0, 0.0, -1.0], 90.0, 0.05, 10.0),
+        CameraSpec::looking_at([0.2, 0.1, 0.3], [0.0, 0.0, -1.0], 90.0, 0.05, 10.0),
         false,
         64,
         64,
@@ -194,7 +183,7 @@ fn eye_inside_a_closed_mesh_and_on_a_triangle_plane() {
             &[[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 0.0, -3.0]],
             &[[0, 1, 2]],
         ),
-        cam([0.0, 0.0, 0.0], [0.0, 0.0, -2.0], 60.0, 0.1, 10.0),
+        CameraSpec::looking_at([0.0, 0.0, 0.0], [0.0, 0.0, -2.0], 60.0, 0.1, 10.0),
         false,
         64,
         64,
@@ -222,7 +211,7 @@ fn near_far_ratios_from_ten_to_a_hundred_thousand() {
         let (m, _) = check(
             &name,
             mesh(&v, &f),
-            cam([0.0; 3], [0.0, 0.0, -1.0], 60.0, near, far),
+            CameraSpec::looking_at([0.0; 3], [0.0, 0.0, -1.0], 60.0, near, far),
             true,
             64,
             64,
@@ -244,7 +233,7 @@ fn near_far_ratios_from_ten_to_a_hundred_thousand() {
     ];
     let spec = SceneSpec::single(
         mesh(&v, &[[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]]),
-        cam([0.0; 3], [0.0, 0.0, -1.0], 60.0, near, far),
+        CameraSpec::looking_at([0.0; 3], [0.0, 0.0, -1.0], 60.0, near, far),
         LightSpec::default(),
         true,
     );
@@ -263,7 +252,7 @@ fn extreme_fields_of_view_and_screen_shapes() {
     check(
         "fov 1 degree",
         sphere.clone(),
-        cam([0.0, 0.0, 100.0], [0.0; 3], 1.0, 50.0, 200.0),
+        CameraSpec::looking_at([0.0, 0.0, 100.0], [0.0; 3], 1.0, 50.0, 200.0),
         true,
         64,
         64,
@@ -271,7 +260,7 @@ fn extreme_fields_of_view_and_screen_shapes() {
     check(
         "fov 170 degrees",
         sphere.clone(),
-        cam([0.0, 0.0, 1.5], [0.0; 3], 170.0, 0.1, 10.0),
+        CameraSpec::looking_at([0.0, 0.0, 1.5], [0.0; 3], 170.0, 0.1, 10.0),
         true,
         64,
         64,
@@ -281,7 +270,7 @@ fn extreme_fields_of_view_and_screen_shapes() {
         &[[-60.0, -1.0, 0.0], [60.0, -1.0, 0.0], [0.0, 1.5, 0.0]],
         &[[0, 1, 2]],
     );
-    let c = cam([0.5, 0.3, 3.0], [0.0; 3], 50.0, 0.5, 10.0);
+    let c = CameraSpec::looking_at([0.5, 0.3, 3.0], [0.0; 3], 50.0, 0.5, 10.0);
     for (w, h) in [(1, 1), (1, 64), (64, 1), (2048, 4)] {
         let (m, stats) = check(&format!("screen {w}x{h}"), wide.clone(), c, false, w, h);
         assert_eq!(m.pixels, w * h);
