@@ -176,6 +176,12 @@ impl TriangleWalk {
         }
     }
 
+    /// The row after the walk's last row.
+    #[inline]
+    pub fn end_row(&self) -> i32 {
+        self.end_row as i32
+    }
+
     /// Moves to the next row; `false` when the triangle is finished.
     #[inline]
     pub fn advance<const S: u32>(&mut self) -> bool {

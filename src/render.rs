@@ -98,18 +98,45 @@ pub struct FrameStats {
     pub pixels_written: u32,
     /// Largest number of triangles active on one row.
     pub peak_active: u16,
+    /// Largest number of non-empty spans on one row.
+    pub peak_spans: u16,
     /// Triangle pieces not drawn because the active list was full (0 in a complete frame).
     pub dropped: u32,
-    /// First row on which a piece was dropped.
-    pub first_dropped_row: Option<u16>,
+    /// The first [`DROP_LOG`] pieces dropped, in the order they were dropped (top to bottom):
+    /// which triangle lost which rows.
+    pub dropped_pieces: [Option<DroppedPiece>; DROP_LOG],
+    /// Rows that a dropped piece spans, i.e. rows that may be missing a triangle. Each such
+    /// row is also sent with [`Row::complete`] false.
+    pub incomplete_rows: u16,
     /// Rows handed to the sink.
     pub rows: u16,
+}
+
+/// How many dropped pieces [`FrameStats::dropped_pieces`] records (all are counted).
+pub const DROP_LOG: usize = 4;
+
+/// A triangle piece the active list had no room for, and the rows it would have covered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DroppedPiece {
+    /// Global triangle id (the index across the scene's instances, as in [`TriangleId`]).
+    ///
+    /// [`TriangleId`]: crate::sink::TriangleId
+    pub triangle: u32,
+    /// First row the piece would have been drawn on.
+    pub first_row: u16,
+    /// Last row the piece would have been drawn on.
+    pub last_row: u16,
 }
 
 impl FrameStats {
     /// Whether every triangle was drawn (no capacity degradation).
     pub fn is_complete(&self) -> bool {
         self.dropped == 0
+    }
+
+    /// The first row that may be missing a triangle, if any.
+    pub fn first_incomplete_row(&self) -> Option<u16> {
+        self.dropped_pieces[0].map(|d| d.first_row)
     }
 }
 
@@ -196,7 +223,7 @@ const NO_ENTRY: u16 = u16::MAX;
 /// * `W × H`: the target size (1..=2048 each);
 /// * `TRIS`: triangles that may survive culling in one frame (≤ 65535);
 /// * `ACTIVE`: triangles that may cross one row (more are dropped and reported in
-///   [`FrameStats::dropped`]).
+///   [`FrameStats::dropped`], [`FrameStats::dropped_pieces`] and [`Row::complete`]).
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
@@ -580,6 +607,8 @@ fn render_frame<P: RowPixel, S: Shading, const SUB: u32, K: RowSink<P>>(
 
     // Pass 2: rows top to bottom.
     ws.active.clear();
+    // Last row covered by any dropped piece so far: rows up to it are incomplete.
+    let mut lost_until = -1i32;
     for row in 0..height {
         let y = row as i32;
         // Activate this row's bucket.
@@ -612,11 +641,21 @@ fn render_frame<P: RowPixel, S: Shading, const SUB: u32, K: RowSink<P>>(
                     depth: DepthPlane::new(&solver, &s),
                     payload: S::payload::<P, SUB>(face, id as u32, &solver, &s),
                 };
+                let (first_row, last_row) = (tri_state.walk.row(), tri_state.walk.end_row() - 1);
                 if active.push(tri_state).is_ok() {
                     stats.activated += 1;
                 } else {
+                    // Degrade deterministically: this piece is lost, everything else is drawn.
+                    let piece = DroppedPiece {
+                        triangle: id as u32,
+                        first_row: first_row as u16,
+                        last_row: last_row as u16,
+                    };
+                    if let Some(slot) = stats.dropped_pieces.get_mut(stats.dropped as usize) {
+                        *slot = Some(piece);
+                    }
                     stats.dropped += 1;
-                    stats.first_dropped_row.get_or_insert(row as u16);
+                    lost_until = lost_until.max(last_row);
                 }
             });
         }
@@ -626,6 +665,7 @@ fn render_frame<P: RowPixel, S: Shading, const SUB: u32, K: RowSink<P>>(
         ws.depth.fill(Depth::ZERO);
         ws.pixels.fill(ws.background);
         let (depth, pixels) = (&mut *ws.depth, &mut *ws.pixels);
+        let mut spans = 0u16;
         ws.active.retain_mut(|t| {
             if t.walk.row() > y {
                 return true; // a clipped piece that starts lower down
@@ -637,17 +677,22 @@ fn render_frame<P: RowPixel, S: Shading, const SUB: u32, K: RowSink<P>>(
                 let span = SpanDepth { x0: l, y, q, dq };
                 let cols = l as usize..r as usize;
                 if let (Some(d), Some(p)) = (depth.get_mut(cols.clone()), pixels.get_mut(cols)) {
-                    stats.spans += 1;
+                    spans += 1;
                     stats.fragments += (r - l) as u32;
                     stats.pixels_written += S::fill(&t.payload, t.depth.origin(), span, d, p);
                 }
             }
             t.walk.advance::<SUB>()
         });
+        stats.spans += spans as u32;
+        stats.peak_spans = stats.peak_spans.max(spans);
+        let complete = y > lost_until;
+        stats.incomplete_rows += !complete as u16;
         sink.write_row(Row {
             y: row as u16,
             pixels: ws.pixels,
             depth: ws.depth,
+            complete,
         })
         .map_err(|error| RenderError::Sink {
             row: row as u16,

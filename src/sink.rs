@@ -86,6 +86,9 @@ pub struct Row<'a, P> {
     pub pixels: &'a [P],
     /// The row's depth (`near / w`, 0 = background), same length.
     pub depth: &'a [Depth],
+    /// `false` if a triangle piece that spans this row was dropped because the active list was
+    /// full (see [`FrameStats::dropped_pieces`](crate::render::FrameStats::dropped_pieces)).
+    pub complete: bool,
 }
 
 /// Receives finished rows, each exactly once, top to bottom.
@@ -109,7 +112,7 @@ pub trait RowSink<P> {
 /// let mut display = MockDisplay::<BinaryColor>::new();
 /// let mut sink = DrawTargetSink::new(&mut display);
 /// let pixels = [BinaryColor::On, BinaryColor::Off];
-/// sink.write_row(Row { y: 1, pixels: &pixels, depth: &[Default::default(); 2] }).unwrap();
+/// sink.write_row(Row { y: 1, pixels: &pixels, depth: &[Default::default(); 2], complete: true }).unwrap();
 /// display.assert_pattern(&[
 ///     "  ",
 ///     "#.",
@@ -199,7 +202,7 @@ pub enum FrameBufferError {
 /// use scanline3d::sink::{FrameBuffer, Row, RowSink};
 /// let mut pixels = [Gray8::new(0); 6];
 /// let mut fb = FrameBuffer::new(&mut pixels, 3);
-/// fb.write_row(Row { y: 1, pixels: &[Gray8::new(9); 3], depth: &[Default::default(); 3] }).unwrap();
+/// fb.write_row(Row { y: 1, pixels: &[Gray8::new(9); 3], depth: &[Default::default(); 3], complete: true }).unwrap();
 /// assert_eq!(pixels[3], Gray8::new(9));
 /// ```
 pub struct FrameBuffer<'a, P> {
@@ -236,7 +239,7 @@ impl<P: Copy> RowSink<P> for FrameBuffer<'_, P> {
 /// use scanline3d::sink::{FnSink, Row, RowSink};
 /// let mut rows = 0;
 /// let mut sink = FnSink(|row: Row<'_, Rgb565>| -> Result<(), ()> { rows += row.y as usize; Ok(()) });
-/// sink.write_row(Row { y: 2, pixels: &[], depth: &[] }).unwrap();
+/// sink.write_row(Row { y: 2, pixels: &[], depth: &[], complete: true }).unwrap();
 /// assert_eq!(rows, 2);
 /// ```
 pub struct FnSink<F>(pub F);
@@ -257,9 +260,9 @@ impl<P, E, F: FnMut(Row<'_, P>) -> Result<(), E>> RowSink<P> for FnSink<F> {
 /// use embedded_graphics::pixelcolor::Rgb565;
 /// use scanline3d::sink::{HashSink, Row, RowSink};
 /// let mut a = HashSink::new();
-/// a.write_row(Row { y: 0, pixels: &[Rgb565::new(1, 2, 3)], depth: &[Default::default()] }).unwrap();
+/// a.write_row(Row { y: 0, pixels: &[Rgb565::new(1, 2, 3)], depth: &[Default::default()], complete: true }).unwrap();
 /// let mut b = HashSink::new();
-/// b.write_row(Row { y: 0, pixels: &[Rgb565::new(1, 2, 4)], depth: &[Default::default()] }).unwrap();
+/// b.write_row(Row { y: 0, pixels: &[Rgb565::new(1, 2, 4)], depth: &[Default::default()], complete: true }).unwrap();
 /// assert_ne!(a.hash(), b.hash());
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -348,6 +351,7 @@ mod tests {
             y: 2,
             pixels: &[1u8, 2],
             depth: &[Depth::ZERO; 2],
+            complete: true,
         };
         assert_eq!(fb.write_row(row), Err(FrameBufferError::OutOfBounds));
     }

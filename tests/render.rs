@@ -222,8 +222,74 @@ fn too_many_triangles_fails_before_any_row() {
     assert_eq!(rows, 0);
 }
 
+/// Renders `scene` into a 64×64 id image with an active list of `ACTIVE` entries; returns the
+/// ids, each row's `complete` flag and the stats.
+fn render_with_active<const ACTIVE: usize>(
+    scene: &Scene<'_>,
+) -> (Vec<i32>, Vec<bool>, scanline3d::FrameStats) {
+    let mut ws: Box<Workspace<TriangleId, Flat, 64, 64, 512, ACTIVE>> =
+        Box::new(Workspace::new(TriangleId::NONE));
+    let (mut ids, mut complete) = (Vec::new(), Vec::new());
+    let stats = ws
+        .render(
+            scene,
+            &RenderOptions::default(),
+            &mut FnSink(|row: Row<'_, TriangleId>| -> Result<(), ()> {
+                ids.extend(row.pixels.iter().map(|p| p.0));
+                complete.push(row.complete);
+                Ok(())
+            }),
+        )
+        .unwrap();
+    (ids, complete, stats)
+}
+
+/// Checks a degraded frame against the complete one: only incomplete rows differ, and only
+/// where a dropped triangle was visible; the flags and the log agree.
+fn check_degraded(
+    full: &[i32],
+    (ids, complete, s): &(Vec<i32>, Vec<bool>, scanline3d::FrameStats),
+) {
+    assert!(!s.is_complete());
+    assert_eq!(s.rows, 64);
+    let logged: Vec<_> = s.dropped_pieces.iter().flatten().collect();
+    assert_eq!(
+        logged.len(),
+        (s.dropped as usize).min(scanline3d::render::DROP_LOG)
+    );
+    assert_eq!(s.first_incomplete_row(), Some(logged[0].first_row));
+    assert_eq!(
+        complete.iter().filter(|c| !**c).count(),
+        s.incomplete_rows as usize
+    );
+    for d in &logged {
+        assert!(d.first_row <= d.last_row);
+        for r in d.first_row..=d.last_row {
+            assert!(
+                !complete[r as usize],
+                "row {r} lost triangle {} but is flagged complete",
+                d.triangle
+            );
+        }
+    }
+    let mut differing = 0;
+    for (i, (&a, &b)) in full.iter().zip(ids.iter()).enumerate() {
+        if a != b {
+            differing += 1;
+            assert!(!complete[i / 64], "pixel {i} differs in a complete row");
+            if s.dropped as usize <= scanline3d::render::DROP_LOG {
+                assert!(
+                    logged.iter().any(|d| d.triangle as i32 == a),
+                    "pixel {i}: triangle {a} was not dropped"
+                );
+            }
+        }
+    }
+    assert!(differing > 0);
+}
+
 #[test]
-fn full_active_list_degrades_deterministically_and_reports() {
+fn full_active_list_degrades_deterministically_and_reports_what_was_lost() {
     let sphere = icosphere(2, 1.0);
     let mesh = sphere.mesh().unwrap();
     let instances = [instance(&mesh)];
@@ -232,27 +298,25 @@ fn full_active_list_degrades_deterministically_and_reports() {
         camera: front_camera().fixed().unwrap(),
         light: light(),
     };
-    let render = || {
-        let mut ws: Box<Workspace<TriangleId, Flat, 64, 64, 512, 6>> =
-            Box::new(Workspace::new(TriangleId::NONE));
-        let mut ids = Vec::new();
-        let stats = ws
-            .render(
-                &scene,
-                &RenderOptions::default(),
-                &mut FnSink(|row: Row<'_, TriangleId>| -> Result<(), ()> {
-                    ids.extend(row.pixels.iter().map(|p| p.0));
-                    Ok(())
-                }),
-            )
-            .unwrap();
-        (ids, stats)
-    };
-    let (a, sa) = render();
-    let (b, sb) = render();
-    assert!(!sa.is_complete() && sa.dropped > 0 && sa.first_dropped_row.is_some());
-    assert_eq!(sa.rows, 64);
-    assert_eq!((a, sa), (b, sb));
+    let (full, full_complete, full_stats) = render_with_active::<64>(&scene);
+    assert!(full_stats.is_complete() && full_complete.iter().all(|c| *c));
+    assert_eq!(full_stats.incomplete_rows, 0);
+    let peak = full_stats.peak_active;
+    assert_eq!(peak, 18, "the scene this test was sized for");
+
+    // One entry short of the peak: a few pieces are lost, each one logged.
+    let few = render_with_active::<17>(&scene);
+    assert!(
+        few.2.dropped as usize <= scanline3d::render::DROP_LOG,
+        "{:?}",
+        few.2
+    );
+    check_degraded(&full, &few);
+    // Far too small: many pieces are lost; counts stay exact, the log keeps the first ones.
+    let many = render_with_active::<6>(&scene);
+    assert!(many.2.dropped as usize > scanline3d::render::DROP_LOG);
+    check_degraded(&full, &many);
+    assert_eq!(many, render_with_active::<6>(&scene), "deterministic");
 }
 
 #[test]
