@@ -38,6 +38,80 @@ pub enum Clipped {
     Outside,
     /// Cut: the remaining convex polygon (at least 3 vertices) is in the output buffer.
     Polygon,
+    /// Crosses a plane but clipping is compiled out ([`NoClip`]): not drawn, and counted in
+    /// [`FrameStats::unclipped`](crate::render::FrameStats::unclipped).
+    Skipped,
+}
+
+/// The clipping stage, chosen at compile time in
+/// [`RenderOptions`](crate::render::RenderOptions): [`FrustumClip`] (the default) or
+/// [`NoClip`] for scenes that provably never cross the near, far or guard-band planes, which
+/// leaves the clipper (and its 128-bit arithmetic) out of the build.
+pub trait Clipping: Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed {
+    /// Whether this stage can cut triangles.
+    const CLIPS: bool;
+    /// Classifies `tri` and, if it is cut, leaves the remaining polygon in `out`.
+    fn clip<const S: u32>(
+        vp: &Viewport<S>,
+        tri: &[ClipVertex; 3],
+        out: &mut ClipPolygon,
+    ) -> Clipped;
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for super::FrustumClip {}
+    impl Sealed for super::NoClip {}
+}
+
+/// Clips against the near and far planes and the guard band ([`clip_triangle`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrustumClip;
+
+/// No clipping: triangles inside the view volume are drawn exactly as with [`FrustumClip`],
+/// triangles entirely outside are rejected, and triangles that cross a plane are skipped and
+/// counted ([`Clipped::Skipped`]), never drawn wrongly.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NoClip;
+
+impl Clipping for FrustumClip {
+    const CLIPS: bool = true;
+    fn clip<const S: u32>(
+        vp: &Viewport<S>,
+        tri: &[ClipVertex; 3],
+        out: &mut ClipPolygon,
+    ) -> Clipped {
+        clip_triangle(vp, tri, out)
+    }
+}
+
+impl Clipping for NoClip {
+    const CLIPS: bool = false;
+    fn clip<const S: u32>(vp: &Viewport<S>, tri: &[ClipVertex; 3], _: &mut ClipPolygon) -> Clipped {
+        match classify(vp, tri) {
+            Clipped::Polygon => Clipped::Skipped,
+            other => other,
+        }
+    }
+}
+
+/// Whether `tri` is inside, outside, or crosses a plane ([`Clipped::Polygon`], with nothing
+/// written anywhere).
+pub fn classify<const S: u32>(vp: &Viewport<S>, tri: &[ClipVertex; 3]) -> Clipped {
+    let d = tri.each_ref().map(|v| vp.clip_distances(&v.p));
+    let mut any_out = false;
+    for plane in 0..6 {
+        let outs = d.iter().filter(|dist| dist[plane] < 0).count();
+        if outs == 3 {
+            return Clipped::Outside;
+        }
+        any_out |= outs > 0;
+    }
+    if any_out {
+        Clipped::Polygon
+    } else {
+        Clipped::Inside
+    }
 }
 
 /// Fractional bits of the intersection parameter `t = d_in / (d_in − d_out)` in [0, 1].
@@ -75,17 +149,9 @@ pub fn clip_triangle<const S: u32>(
     tri: &[ClipVertex; 3],
     out: &mut ClipPolygon,
 ) -> Clipped {
-    let d = tri.each_ref().map(|v| vp.clip_distances(&v.p));
-    let mut any_out = false;
-    for plane in 0..6 {
-        let outs = d.iter().filter(|dist| dist[plane] < 0).count();
-        if outs == 3 {
-            return Clipped::Outside;
-        }
-        any_out |= outs > 0;
-    }
-    if !any_out {
-        return Clipped::Inside;
+    match classify(vp, tri) {
+        Clipped::Polygon => {}
+        other => return other,
     }
     out.clear();
     for v in tri {

@@ -17,7 +17,7 @@
 //! `ACTIVE · size_of` of an active triangle (about 104 for flat shading). See
 //! [`Workspace::BYTES`].
 
-use crate::clip::{clip_triangle, ClipPolygon, ClipVertex, Clipped};
+use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping, FrustumClip};
 use crate::project::{Depth, ScreenVertex, Viewport};
 use crate::raster::{
     color_channels, first_row, signed_area, xy, DepthPlane, PlaneSolver, TriangleWalk,
@@ -45,32 +45,53 @@ pub const MAX_INSTANCES: usize = 8;
 /// assert!(!both_sides.cull_back_faces);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RenderOptions<const SUB_BITS: u32 = 4> {
+pub struct RenderOptions<const SUB_BITS: u32 = 4, C: Clipping = FrustumClip> {
     /// Skip triangles whose front (counter-clockwise) side faces away from the camera.
     pub cull_back_faces: bool,
+    /// The clipping stage (a zero-sized type).
+    pub clipping: C,
 }
 
 impl Default for RenderOptions<4> {
     fn default() -> Self {
         RenderOptions {
             cull_back_faces: true,
+            clipping: FrustumClip,
         }
     }
 }
 
-impl<const SUB_BITS: u32> RenderOptions<SUB_BITS> {
+impl<const SUB_BITS: u32, C: Clipping> RenderOptions<SUB_BITS, C> {
     /// The same options with back-face culling on or off. (Prefer this to a struct literal,
     /// which cannot infer the default `SUB_BITS`.)
     pub const fn with_back_face_culling(self, on: bool) -> Self {
         RenderOptions {
             cull_back_faces: on,
+            clipping: self.clipping,
         }
     }
 
     /// The same options with another number of sub-pixel bits.
-    pub const fn with_sub_pixel_bits<const N: u32>(self) -> RenderOptions<N> {
+    pub const fn with_sub_pixel_bits<const N: u32>(self) -> RenderOptions<N, C> {
         RenderOptions {
             cull_back_faces: self.cull_back_faces,
+            clipping: self.clipping,
+        }
+    }
+
+    /// The same options with another clipping stage: [`NoClip`](crate::clip::NoClip) compiles the clipper out
+    /// for scenes that never need it (`sim analyze` reports whether one does); triangles
+    /// that would need it anyway are counted in [`FrameStats::unclipped`].
+    ///
+    /// ```
+    /// use scanline3d::{clip::NoClip, RenderOptions};
+    /// let lean = RenderOptions::default().with_clipping(NoClip);
+    /// assert_eq!(lean.clipping, NoClip);
+    /// ```
+    pub const fn with_clipping<D: Clipping>(self, clipping: D) -> RenderOptions<SUB_BITS, D> {
+        RenderOptions {
+            cull_back_faces: self.cull_back_faces,
+            clipping,
         }
     }
 }
@@ -86,6 +107,9 @@ pub struct FrameStats {
     pub clipped: u32,
     /// Triangles outside the view volume or the screen, or of zero area once snapped.
     pub rejected: u32,
+    /// Triangles not drawn because they cross a clip plane and the options use
+    /// [`NoClip`](crate::clip::NoClip) (0 with [`FrustumClip`]).
+    pub unclipped: u32,
     /// Triangles filed in row buckets.
     pub bucketed: u32,
     /// Triangles (or clipped pieces) set up for the walk.
@@ -331,10 +355,10 @@ impl<
     /// assert_eq!(stats.fragments, 28);
     /// # Ok::<(), scanline3d::scene::SceneError>(())
     /// ```
-    pub fn render<const SUB_BITS: u32, K: RowSink<P>>(
+    pub fn render<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
         &mut self,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS>,
+        options: &RenderOptions<SUB_BITS, C>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         self.render_sized(W, H, scene, options, sink)
@@ -361,12 +385,12 @@ impl<
     /// assert_eq!((rows, stats.rows), (80, 80));
     /// # Ok::<(), scanline3d::scene::SceneError>(())
     /// ```
-    pub fn render_sized<const SUB_BITS: u32, K: RowSink<P>>(
+    pub fn render_sized<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
         &mut self,
         width: usize,
         height: usize,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS>,
+        options: &RenderOptions<SUB_BITS, C>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         if width == 0 || height == 0 || width > W || height > H {
@@ -436,6 +460,7 @@ fn setup_instances<'a, E>(
 enum Fate {
     Culled,
     Rejected,
+    Unclipped,
     Visible { first_row: i32, clipped: bool },
 }
 
@@ -481,7 +506,7 @@ impl InstanceSetup<'_> {
     }
 
     /// Clips and projects triangle `tri`, calling `f` with each visible screen triangle.
-    fn screen_triangles<const S: u32>(
+    fn screen_triangles<const S: u32, C: Clipping>(
         &self,
         tri: usize,
         vp: &Viewport<S>,
@@ -513,8 +538,9 @@ impl InstanceSetup<'_> {
         };
         let project = |c: &ClipVertex| vp.project(&c.p, c.color);
         let mut polygon = ClipPolygon::new();
-        let clipped = match clip_triangle(vp, &cv, &mut polygon) {
+        let clipped = match C::clip(vp, &cv, &mut polygon) {
             Clipped::Outside => return Fate::Rejected,
+            Clipped::Skipped => return Fate::Unclipped,
             Clipped::Inside => {
                 if let [Some(a), Some(b), Some(c)] = cv.each_ref().map(project) {
                     emit([a, b, c]);
@@ -553,10 +579,10 @@ fn locate<'s, 'a>(
         .map(|s| (s, (id - s.first_id) as usize))
 }
 
-fn render_frame<P: RowPixel, S: Shading, const SUB: u32, K: RowSink<P>>(
+fn render_frame<P: RowPixel, S: Shading, const SUB: u32, C: Clipping, K: RowSink<P>>(
     ws: View<'_, P, S>,
     scene: &Scene<'_>,
-    options: &RenderOptions<SUB>,
+    options: &RenderOptions<SUB, C>,
     vp: &Viewport<SUB>,
     sink: &mut K,
 ) -> Result<FrameStats, RenderError<K::Error>> {
@@ -573,9 +599,11 @@ fn render_frame<P: RowPixel, S: Shading, const SUB: u32, K: RowSink<P>>(
         let n = setup.instance.mesh.triangles().len();
         stats.triangles_in += n as u32;
         for tri in (0..n).rev() {
-            match setup.screen_triangles(tri, vp, options.cull_back_faces, false, |_| {}) {
+            match setup.screen_triangles::<SUB, C>(tri, vp, options.cull_back_faces, false, |_| {})
+            {
                 Fate::Culled => stats.culled += 1,
                 Fate::Rejected => stats.rejected += 1,
+                Fate::Unclipped => stats.unclipped += 1,
                 Fate::Visible { first_row, clipped } => {
                     stats.clipped += clipped as u32;
                     stats.bucketed += 1;
@@ -629,35 +657,42 @@ fn render_frame<P: RowPixel, S: Shading, const SUB: u32, K: RowSink<P>>(
                 setup.face_color(tri, idx)
             };
             let active = &mut *ws.active;
-            setup.screen_triangles(tri, vp, options.cull_back_faces, S::PER_VERTEX, |s| {
-                let (Some(walk), Some(solver)) = (
-                    TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32),
-                    PlaneSolver::new(&s),
-                ) else {
-                    return;
-                };
-                let tri_state = ActiveTri {
-                    walk,
-                    depth: DepthPlane::new(&solver, &s),
-                    payload: S::payload::<P, SUB>(face, id as u32, &solver, &s),
-                };
-                let (first_row, last_row) = (tri_state.walk.row(), tri_state.walk.end_row() - 1);
-                if active.push(tri_state).is_ok() {
-                    stats.activated += 1;
-                } else {
-                    // Degrade deterministically: this piece is lost, everything else is drawn.
-                    let piece = DroppedPiece {
-                        triangle: id as u32,
-                        first_row: first_row as u16,
-                        last_row: last_row as u16,
+            setup.screen_triangles::<SUB, C>(
+                tri,
+                vp,
+                options.cull_back_faces,
+                S::PER_VERTEX,
+                |s| {
+                    let (Some(walk), Some(solver)) = (
+                        TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32),
+                        PlaneSolver::new(&s),
+                    ) else {
+                        return;
                     };
-                    if let Some(slot) = stats.dropped_pieces.get_mut(stats.dropped as usize) {
-                        *slot = Some(piece);
+                    let tri_state = ActiveTri {
+                        walk,
+                        depth: DepthPlane::new(&solver, &s),
+                        payload: S::payload::<P, SUB>(face, id as u32, &solver, &s),
+                    };
+                    let (first_row, last_row) =
+                        (tri_state.walk.row(), tri_state.walk.end_row() - 1);
+                    if active.push(tri_state).is_ok() {
+                        stats.activated += 1;
+                    } else {
+                        // Degrade deterministically: this piece is lost, everything else is drawn.
+                        let piece = DroppedPiece {
+                            triangle: id as u32,
+                            first_row: first_row as u16,
+                            last_row: last_row as u16,
+                        };
+                        if let Some(slot) = stats.dropped_pieces.get_mut(stats.dropped as usize) {
+                            *slot = Some(piece);
+                        }
+                        stats.dropped += 1;
+                        lost_until = lost_until.max(last_row);
                     }
-                    stats.dropped += 1;
-                    lost_until = lost_until.max(last_row);
-                }
-            });
+                },
+            );
         }
         stats.peak_active = stats.peak_active.max(ws.active.len() as u16);
 

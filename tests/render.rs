@@ -5,9 +5,10 @@ mod common;
 
 use common::*;
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888, RgbColor};
+use scanline3d::clip::NoClip;
 use scanline3d::render::CapacityKind;
 use scanline3d::scene::{Instance, Mesh, MeshColors, Scene, Transform};
-use scanline3d::sink::{FnSink, Row, TriangleId};
+use scanline3d::sink::{FnSink, HashSink, Row, TriangleId};
 use scanline3d::{Flat, Gouraud, RenderError, RenderOptions, Workspace};
 
 #[test]
@@ -82,6 +83,67 @@ fn near_plane_crossing_triangles_render() {
         let (mismatches, real) = compare(&[&data], &cam, &ids, 48, 48, 4, false);
         assert_eq!(real, 0, "{name}: {mismatches} mismatches");
         assert!(ids.iter().filter(|&&i| i == 0).count() > 100, "{name}");
+    }
+}
+
+#[test]
+fn without_clipping_crossing_triangles_are_skipped_and_counted_never_drawn_wrong() {
+    let verts = [
+        [-20.0, 0.0, 20.0],
+        [20.0, 0.0, 20.0],
+        [20.0, 0.0, -20.0],
+        [-20.0, 0.0, -20.0],
+        [0.0, 0.0, 1.0],
+    ];
+    // The near-plane fan above plus a small triangle well inside the view volume (id 4).
+    let mut verts = verts.to_vec();
+    verts.extend([[-0.5, 0.5, -3.0], [0.5, 0.5, -3.0], [0.0, 1.2, -3.0]]);
+    let tris = [[4, 0, 1], [4, 1, 2], [4, 2, 3], [4, 3, 0], [5, 6, 7]];
+    let data = mesh_data(&verts, &tris);
+    let mesh = data.mesh().unwrap();
+    let cam = CameraSpec::looking_at([0.0, 1.0, 2.0], [0.0, 0.0, -3.0], 70.0, 0.2, 60.0);
+    let instances = [instance(&mesh)];
+    let clipping = RenderOptions::default().with_back_face_culling(false);
+    let (full, fs) = render_ids_with::<64, 48, 4, _>(&instances, &cam, &clipping);
+    let (lean, ls) =
+        render_ids_with::<64, 48, 4, _>(&instances, &cam, &clipping.with_clipping(NoClip));
+    assert!(fs.clipped >= 2 && fs.unclipped == 0, "{fs:?}");
+    assert_eq!(ls.clipped, 0);
+    assert_eq!(
+        ls.unclipped, fs.clipped,
+        "every cut triangle is skipped instead"
+    );
+    // What is drawn is drawn exactly as with clipping; the skipped triangles never appear.
+    let ids = |img: &[i32]| {
+        let mut v: Vec<i32> = img.iter().copied().filter(|&id| id >= 0).collect();
+        v.sort();
+        v.dedup();
+        v
+    };
+    for id in ids(&lean) {
+        let at = |img: &[i32]| (0..img.len()).filter(|&i| img[i] == id).collect::<Vec<_>>();
+        assert_eq!(at(&lean), at(&full), "triangle {id}");
+    }
+    assert!(ids(&lean).contains(&4));
+    assert!(ids(&full).len() > ids(&lean).len());
+}
+
+#[test]
+fn without_clipping_scenes_that_need_none_render_bit_identically() {
+    let mut ws = Box::new(scanline3d::demo::PanelWorkspace::new(Rgb565::new(0, 0, 0)));
+    // Sphere and cube: the ground plane is cut by the guard band in some frames.
+    let instances = &scanline3d::demo::instances()[..2];
+    for frame in 0..scanline3d::demo::ORBIT_FRAMES {
+        let scene = scanline3d::demo::scene(instances, frame, 8).unwrap();
+        let (mut a, mut b) = (HashSink::new(), HashSink::new());
+        let sa = ws
+            .render(&scene, &RenderOptions::default(), &mut a)
+            .unwrap();
+        let lean = RenderOptions::default().with_clipping(NoClip);
+        let sb = ws.render(&scene, &lean, &mut b).unwrap();
+        let (a, b) = (a.hash(), b.hash());
+        assert_eq!(sa.clipped + sa.unclipped + sb.unclipped, 0);
+        assert_eq!((a, sa), (b, sb), "frame {frame}");
     }
 }
 

@@ -4,6 +4,7 @@
 
 use embedded_graphics::pixelcolor::Rgb888;
 use fixed::types::I16F16;
+use scanline3d::clip::Clipping;
 use scanline3d::scene::{Instance, Light, Mesh, Scene, Transform, Vertex};
 use scanline3d::sink::{FnSink, Row, TriangleId};
 use scanline3d::{Flat, FrameStats, RenderOptions, Workspace};
@@ -43,6 +44,18 @@ pub fn render_ids<const W: usize, const H: usize, const S: u32>(
     cam: &CameraSpec,
     cull: bool,
 ) -> (Vec<i32>, FrameStats) {
+    let options = RenderOptions::default()
+        .with_back_face_culling(cull)
+        .with_sub_pixel_bits::<S>();
+    render_ids_with::<W, H, S, _>(instances, cam, &options)
+}
+
+/// [`render_ids`] with any options (such as another clipping stage).
+pub fn render_ids_with<const W: usize, const H: usize, const S: u32, C: Clipping>(
+    instances: &[Instance<'_>],
+    cam: &CameraSpec,
+    options: &RenderOptions<S, C>,
+) -> (Vec<i32>, FrameStats) {
     let scene = Scene {
         instances,
         camera: cam.fixed().unwrap(),
@@ -60,10 +73,7 @@ pub fn render_ids<const W: usize, const H: usize, const S: u32>(
         }
         Ok(())
     });
-    let options = RenderOptions::default()
-        .with_back_face_culling(cull)
-        .with_sub_pixel_bits::<S>();
-    let stats = ws.render(&scene, &options, &mut sink).unwrap();
+    let stats = ws.render(&scene, options, &mut sink).unwrap();
     assert_eq!(stats.rows as usize, H);
     (ids, stats)
 }
