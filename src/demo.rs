@@ -133,10 +133,15 @@ pub fn scene<'a>(
 /// The demo's background colour.
 pub const BACKGROUND: Rgb888 = Rgb888::new(24, 28, 40);
 
+/// Triangles the demo orbit files per frame at most, as `sim analyze --demo` measures it over
+/// every sub-pixel setting (a test keeps the two equal).
+pub const PANEL_TRIANGLES: usize = 584;
+/// Triangles crossing one row at most in the demo orbit (`sim analyze --demo`).
+pub const PANEL_ACTIVE: usize = 63;
+
 /// The workspace the firmware examples use for the demo: RGB565 (an SPI panel's format), flat
-/// shading, 240×240. Capacities come from measuring the orbit (the firmware prints them): at
-/// most 583 triangles survive culling and 63 cross one row, so 640 and 64.
-pub type PanelWorkspace = Workspace<Rgb565, Flat, WIDTH, HEIGHT, 640, 64>;
+/// shading, 240×240, with exactly the capacities the orbit needs.
+pub type PanelWorkspace = Workspace<Rgb565, Flat, WIDTH, HEIGHT, PANEL_TRIANGLES, PANEL_ACTIVE>;
 
 /// What one demo frame produced on the hashing panel model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

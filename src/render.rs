@@ -272,6 +272,43 @@ pub struct Workspace<
     active: Vec<ActiveTri<S::Payload<P>>, ACTIVE>,
 }
 
+/// Bytes of a [`Workspace`] for pixel type `P` and shading `S` with the given size and
+/// capacities: what `Workspace::<P, S, W, H, TRIS, ACTIVE>::BYTES` is, computed at run time
+/// (for tools such as `sim analyze` that choose the capacities).
+///
+/// ```
+/// use embedded_graphics::pixelcolor::Rgb565;
+/// use scanline3d::{render::workspace_bytes, Flat, Workspace};
+/// assert_eq!(
+///     workspace_bytes::<Rgb565, Flat>(240, 240, 100, 12),
+///     Workspace::<Rgb565, Flat, 240, 240, 100, 12>::BYTES
+/// );
+/// ```
+pub const fn workspace_bytes<P: RowPixel, S: Shading>(
+    width: usize,
+    height: usize,
+    triangles: usize,
+    active: usize,
+) -> usize {
+    use core::mem::{align_of, size_of};
+    let entry = size_of::<ActiveTri<S::Payload<P>>>();
+    let align = {
+        let a = align_of::<ActiveTri<S::Payload<P>>>();
+        if a > align_of::<usize>() {
+            a
+        } else {
+            align_of::<usize>()
+        }
+    };
+    let unpadded = width * (size_of::<Depth>() + size_of::<P>())
+        + size_of::<P>()
+        + height * size_of::<u16>()
+        + triangles * 2 * size_of::<u16>()
+        + active * entry
+        + size_of::<usize>();
+    unpadded.div_ceil(align) * align
+}
+
 /// The workspace as slices, so the driver is not generic over the capacities.
 struct View<'a, P: RowPixel, S: Shading> {
     depth: &'a mut [Depth],

@@ -6,7 +6,11 @@
 #![cfg_attr(target_os = "none", no_std)]
 
 #[cfg(not(target_os = "none"))]
+pub mod analyze;
+#[cfg(not(target_os = "none"))]
 pub mod corpus;
+#[cfg(not(target_os = "none"))]
+pub mod export;
 #[cfg(not(target_os = "none"))]
 pub mod fuzz;
 #[cfg(not(target_os = "none"))]

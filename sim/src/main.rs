@@ -8,7 +8,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use scanline3d_sim::metrics::{self, ErrorBound};
 use scanline3d_sim::reference::Image;
 use scanline3d_sim::scene::{self, CameraSpec, LightSpec, MeshData, SceneSpec};
-use scanline3d_sim::{accuracy, corpus};
+use scanline3d_sim::{accuracy, analyze, corpus};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -41,6 +41,12 @@ enum Command {
     Render(RenderArgs),
     /// Compare two id/depth image pairs, or re-render a scene with both renderers and compare.
     Compare(CompareArgs),
+    /// Report what a scene needs from the renderer over a set of views: capacities, RAM per
+    /// buffer, numeric headroom, clipping, and accuracy per sub-pixel setting.
+    Analyze(AnalyzeArgs),
+    /// Write a scene as Rust source for firmware: static fixed-point arrays and the budget
+    /// `analyze` measures.
+    Export(ExportArgs),
     /// Write the scene corpus as OBJ files (and list its cameras).
     Corpus {
         /// Output directory.
@@ -170,6 +176,200 @@ struct CompareArgs {
     /// With --scene: write fixed | reference | mismatches side by side to this PNG.
     #[arg(long)]
     side_by_side: Option<PathBuf>,
+}
+
+/// The views `analyze` and `export` look from.
+#[derive(Args, Debug, Clone)]
+struct Views {
+    /// The OBJ scene (or --demo).
+    scene: Option<PathBuf>,
+    /// The built-in demo scene seen from its 8-frame camera orbit (the firmware's views).
+    #[arg(long, conflicts_with = "scene")]
+    demo: bool,
+    /// One view from this eye position instead of a sphere of views.
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true)]
+    eye: Option<[f64; 3]>,
+    /// Point looked at (default: the centre of the scene's bounding box).
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true)]
+    target: Option<[f64; 3]>,
+    /// Up direction for --eye.
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true, default_value = "0,1,0")]
+    up: [f64; 3],
+    /// Number of views on the sphere of directions around the scene.
+    #[arg(long, default_value_t = 12)]
+    views: usize,
+    /// Distance of the sphere of views from the centre (default: 3 × the bounding radius).
+    #[arg(long, value_parser = finite)]
+    distance: Option<f64>,
+    /// Vertical field of view in degrees.
+    #[arg(long, value_parser = finite, default_value = "50")]
+    fov: f64,
+    /// Near plane (default: distance / 20).
+    #[arg(long, value_parser = finite)]
+    near: Option<f64>,
+    /// Far plane (default: distance × 4).
+    #[arg(long, value_parser = finite)]
+    far: Option<f64>,
+    /// Image size WxH.
+    #[arg(long, value_parser = size, default_value = "240x240")]
+    size: (usize, usize),
+    /// Draw back faces too (open surfaces).
+    #[arg(long)]
+    no_cull: bool,
+    /// Safety margin on the capacities, in percent.
+    #[arg(long, default_value_t = 0)]
+    margin: u32,
+}
+
+impl Views {
+    /// The scene (camera unused) and the cameras to analyse.
+    fn resolve(&self) -> Result<(SceneSpec, Vec<CameraSpec>), String> {
+        if self.demo {
+            let frames = scanline3d::demo::ORBIT_FRAMES;
+            let cams = (0..frames)
+                .map(|f| SceneSpec::demo(f).map(|s| s.camera))
+                .collect::<Result<Vec<_>, _>>()?;
+            return Ok((SceneSpec::demo(0)?, cams));
+        }
+        let path = self.scene.as_ref().ok_or("give an OBJ scene or --demo")?;
+        let mesh = MeshData::load_obj(path)?;
+        let placeholder = CameraSpec::looking_at([0.0, 0.0, 1.0], [0.0; 3], 50.0, 0.1, 100.0);
+        let spec = SceneSpec::single(mesh, placeholder, LightSpec::default(), !self.no_cull);
+        let (centre, radius) = analyze::bounds(&spec)?;
+        let target = self.target.unwrap_or(centre);
+        let distance = self.distance.unwrap_or(3.0 * radius.max(1e-3));
+        if !(distance > 0.0) {
+            return Err(format!("distance {distance} must be positive"));
+        }
+        if self.views == 0 || self.views > 1000 {
+            return Err(format!("--views {} must be 1..=1000", self.views));
+        }
+        let near = self.near.unwrap_or(distance / 20.0);
+        let far = self.far.unwrap_or(distance * 4.0);
+        let cams = match self.eye {
+            Some(eye) => vec![CameraSpec {
+                eye,
+                target,
+                up: self.up,
+                fovy: self.fov,
+                near,
+                far,
+            }],
+            None => analyze::sphere_views(target, distance, self.views, self.fov, near, far),
+        };
+        for c in &cams {
+            c.fixed()?;
+        }
+        Ok((spec, cams))
+    }
+}
+
+#[derive(Args, Debug)]
+struct AnalyzeArgs {
+    #[command(flatten)]
+    views: Views,
+    /// Accuracy goal for the recommendation: worst-view id mismatches in percent (and no real
+    /// mismatches).
+    #[arg(long, value_parser = finite, default_value = "0.1")]
+    goal: f64,
+}
+
+#[derive(Args, Debug)]
+struct ExportArgs {
+    #[command(flatten)]
+    views: Views,
+    /// Output Rust file.
+    #[arg(long)]
+    out: PathBuf,
+    /// Also export vertex normals (only Gouraud shading uses them).
+    #[arg(long)]
+    normals: bool,
+}
+
+fn run_analysis(v: &Views) -> Result<(SceneSpec, Vec<CameraSpec>, analyze::Analysis), String> {
+    let (spec, cams) = v.resolve()?;
+    let (w, h) = v.size;
+    let a = analyze::analyze(&spec, &cams, w, h)?;
+    Ok((spec, cams, a))
+}
+
+fn analyze_command(a: AnalyzeArgs) -> Result<(), String> {
+    let (_, _, analysis) = run_analysis(&a.views)?;
+    say!("{analysis}");
+    let margin = a.views.margin;
+    say!(
+        "capacities (margin {margin} %): TRIS = {}, ACTIVE = {}; RAM per buffer:",
+        analysis.triangle_capacity(margin),
+        analysis.active_capacity(margin)
+    );
+    for (name, bytes) in analysis.buffers(margin) {
+        say!("  {bytes:>7} B  {name}");
+    }
+    match analysis.recommended(a.goal) {
+        Some(s) => say!(
+            "recommended for ≤ {} % id mismatches and no real ones: {} sub-pixel bits",
+            a.goal,
+            s.sub_bits
+        ),
+        None => say!(
+            "no sub-pixel setting meets ≤ {} % id mismatches with no real ones",
+            a.goal
+        ),
+    }
+    Ok(())
+}
+
+fn export_command(a: ExportArgs) -> Result<(), String> {
+    if a.views.demo {
+        return Err("export takes an OBJ scene (the demo is already built in)".into());
+    }
+    let (spec, cams, analysis) = run_analysis(&a.views)?;
+    // The command in the header leaves out the output path, so the same scene and options
+    // always produce the same file.
+    let mut args = std::env::args().skip(1);
+    let mut kept = vec!["sim".to_string()];
+    while let Some(arg) = args.next() {
+        if arg == "--out" {
+            args.next();
+        } else if !arg.starts_with("--out=") {
+            kept.push(arg);
+        }
+    }
+    let command = kept.join(" ");
+    let export = scanline3d_sim::export::Export {
+        mesh: &spec.instances[0].mesh,
+        analysis: &analysis,
+        views: &cams,
+        light: spec.light,
+        cull_back_faces: spec.cull_back_faces,
+        margin_percent: a.views.margin,
+        normals: a.normals,
+        command,
+    };
+    let source = export.source();
+    let source = scanline3d_sim::export::rustfmt(&source).unwrap_or_else(|| {
+        let _ = writeln!(
+            std::io::stderr(),
+            "sim: rustfmt not found or failed: {} is valid but not formatted",
+            a.out.display()
+        );
+        source
+    });
+    std::fs::write(&a.out, source).map_err(|e| format!("{}: {e}", a.out.display()))?;
+    say!(
+        "wrote {} ({} vertices, {} triangles, TRIS = {}, ACTIVE = {}, clipping {})",
+        a.out.display(),
+        analysis.vertices,
+        analysis.triangles,
+        analysis.triangle_capacity(a.views.margin),
+        analysis.active_capacity(a.views.margin),
+        if analysis.views_clipping > 0 {
+            "needed"
+        } else {
+            "never needed"
+        }
+    );
+    Ok(())
 }
 
 fn spec_from(path: &Path, v: &View) -> Result<SceneSpec, String> {
@@ -399,6 +599,8 @@ fn main() -> ExitCode {
         None => demo(&cli.out),
         Some(Command::Render(a)) => render(a),
         Some(Command::Compare(a)) => compare(a),
+        Some(Command::Analyze(a)) => analyze_command(a),
+        Some(Command::Export(a)) => export_command(a),
         Some(Command::Corpus { out }) => write_corpus(&out),
     };
     match result {

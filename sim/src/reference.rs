@@ -87,6 +87,12 @@ impl Camera {
         add(self.forward, add(scale(self.side, sx), scale(self.up, sy)))
     }
 
+    /// Eye-space coordinates of a world point: (right, up, depth along the view axis).
+    pub fn eye_coords(&self, p: V3) -> V3 {
+        let d = sub(p, self.eye);
+        [dot(d, self.side), dot(d, self.up), dot(d, self.forward)]
+    }
+
     /// Eye depth of a world point (distance along the view axis).
     pub fn depth(&self, p: V3) -> f64 {
         dot(sub(p, self.eye), self.forward)

@@ -1,0 +1,112 @@
+//! `sim analyze` and `sim export`: the demo's budget, and the lean firmware scene round trip
+//! (OBJ → generated Rust → render) against the host render of the same OBJ.
+
+use scanline3d_sim::analyze;
+use scanline3d_sim::meshgen;
+use scanline3d_sim::scene::{MeshData, SceneSpec};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The lean firmware's scene: an 80-triangle icosphere.
+const LEAN_OBJ: &str = "examples/lean/icosphere80.obj";
+const LEAN_RS: &str = "examples/lean/scene.rs";
+/// The export command for it (run from the repository root).
+const LEAN_EXPORT: [&str; 4] = ["export", LEAN_OBJ, "--views", "8"];
+
+#[test]
+fn demo_workspace_has_exactly_the_capacities_analyze_measures() {
+    let cams: Vec<_> = (0..scanline3d::demo::ORBIT_FRAMES)
+        .map(|f| SceneSpec::demo(f).unwrap().camera)
+        .collect();
+    let a = analyze::analyze(&SceneSpec::demo(0).unwrap(), &cams, 240, 240).unwrap();
+    assert_eq!(a.triangle_capacity(0), scanline3d::demo::PANEL_TRIANGLES);
+    assert_eq!(a.active_capacity(0), scanline3d::demo::PANEL_ACTIVE);
+    assert_eq!(a.views_clipping, 0);
+    let total = a.buffers(0).last().unwrap().1;
+    assert_eq!(total, scanline3d::demo::PanelWorkspace::BYTES);
+    // Every setting is free of real mismatches; 8 bits is the only one under 0.1 %.
+    assert!(a.settings.iter().all(|s| s.real == 0));
+    assert_eq!(a.recommended(0.1).unwrap().sub_bits, 8);
+    assert_eq!(a.recommended(1.0).unwrap().sub_bits, 2);
+}
+
+#[test]
+fn lean_obj_is_the_generated_icosphere() {
+    let (positions, triangles) = meshgen::icosphere(1);
+    let obj = MeshData::new(&positions, triangles, Default::default())
+        .unwrap()
+        .to_obj();
+    let path = root().join(LEAN_OBJ);
+    if std::env::var_os("SCANLINE3D_BLESS").is_some() {
+        std::fs::write(&path, &obj).unwrap();
+    }
+    assert_eq!(std::fs::read_to_string(path).unwrap(), obj);
+}
+
+#[test]
+fn export_regenerates_the_committed_lean_scene_and_it_is_rustfmt_clean() {
+    let dir = std::env::temp_dir().join(format!("scanline3d-export-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("scene.rs");
+    let status = Command::new(env!("CARGO_BIN_EXE_sim"))
+        .args(LEAN_EXPORT)
+        .arg("--out")
+        .arg(&out)
+        .current_dir(root())
+        .output()
+        .unwrap();
+    assert!(status.status.success(), "{status:?}");
+    let generated = std::fs::read_to_string(&out).unwrap();
+    let committed = root().join(LEAN_RS);
+    if std::env::var_os("SCANLINE3D_BLESS").is_some() {
+        std::fs::write(&committed, &generated).unwrap();
+    }
+    assert_eq!(
+        std::fs::read_to_string(&committed).unwrap(),
+        generated,
+        "regenerate with: cargo run -p scanline3d-sim --bin sim -- {} --out {LEAN_RS}",
+        LEAN_EXPORT.join(" ")
+    );
+    let fmt = Command::new("rustfmt")
+        .args(["--edition", "2021", "--check"])
+        .arg(&out)
+        .output()
+        .expect("rustfmt (installed by `cargo xtask test`)");
+    assert!(
+        fmt.status.success(),
+        "{}",
+        String::from_utf8_lossy(&fmt.stdout)
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn bad_export_input_is_one_clear_error() {
+    let run = |args: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_sim"))
+            .args(args)
+            .current_dir(root())
+            .output()
+            .unwrap();
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (code, err) = run(&["export", "no-such.obj", "--out", "x.rs"]);
+    assert_eq!(code, Some(2));
+    assert!(
+        err.starts_with("sim: no-such.obj") && err.lines().count() == 1,
+        "{err}"
+    );
+    let (code, err) = run(&["export", "--demo", "--out", "x.rs"]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("OBJ"), "{err}");
+    let (code, err) = run(&["analyze", LEAN_OBJ, "--views", "0"]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("--views"), "{err}");
+}
