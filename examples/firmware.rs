@@ -24,91 +24,12 @@ fn main() {
     println!("  cargo run --release --example firmware --target thumbv7em-none-eabihf");
 }
 
-/// Cortex-M: SysTick as the instruction counter, cortex-m-rt start-up.
-#[cfg(all(target_os = "none", target_arch = "arm"))]
-mod arch {
-    use cortex_m::peripheral::{syst::SystClkSource, SYST};
-
-    /// 25 MHz SysTick, 1 ns per instruction under `-icount shift=0`.
-    const INSTRUCTIONS_PER_TICK: u64 = 40;
-    /// Resolution of [`instructions`].
-    pub const GRANULARITY: u64 = INSTRUCTIONS_PER_TICK;
-
-    pub fn start_counter() -> Result<(), &'static str> {
-        let mut core = cortex_m::Peripherals::take().ok_or("peripherals taken")?;
-        core.SYST.set_clock_source(SystClkSource::Core);
-        core.SYST.set_reload(0x00FF_FFFF);
-        core.SYST.clear_current();
-        core.SYST.enable_counter();
-        Ok(())
-    }
-
-    /// Instructions executed since `start()`. The counter runs down from 0xFF_FFFF and every
-    /// measured interval is far shorter than one wrap (671 M instructions).
-    pub struct Mark(u32);
-    pub fn start() -> Mark {
-        Mark(SYST::get_current())
-    }
-    pub fn instructions(since: &Mark) -> u64 {
-        (since.0.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF) as u64 * INSTRUCTIONS_PER_TICK
-    }
-
-    /// Runs exactly `3 n` instructions.
-    pub fn known_loop(n: u32) {
-        // SAFETY: a register-only countdown loop (nop, subs, bne).
-        unsafe {
-            core::arch::asm!("2:", "nop", "subs {0}, #1", "bne 2b", inout(reg) n => _, options(nomem, nostack));
-        }
-    }
-
-    pub fn sp() -> usize {
-        cortex_m::register::msp::read() as usize
-    }
-
-    #[cortex_m_rt::entry]
-    fn main() -> ! {
-        super::firmware::main()
-    }
-}
-
-/// RISC-V: `minstret` as the instruction counter, riscv-rt start-up (machine mode).
-#[cfg(all(target_os = "none", target_arch = "riscv32"))]
-mod arch {
-    /// `minstret` counts single instructions.
-    pub const GRANULARITY: u64 = 1;
-
-    pub fn start_counter() -> Result<(), &'static str> {
-        Ok(())
-    }
-
-    pub struct Mark(u64);
-    pub fn start() -> Mark {
-        Mark(riscv::register::minstret::read64())
-    }
-    pub fn instructions(since: &Mark) -> u64 {
-        riscv::register::minstret::read64().wrapping_sub(since.0)
-    }
-
-    /// Runs exactly `3 n` instructions.
-    pub fn known_loop(n: u32) {
-        // SAFETY: a register-only countdown loop (nop, addi, bnez).
-        unsafe {
-            core::arch::asm!("2:", "nop", "addi {0}, {0}, -1", "bnez {0}, 2b", inout(reg) n => _, options(nomem, nostack));
-        }
-    }
-
-    pub fn sp() -> usize {
-        let sp: usize;
-        // SAFETY: reads the stack pointer register.
-        unsafe { core::arch::asm!("mv {0}, sp", out(reg) sp, options(nomem, nostack)) };
-        sp
-    }
-
-    #[riscv_rt::entry]
-    fn main() -> ! {
-        super::firmware::main()
-    }
-}
+#[cfg(target_os = "none")]
+#[path = "common/arch.rs"]
+mod arch;
+#[cfg(target_os = "none")]
+#[path = "common/measure.rs"]
+mod measure;
 
 #[cfg(target_os = "none")]
 mod firmware {
@@ -120,69 +41,7 @@ mod firmware {
     use scanline3d::{Depth, Flat};
     use semihosting::println;
 
-    // Defined by both cortex-m-rt's and riscv-rt's linker scripts.
-    extern "C" {
-        static _stack_start: u32;
-        static __sdata: u32;
-        static __edata: u32;
-        static __sbss: u32;
-        static __ebss: u32;
-    }
-
-    fn static_ram() -> usize {
-        (&raw const __edata as usize - &raw const __sdata as usize)
-            + (&raw const __ebss as usize - &raw const __sbss as usize)
-    }
-
-    /// Bytes of stack below the entry stack pointer painted to find the high-water mark.
-    const PAINTED: usize = 64 * 1024;
-    const PAINT: u32 = 0x5AA5_C33C;
-
-    /// Fills the stack below the current frame with a pattern. Writes below the stack pointer
-    /// only, into memory nothing uses yet.
-    #[inline(never)]
-    fn paint_stack() {
-        let top = arch::sp() - 256; // leave this function's own frame alone
-        let mut p = top - PAINTED;
-        while p < top {
-            // SAFETY: [top - PAINTED, top) is unused stack below the live frames (RAM is 4 MiB
-            // on the MPS2 boards, 16 MiB on virt).
-            unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
-            p += 4;
-        }
-    }
-
-    /// Deepest stack address reached since painting, found as the lowest overwritten word.
-    fn stack_low_water() -> usize {
-        let top = arch::sp() - 256;
-        let mut p = top - PAINTED;
-        // SAFETY: reads the same painted, word-aligned region.
-        while p < top && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
-            p += 4;
-        }
-        p
-    }
-
-    /// Checks the instruction counter: a loop of exactly 3 instructions per iteration must read
-    /// as 3 · n instructions, or every figure printed would be wrong.
-    fn calibrate() -> Result<(), &'static str> {
-        let n: u32 = 100_000;
-        let mark = arch::start();
-        arch::known_loop(n);
-        let measured = arch::instructions(&mark);
-        println!(
-            "calibration {} instructions measured for {} executed",
-            measured,
-            3 * n
-        );
-        // The counter's own reads add a handful of instructions (RISC-V counts them exactly).
-        if measured.abs_diff(3 * n as u64) > arch::GRANULARITY.max(16) {
-            return Err(
-                "instruction counter is not 1 per instruction (run QEMU with -icount shift=0)",
-            );
-        }
-        Ok(())
-    }
+    use crate::measure::{self, _stack_start};
 
     /// One flat span fill, called the way the renderer calls it: through row slices.
     #[inline(never)]
@@ -247,12 +106,12 @@ mod firmware {
 
     fn run() -> Result<(), &'static str> {
         arch::start_counter()?;
-        calibrate()?;
+        measure::calibrate()?;
 
         // Render every frame first and print afterwards, so the stack high-water mark is the
         // renderer's (and this loop's), not the formatter's.
         let stack_top = &raw const _stack_start as usize;
-        paint_stack();
+        measure::paint_stack();
         let mut lines: [Option<FrameLine>; demo::ORBIT_FRAMES as usize] = Default::default();
         {
             let mut ws = PanelWorkspace::new(demo::BACKGROUND.into());
@@ -278,7 +137,7 @@ mod firmware {
                 });
             }
         }
-        let peak_stack = stack_top - stack_low_water();
+        let peak_stack = stack_top - measure::stack_low_water();
 
         let (mut max_bucketed, mut max_active) = (0, 0);
         for (frame, line) in lines.iter().enumerate() {
@@ -309,7 +168,7 @@ mod firmware {
         println!(
             "summary peak_stack {} static_ram {} renderer_ram {} max_bucketed {} max_active {}",
             peak_stack,
-            static_ram(),
+            measure::static_ram(),
             PanelWorkspace::BYTES,
             max_bucketed,
             max_active

@@ -163,15 +163,15 @@ pub const WIDTH: usize = 240;
 /// Target height the budget was measured for.
 pub const HEIGHT: usize = 240;
 /// Triangles filed per frame: 29 measured, plus the margin.
-pub const TRIANGLES: usize = 29;
+pub const MAX_TRIANGLES: usize = 29;
 /// Triangles crossing one row: 11 measured, plus the margin.
-pub const ACTIVE: usize = 11;
+pub const MAX_ACTIVE: usize = 11;
 /// Whether any analysed view needed clipping (if not, `NoClip` is safe for these views).
 pub const NEEDS_CLIPPING: bool = false;
 /// Back-face culling, as analysed.
 pub const CULL_BACK_FACES: bool = true;
 /// The workspace this budget asks for.
-pub type SceneWorkspace<P, S> = Workspace<P, S, WIDTH, HEIGHT, TRIANGLES, ACTIVE>;
+pub type SceneWorkspace<P, S> = Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE>;
 
 /// Vertical field of view (degrees), near and far planes of every view.
 pub const PROJECTION: (f32, f32, f32) = (50.0, 0.15000068, 12.000053);

@@ -47,6 +47,22 @@ pub fn sphere_views(
         .collect()
 }
 
+/// The default sphere of views for a scene: `count` views at 3 × its bounding radius from its
+/// centre, 50° field of view, near = distance / 20, far = distance × 4 (what `sim analyze` and
+/// `sim export` use without camera options).
+pub fn default_views(spec: &SceneSpec, count: usize) -> Result<Vec<CameraSpec>, String> {
+    let (centre, radius) = bounds(spec)?;
+    let distance = 3.0 * radius.max(1e-3);
+    Ok(sphere_views(
+        centre,
+        distance,
+        count,
+        50.0,
+        distance / 20.0,
+        distance * 4.0,
+    ))
+}
+
 /// Centre and radius of the scene's bounding sphere (around its bounding-box centre), in world
 /// coordinates.
 pub fn bounds(spec: &SceneSpec) -> Result<(V3, f64), String> {

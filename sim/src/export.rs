@@ -194,13 +194,13 @@ impl Export<'_> {
             "/// Triangles filed per frame: {} measured, plus the margin.",
             a.max_bucketed
         );
-        let _ = writeln!(s, "pub const TRIANGLES: usize = {tris};");
+        let _ = writeln!(s, "pub const MAX_TRIANGLES: usize = {tris};");
         let _ = writeln!(
             s,
             "/// Triangles crossing one row: {} measured, plus the margin.",
             a.peak_active
         );
-        let _ = writeln!(s, "pub const ACTIVE: usize = {active};");
+        let _ = writeln!(s, "pub const MAX_ACTIVE: usize = {active};");
         let _ = writeln!(
             s,
             "/// Whether any analysed view needed clipping (if not, `NoClip` is safe for these views)."
@@ -217,7 +217,7 @@ impl Export<'_> {
             self.cull_back_faces
         );
         let _ = writeln!(s, "/// The workspace this budget asks for.");
-        s += "pub type SceneWorkspace<P, S> = Workspace<P, S, WIDTH, HEIGHT, TRIANGLES, ACTIVE>;\n\n";
+        s += "pub type SceneWorkspace<P, S> = Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE>;\n\n";
         let first = self
             .views
             .first()

@@ -407,6 +407,49 @@ impl SceneSpec {
         })
     }
 
+    /// Hash of the frame as the firmware's hashing panel model receives it: RGB565 rows on a
+    /// black background, flat shading, 4 sub-pixel bits ([`scanline3d::sink::HashSink`]).
+    /// Firmware that renders the same scene must print the same hash.
+    pub fn panel_hash(&self, w: usize, h: usize) -> Result<u32, String> {
+        std::thread::scope(|scope| {
+            std::thread::Builder::new()
+                .stack_size(64 << 20)
+                .spawn_scoped(scope, || self.panel_hash_on_this_thread(w, h))
+                .map_err(|e| format!("cannot start render thread: {e}"))?
+                .join()
+                .map_err(|_| "render thread panicked".to_string())?
+        })
+    }
+
+    fn panel_hash_on_this_thread(&self, w: usize, h: usize) -> Result<u32, String> {
+        use embedded_graphics::pixelcolor::Rgb565;
+        let meshes = self
+            .instances
+            .iter()
+            .map(|i| i.mesh.mesh())
+            .collect::<Result<Vec<_>, _>>()?;
+        let instances: Vec<Instance<'_>> = meshes
+            .iter()
+            .zip(&self.instances)
+            .map(|(mesh, i)| Instance {
+                mesh,
+                transform: i.transform,
+            })
+            .collect();
+        let scene = Scene {
+            instances: &instances,
+            camera: self.camera.fixed()?,
+            light: self.light.fixed()?,
+        };
+        type PanelWs = Workspace<Rgb565, Flat, MAX_SIZE, MAX_SIZE, 65534, 4096>;
+        let mut ws: Box<PanelWs> = Box::new(Workspace::new(Rgb565::new(0, 0, 0)));
+        let mut sink = scanline3d::sink::HashSink::new();
+        let options = RenderOptions::default().with_back_face_culling(self.cull_back_faces);
+        ws.render_sized(w, h, &scene, &options, &mut sink)
+            .map_err(|e| e.to_string())?;
+        Ok(sink.hash())
+    }
+
     fn render_fixed_on_this_thread(
         &self,
         w: usize,

@@ -202,6 +202,131 @@ fn firmware() -> Result<(), String> {
     Ok(())
 }
 
+/// The lean firmware variants (`examples/lean_*.rs`), built with the size-optimised `lean`
+/// profile.
+const LEAN_VARIANTS: [&str; 3] = ["minimal", "full", "baseline"];
+/// The scene the lean firmware was exported from, and how many views it was analysed from.
+const LEAN_OBJ: &str = "examples/lean/icosphere80.obj";
+const LEAN_VIEWS: usize = 8;
+
+/// Runs one lean variant on `target` under QEMU, returning its output.
+fn run_lean(target: &str, variant: &str) -> Result<String, String> {
+    let out = cargo()
+        .args(["run", "--quiet", "--profile", "lean", "--example"])
+        .arg(format!("lean_{variant}"))
+        .args(["--target", target])
+        .current_dir(root())
+        .stderr(Stdio::inherit())
+        .output()
+        .map_err(|e| format!("lean_{variant} on {target}: {e}"))?;
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    if !out.status.success() {
+        return Err(format!(
+            "lean_{variant} on {target} failed ({}):\n{text}",
+            out.status
+        ));
+    }
+    Ok(text)
+}
+
+/// Flash (vector table, code, read-only data, initialised data) of an ELF.
+fn flash_bytes(path: &std::path::Path) -> Result<u64, String> {
+    let e = elf(path)?;
+    Ok(e.sections
+        .iter()
+        .filter(|s| [".vector_table", ".text", ".rodata", ".data"].contains(&s.0.as_str()))
+        .map(|s| s.1 as u64)
+        .sum())
+}
+
+fn summary_field(output: &str, name: &str) -> u64 {
+    output
+        .lines()
+        .find_map(|l| l.strip_prefix("summary "))
+        .and_then(|l| {
+            let words: Vec<&str> = l.split_whitespace().collect();
+            words
+                .windows(2)
+                .find(|w| w[0] == name)
+                .and_then(|w| w[1].parse().ok())
+        })
+        .unwrap_or(0)
+}
+
+/// The lean firmware on every target: frame hashes must equal the host's render of the OBJ the
+/// scene was exported from; then flash and RAM of the minimal and full builds, with the
+/// renderer's share measured against the renderer-less baseline.
+fn lean() -> Result<(), String> {
+    use scanline3d_sim::scene::{MeshData, SceneSpec};
+    let mesh = MeshData::load_obj(&root().join(LEAN_OBJ))?;
+    let base = SceneSpec::single(
+        mesh,
+        scanline3d_sim::scene::CameraSpec::looking_at([0.0, 0.0, 1.0], [0.0; 3], 50.0, 0.1, 10.0),
+        Default::default(),
+        true,
+    );
+    let expected = scanline3d_sim::analyze::default_views(&base, LEAN_VIEWS)?
+        .into_iter()
+        .map(|camera| {
+            SceneSpec {
+                camera,
+                ..base.clone()
+            }
+            .panel_hash(240, 240)
+        })
+        .collect::<Result<Vec<u32>, String>>()?;
+    let mut table = Vec::new();
+    for (target, machine) in FIRMWARE {
+        let mut flash = std::collections::HashMap::new();
+        for variant in LEAN_VARIANTS {
+            step(&format!(
+                "lean firmware ({variant}) on QEMU {machine}, {target}"
+            ));
+            let out = run_lean(target, variant)?;
+            print!("{out}");
+            let hashes: Vec<u32> = out
+                .lines()
+                .filter_map(|l| l.strip_prefix("view "))
+                .filter_map(|l| {
+                    l.split_whitespace()
+                        .nth(2)
+                        .and_then(|h| u32::from_str_radix(h, 16).ok())
+                })
+                .collect();
+            if variant != "baseline" {
+                if hashes != expected {
+                    return Err(format!("lean_{variant} on {target}: hashes {hashes:08x?} differ from the host render of {LEAN_OBJ}: {expected:08x?}"));
+                }
+                println!("view hashes equal the host render of {LEAN_OBJ}");
+            }
+            let elf_path = root()
+                .join("target")
+                .join(target)
+                .join(format!("lean/examples/lean_{variant}"));
+            flash.insert(variant, (flash_bytes(&elf_path)?, out));
+        }
+        let (base_flash, base_out) = &flash["baseline"];
+        let base_stack = summary_field(base_out, "peak_stack");
+        for variant in ["minimal", "full"] {
+            let (f, out) = &flash[variant];
+            let workspace = summary_field(out, "workspace");
+            let stack = summary_field(out, "peak_stack");
+            table.push(format!(
+                "| {target} | {variant} | {f} | {} | {workspace} | {} |",
+                f - base_flash,
+                stack.saturating_sub(base_stack)
+            ));
+        }
+    }
+    println!("\nlean firmware, {LEAN_OBJ} (80 triangles), 240x240, `lean` profile (opt-level z):");
+    println!("| target | build | firmware flash B | renderer flash B (minus baseline) | workspace B | render stack B (peak minus baseline) |");
+    println!("|---|---|---|---|---|---|");
+    for row in table {
+        println!("{row}");
+    }
+    Ok(())
+}
+
 fn test() -> Result<(), String> {
     install()?;
     step("format");
@@ -240,6 +365,7 @@ fn test() -> Result<(), String> {
         ]))?;
     }
     firmware()?;
+    lean()?;
     fuzz(FUZZ_SECONDS_IN_TEST)?;
     println!("\nxtask: {} passed, {} failed", totals.0, totals.1);
     Ok(())
@@ -332,6 +458,7 @@ fn main() -> ExitCode {
     let result = match task.as_str() {
         "test" => test(),
         "firmware" => install().and_then(|_| firmware()),
+        "lean" => install().and_then(|_| lean()),
         "fuzz" => {
             let seconds = std::env::args()
                 .nth(2)
@@ -340,7 +467,7 @@ fn main() -> ExitCode {
             fuzz(seconds)
         }
         _ => {
-            eprintln!("usage: cargo xtask test | firmware | fuzz [SECONDS]");
+            eprintln!("usage: cargo xtask test | firmware | lean | fuzz [SECONDS]");
             return ExitCode::from(2);
         }
     };

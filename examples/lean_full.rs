@@ -1,0 +1,47 @@
+//! Lean firmware, full build of the same scene: Gouraud shading and frustum clipping.
+//!
+//! ```sh
+//! cargo run --profile lean --example lean_full --target thumbv6m-none-eabi
+//! ```
+//!
+//! `cargo xtask lean` builds and runs all lean variants on every target and compares sizes.
+#![cfg_attr(target_os = "none", no_std)]
+#![cfg_attr(target_os = "none", no_main)]
+
+// The exported scene (`sim export`); not every constant is used by every variant.
+#[allow(dead_code)]
+#[path = "lean/scene.rs"]
+mod scene;
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    println!("lean_full: a firmware example; run it on a target, e.g.");
+    println!("  cargo run --profile lean --example lean_full --target thumbv6m-none-eabi");
+    println!(
+        "scene budget: TRIS = {}, ACTIVE = {}",
+        scene::TRIANGLES,
+        scene::ACTIVE
+    );
+}
+
+#[cfg(target_os = "none")]
+#[path = "common/arch.rs"]
+mod arch;
+#[cfg(target_os = "none")]
+#[path = "common/lean.rs"]
+mod lean;
+#[cfg(target_os = "none")]
+#[path = "common/measure.rs"]
+mod measure;
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use super::lean;
+    #[allow(unused_imports)]
+    use super::scene;
+    use scanline3d::{clip::FrustumClip, Gouraud};
+
+    pub fn main() -> ! {
+        lean::exit(lean::run::<Gouraud, FrustumClip, true>("full", FrustumClip))
+    }
+}

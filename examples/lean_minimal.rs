@@ -1,0 +1,50 @@
+//! Lean firmware, minimal build: flat shading, no clipping (the exported analysis shows the
+//! scene's views never cut a visible triangle), workspace sized by the exported budget.
+//!
+//! ```sh
+//! cargo run --profile lean --example lean_minimal --target thumbv6m-none-eabi
+//! ```
+//!
+//! `cargo xtask lean` builds and runs all lean variants on every target and compares sizes.
+#![cfg_attr(target_os = "none", no_std)]
+#![cfg_attr(target_os = "none", no_main)]
+
+// The exported scene (`sim export`); not every constant is used by every variant.
+#[allow(dead_code)]
+#[path = "lean/scene.rs"]
+mod scene;
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    println!("lean_minimal: a firmware example; run it on a target, e.g.");
+    println!("  cargo run --profile lean --example lean_minimal --target thumbv6m-none-eabi");
+    println!(
+        "scene budget: TRIS = {}, ACTIVE = {}",
+        scene::TRIANGLES,
+        scene::ACTIVE
+    );
+}
+
+#[cfg(target_os = "none")]
+#[path = "common/arch.rs"]
+mod arch;
+#[cfg(target_os = "none")]
+#[path = "common/lean.rs"]
+mod lean;
+#[cfg(target_os = "none")]
+#[path = "common/measure.rs"]
+mod measure;
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use super::lean;
+    #[allow(unused_imports)]
+    use super::scene;
+    use scanline3d::{clip::NoClip, Flat};
+
+    pub fn main() -> ! {
+        // The minimal build is only valid for scenes the analysis proved need no clipping.
+        const { assert!(!scene::NEEDS_CLIPPING) };
+        lean::exit(lean::run::<Flat, NoClip, true>("minimal", NoClip))
+    }
+}
