@@ -19,8 +19,8 @@ fn main() {
     println!("  cargo run --profile lean --example lean_full --target thumbv6m-none-eabi");
     println!(
         "scene budget: TRIS = {}, ACTIVE = {}",
-        scene::TRIANGLES,
-        scene::ACTIVE
+        scene::MAX_TRIANGLES,
+        scene::MAX_ACTIVE
     );
 }
 

@@ -20,8 +20,8 @@ fn main() {
     println!("  cargo run --profile lean --example lean_minimal --target thumbv6m-none-eabi");
     println!(
         "scene budget: TRIS = {}, ACTIVE = {}",
-        scene::TRIANGLES,
-        scene::ACTIVE
+        scene::MAX_TRIANGLES,
+        scene::MAX_ACTIVE
     );
 }
 

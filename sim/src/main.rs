@@ -238,7 +238,7 @@ impl Views {
         let (centre, radius) = analyze::bounds(&spec)?;
         let target = self.target.unwrap_or(centre);
         let distance = self.distance.unwrap_or(3.0 * radius.max(1e-3));
-        if !(distance > 0.0) {
+        if distance <= 0.0 {
             return Err(format!("distance {distance} must be positive"));
         }
         if self.views == 0 || self.views > 1000 {
