@@ -120,8 +120,11 @@ pub struct Lighting {
 /// gives 0. Written out because `fixed`'s saturating conversion panics on NaN, and the render
 /// path must not contain a panic (`examples/panic_never.rs` checks that at link time).
 fn q30(v: f32) -> i32 {
-    // f32 → f64 and the scaling by 2^30 are exact; `as` saturates and maps NaN to 0.
-    libm::rint(v as f64 * (1u64 << 30) as f64) as i32
+    // Scaling by 2^30 is exact in f32 (it only changes the exponent), and `rintf` of an f32 is
+    // exact too: below 2^23 the rounded integer fits the 24-bit mantissa, above it the value is
+    // already an integer. So this equals rounding in f64, without pulling f64 soft-float code
+    // into builds for cores without an FPU. `as` saturates and maps NaN to 0.
+    libm::rintf(v * (1u32 << 30) as f32) as i32
 }
 
 impl Lighting {
@@ -208,6 +211,31 @@ pub fn shade(base: Rgb888, intensity: I2F30) -> Rgb888 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn q30_rounds_exactly_like_f64() {
+        let reference = |v: f32| libm::rint(v as f64 * (1u64 << 30) as f64) as i32;
+        let mut x = 0x1234_5678u32;
+        let mut values = std::vec![0.0, -0.0, 0.5, -1.0, 1.999_999_9, 2.0, -2.0, 1e-10, 3.7e-9];
+        values.extend([
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::MAX,
+            f32::MIN_POSITIVE,
+        ]);
+        for _ in 0..200_000 {
+            // xorshift: bit patterns across all exponents, plus values in the useful range.
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            values.push(f32::from_bits(x));
+            values.push((x as f32 / u32::MAX as f32) * 4.0 - 2.0);
+        }
+        for v in values {
+            assert_eq!(q30(v), reference(v), "{v:e}");
+        }
+    }
     use crate::scene::Coord;
 
     fn v(x: f32, y: f32, z: f32) -> Vertex {
