@@ -94,19 +94,3 @@ pub fn run<S: Shading, C: Clipping, const RENDER: bool>(
     );
     Ok(())
 }
-
-pub fn exit(result: Result<(), &'static str>) -> ! {
-    match result {
-        Ok(()) => semihosting::process::exit(0),
-        Err(e) => {
-            println!("error: {}", e);
-            semihosting::process::exit(1)
-        }
-    }
-}
-
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    println!("panic: {}", info);
-    semihosting::process::exit(1)
-}

@@ -407,6 +407,23 @@ impl SceneSpec {
         })
     }
 
+    /// The library's view of each instance's mesh (validated).
+    fn meshes(&self) -> Result<Vec<Mesh<'_>>, String> {
+        self.instances.iter().map(|i| i.mesh.mesh()).collect()
+    }
+
+    /// Library instances of `meshes` (from [`Self::meshes`]) with this scene's transforms.
+    fn library_instances<'a>(&self, meshes: &'a [Mesh<'a>]) -> Vec<Instance<'a>> {
+        meshes
+            .iter()
+            .zip(&self.instances)
+            .map(|(mesh, i)| Instance {
+                mesh,
+                transform: i.transform,
+            })
+            .collect()
+    }
+
     /// Hash of the frame as the firmware's hashing panel model receives it: RGB565 rows on a
     /// black background, flat shading, 4 sub-pixel bits ([`scanline3d::sink::HashSink`]).
     /// Firmware that renders the same scene must print the same hash.
@@ -423,19 +440,8 @@ impl SceneSpec {
 
     fn panel_hash_on_this_thread(&self, w: usize, h: usize) -> Result<u32, String> {
         use embedded_graphics::pixelcolor::Rgb565;
-        let meshes = self
-            .instances
-            .iter()
-            .map(|i| i.mesh.mesh())
-            .collect::<Result<Vec<_>, _>>()?;
-        let instances: Vec<Instance<'_>> = meshes
-            .iter()
-            .zip(&self.instances)
-            .map(|(mesh, i)| Instance {
-                mesh,
-                transform: i.transform,
-            })
-            .collect();
+        let meshes = self.meshes()?;
+        let instances = self.library_instances(&meshes);
         let scene = Scene {
             instances: &instances,
             camera: self.camera.fixed()?,
@@ -471,19 +477,8 @@ impl SceneSpec {
         if w == 0 || h == 0 || w > MAX_SIZE || h > MAX_SIZE {
             return Err(format!("size {w}x{h} outside 1x1..{MAX_SIZE}x{MAX_SIZE}"));
         }
-        let meshes = self
-            .instances
-            .iter()
-            .map(|i| i.mesh.mesh())
-            .collect::<Result<Vec<_>, _>>()?;
-        let instances: Vec<Instance<'_>> = meshes
-            .iter()
-            .zip(&self.instances)
-            .map(|(mesh, i)| Instance {
-                mesh,
-                transform: i.transform,
-            })
-            .collect();
+        let meshes = self.meshes()?;
+        let instances = self.library_instances(&meshes);
         let camera = self.camera.fixed()?;
         let scene = Scene {
             instances: &instances,

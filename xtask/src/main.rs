@@ -129,26 +129,20 @@ const FIRMWARE: [(&str, &str); 3] = [
     ("riscv32imc-unknown-none-elf", "virt (RV32IMC)"),
 ];
 
-/// Runs the firmware example on one target under QEMU and returns its output.
-fn run_firmware(target: &str) -> Result<String, String> {
+/// Runs a firmware example on one target under QEMU (the runner in `.cargo/config.toml`)
+/// with the given cargo profile, and returns its output.
+fn run_example(target: &str, profile: &str, example: &str) -> Result<String, String> {
     let out = cargo()
-        .args([
-            "run",
-            "--quiet",
-            "--release",
-            "--example",
-            "firmware",
-            "--target",
-            target,
-        ])
+        .args(["run", "--quiet", "--profile", profile, "--example", example])
+        .args(["--target", target])
         .current_dir(root())
         .stderr(Stdio::inherit())
         .output()
-        .map_err(|e| format!("firmware on {target}: {e}"))?;
+        .map_err(|e| format!("{example} on {target}: {e}"))?;
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
     if !out.status.success() {
         return Err(format!(
-            "firmware on {target} failed ({}):\n{text}",
+            "{example} on {target} failed ({}):\n{text}",
             out.status
         ));
     }
@@ -175,9 +169,9 @@ fn firmware() -> Result<(), String> {
     let expected = host_hashes()?;
     for (target, machine) in FIRMWARE {
         step(&format!("firmware on QEMU {machine}, {target}"));
-        let first = run_firmware(target)?;
+        let first = run_example(target, "release", "firmware")?;
         print!("{first}");
-        let second = run_firmware(target)?;
+        let second = run_example(target, "release", "firmware")?;
         if first != second {
             return Err(format!("{target}: two runs printed different output (instruction counts must be deterministic)\n{second}"));
         }
@@ -208,26 +202,6 @@ const LEAN_VARIANTS: [&str; 3] = ["minimal", "full", "baseline"];
 /// The scene the lean firmware was exported from, and how many views it was analysed from.
 const LEAN_OBJ: &str = "examples/lean/icosphere80.obj";
 const LEAN_VIEWS: usize = 8;
-
-/// Runs one lean variant on `target` under QEMU, returning its output.
-fn run_lean(target: &str, variant: &str) -> Result<String, String> {
-    let out = cargo()
-        .args(["run", "--quiet", "--profile", "lean", "--example"])
-        .arg(format!("lean_{variant}"))
-        .args(["--target", target])
-        .current_dir(root())
-        .stderr(Stdio::inherit())
-        .output()
-        .map_err(|e| format!("lean_{variant} on {target}: {e}"))?;
-    let text = String::from_utf8_lossy(&out.stdout).into_owned();
-    if !out.status.success() {
-        return Err(format!(
-            "lean_{variant} on {target} failed ({}):\n{text}",
-            out.status
-        ));
-    }
-    Ok(text)
-}
 
 /// Flash (vector table, code, read-only data, initialised data) of an ELF.
 fn flash_bytes(path: &std::path::Path) -> Result<u64, String> {
@@ -282,7 +256,7 @@ fn lean() -> Result<(), String> {
             step(&format!(
                 "lean firmware ({variant}) on QEMU {machine}, {target}"
             ));
-            let out = run_lean(target, variant)?;
+            let out = run_example(target, "lean", &format!("lean_{variant}"))?;
             print!("{out}");
             let hashes: Vec<u32> = out
                 .lines()
