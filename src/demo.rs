@@ -67,7 +67,7 @@ pub const HEIGHT: usize = 240;
 pub const ORBIT_FRAMES: u32 = 8;
 
 /// The demo's instances: sphere, cube, ground (triangle ids in that order).
-pub fn instances() -> [Instance<'static>; 3] {
+pub fn instances() -> [Instance<'static>; PANEL_INSTANCES] {
     [
         Instance {
             mesh: &SPHERE,
@@ -138,10 +138,13 @@ pub const BACKGROUND: Rgb888 = Rgb888::new(24, 28, 40);
 pub const PANEL_TRIANGLES: usize = 584;
 /// Triangles crossing one row at most in the demo orbit (`sim analyze --demo`).
 pub const PANEL_ACTIVE: usize = 63;
+/// Mesh instances in the demo ([`instances`] returns exactly this many).
+pub const PANEL_INSTANCES: usize = 3;
 
 /// The workspace the firmware examples use for the demo: RGB565 (an SPI panel's format), flat
 /// shading, 240×240, with exactly the capacities the orbit needs.
-pub type PanelWorkspace = Workspace<Rgb565, Flat, WIDTH, HEIGHT, PANEL_TRIANGLES, PANEL_ACTIVE>;
+pub type PanelWorkspace =
+    Workspace<Rgb565, Flat, WIDTH, HEIGHT, PANEL_TRIANGLES, PANEL_ACTIVE, PANEL_INSTANCES>;
 
 /// What one demo frame produced on the hashing panel model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

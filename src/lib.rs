@@ -66,7 +66,7 @@
 //! | near plane | ≥ [`MIN_NEAR`](scene::MIN_NEAR) = 1/256 | `near` keeps 8 significant bits in I16F16 |
 //! | far plane | ≤ [`MAX_EYE_DISTANCE`](scene::MAX_EYE_DISTANCE) = 16384 | eye-space envelope |
 //! | far/near | ≤ [`MAX_FAR_NEAR_RATIO`](scene::MAX_FAR_NEAR_RATIO) = 2^20 | `q = near/w` keeps ≥ 2^10 steps of I2F30 at the far plane: relative depth resolution 2^-30 · far/near ≤ 2^-10 there |
-//! | instances | [`MAX_INSTANCES`](render::MAX_INSTANCES) = 8 | per-frame set-up on the stack |
+//! | instances | `INSTANCES` of the [`Workspace`], default [`MAX_INSTANCES`](render::MAX_INSTANCES) = 8 | per-frame set-up on the stack, about 120 B each |
 //! | triangles per frame | `TRIS` ≤ 65534 | 16-bit bucket links |
 //!
 //! Any triangle size works: triangles far larger than the screen are clipped to a guard band of

@@ -30,7 +30,8 @@ use embedded_graphics::pixelcolor::Rgb888;
 use fixed::types::I16F16;
 use heapless::{Vec, VecView};
 
-/// Most mesh instances in one scene.
+/// Default for a [`Workspace`]'s `INSTANCES`: most mesh instances in one scene. Each costs
+/// about 120 bytes of stack during a render (its transform and lighting set-up).
 pub const MAX_INSTANCES: usize = 8;
 
 /// Options for one render. `SUB_BITS` is the number of sub-pixel bits vertices snap to
@@ -169,7 +170,7 @@ impl FrameStats {
 pub enum CapacityKind {
     /// `TRIS`: triangles that survive culling and clipping, filed in row buckets.
     Triangles,
-    /// [`MAX_INSTANCES`]: mesh instances in the scene.
+    /// The workspace's `INSTANCES` (default [`MAX_INSTANCES`]): mesh instances in the scene.
     Instances,
 }
 
@@ -246,6 +247,8 @@ const NO_ENTRY: u16 = u16::MAX;
 ///   [`crate::Gouraud`]);
 /// * `W × H`: the target size (1..=2048 each);
 /// * `TRIS`: triangles that may survive culling in one frame (≤ 65535);
+/// * `INSTANCES`: mesh instances a scene may have (their set-up lives on the stack during a
+///   render; default [`MAX_INSTANCES`]);
 /// * `ACTIVE`: triangles that may cross one row (more are dropped and reported in
 ///   [`FrameStats::dropped`], [`FrameStats::dropped_pieces`] and [`Row::complete`]).
 ///
@@ -262,6 +265,7 @@ pub struct Workspace<
     const H: usize,
     const TRIS: usize = 1024,
     const ACTIVE: usize = 64,
+    const INSTANCES: usize = MAX_INSTANCES,
 > {
     depth: [Depth; W],
     pixels: [P; W],
@@ -327,7 +331,8 @@ impl<
         const H: usize,
         const TRIS: usize,
         const ACTIVE: usize,
-    > Workspace<P, S, W, H, TRIS, ACTIVE>
+        const INSTANCES: usize,
+    > Workspace<P, S, W, H, TRIS, ACTIVE, INSTANCES>
 {
     /// Size of this workspace in bytes.
     pub const BYTES: usize = core::mem::size_of::<Self>();
@@ -453,7 +458,7 @@ impl<
             refs: &mut self.refs,
             active: self.active.as_mut_view(),
         };
-        render_frame(view, scene, options, &vp, sink)
+        render_frame::<P, S, SUB_BITS, C, K, INSTANCES>(view, scene, options, &vp, sink)
     }
 }
 
@@ -465,9 +470,9 @@ struct InstanceSetup<'a> {
     first_id: u32,
 }
 
-fn setup_instances<'a, E>(
+fn setup_instances<'a, E, const N: usize>(
     scene: &'a Scene<'a>,
-) -> Result<Vec<InstanceSetup<'a>, MAX_INSTANCES>, RenderError<E>> {
+) -> Result<Vec<InstanceSetup<'a>, N>, RenderError<E>> {
     let mut out = Vec::new();
     let view = &scene.camera.view().world_to_eye;
     let mut first_id = 0u32;
@@ -485,7 +490,7 @@ fn setup_instances<'a, E>(
             return Err(RenderError::Capacity {
                 what: CapacityKind::Instances,
                 needed: scene.instances.len(),
-                capacity: MAX_INSTANCES,
+                capacity: N,
             });
         }
         first_id += inst.mesh.triangles().len() as u32;
@@ -616,14 +621,21 @@ fn locate<'s, 'a>(
         .map(|s| (s, (id - s.first_id) as usize))
 }
 
-fn render_frame<P: RowPixel, S: Shading, const SUB: u32, C: Clipping, K: RowSink<P>>(
+fn render_frame<
+    P: RowPixel,
+    S: Shading,
+    const SUB: u32,
+    C: Clipping,
+    K: RowSink<P>,
+    const INSTANCES: usize,
+>(
     ws: View<'_, P, S>,
     scene: &Scene<'_>,
     options: &RenderOptions<SUB, C>,
     vp: &Viewport<SUB>,
     sink: &mut K,
 ) -> Result<FrameStats, RenderError<K::Error>> {
-    let setups = setup_instances(scene)?;
+    let setups = setup_instances::<K::Error, INSTANCES>(scene)?;
     let mut stats = FrameStats::default();
     let (width, height) = (ws.depth.len().min(ws.pixels.len()), ws.heads.len());
     let capacity = ws.refs.len().min(ws.next.len());

@@ -575,3 +575,37 @@ fn workspace_bytes_matches_the_compiled_layout() {
     check!(embedded_graphics::pixelcolor::BinaryColor, Flat, 3, 5, 1, 0);
     check!(embedded_graphics::pixelcolor::Gray8, Gouraud, 13, 1, 2, 3);
 }
+
+#[test]
+fn instance_capacity_is_a_workspace_parameter() {
+    let data = one_triangle();
+    let mesh = data.mesh().unwrap();
+    let instances = [instance(&mesh), instance(&mesh)];
+    let scene = Scene {
+        instances: &instances,
+        camera: front_camera().fixed().unwrap(),
+        light: light(),
+    };
+    let mut one: Box<Workspace<TriangleId, Flat, 16, 16, 8, 4, 1>> =
+        Box::new(Workspace::new(TriangleId::NONE));
+    let rows = std::cell::Cell::new(0);
+    let mut sink = FnSink(|_: Row<'_, TriangleId>| -> Result<(), ()> {
+        rows.set(rows.get() + 1);
+        Ok(())
+    });
+    assert_eq!(
+        one.render(&scene, &RenderOptions::default(), &mut sink),
+        Err(RenderError::Capacity {
+            what: CapacityKind::Instances,
+            needed: 2,
+            capacity: 1
+        })
+    );
+    assert_eq!(rows.get(), 0, "nothing is sent before the error");
+    let mut two: Box<Workspace<TriangleId, Flat, 16, 16, 8, 4, 2>> =
+        Box::new(Workspace::new(TriangleId::NONE));
+    let stats = two
+        .render(&scene, &RenderOptions::default(), &mut sink)
+        .unwrap();
+    assert_eq!((stats.triangles_in, rows.get()), (2, 16));
+}

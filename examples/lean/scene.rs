@@ -170,8 +170,11 @@ pub const MAX_ACTIVE: usize = 11;
 pub const NEEDS_CLIPPING: bool = false;
 /// Back-face culling, as analysed.
 pub const CULL_BACK_FACES: bool = true;
+/// Mesh instances: this file holds one mesh.
+pub const INSTANCES: usize = 1;
 /// The workspace this budget asks for.
-pub type SceneWorkspace<P, S> = Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE>;
+pub type SceneWorkspace<P, S> =
+    Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE, INSTANCES>;
 
 /// Vertical field of view (degrees), near and far planes of every view.
 pub const PROJECTION: (f32, f32, f32) = (50.0, 0.15000068, 12.000053);

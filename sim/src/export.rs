@@ -216,8 +216,10 @@ impl Export<'_> {
             "pub const CULL_BACK_FACES: bool = {};",
             self.cull_back_faces
         );
+        let _ = writeln!(s, "/// Mesh instances: this file holds one mesh.");
+        let _ = writeln!(s, "pub const INSTANCES: usize = 1;");
         let _ = writeln!(s, "/// The workspace this budget asks for.");
-        s += "pub type SceneWorkspace<P, S> = Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE>;\n\n";
+        s += "pub type SceneWorkspace<P, S> =\n    Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE, INSTANCES>;\n\n";
         let first = self
             .views
             .first()
