@@ -177,6 +177,18 @@ mod firmware {
     }
 
     pub fn main() -> ! {
-        measure::exit(run())
+        match run() {
+            Ok(()) => semihosting::process::exit(0),
+            Err(e) => {
+                println!("error: {}", e);
+                semihosting::process::exit(1)
+            }
+        }
+    }
+
+    #[panic_handler]
+    fn panic(info: &core::panic::PanicInfo) -> ! {
+        println!("panic: {}", info);
+        semihosting::process::exit(1)
     }
 }

@@ -43,6 +43,6 @@ mod firmware {
     use scanline3d::{clip::NoClip, Flat};
 
     pub fn main() -> ! {
-        super::measure::exit(lean::run::<Flat, NoClip, false>("baseline", NoClip))
+        super::lean::exit(lean::run::<Flat, NoClip, false>("baseline", NoClip))
     }
 }

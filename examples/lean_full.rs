@@ -42,6 +42,6 @@ mod firmware {
     use scanline3d::{clip::FrustumClip, Gouraud};
 
     pub fn main() -> ! {
-        super::measure::exit(lean::run::<Gouraud, FrustumClip, true>("full", FrustumClip))
+        super::lean::exit(lean::run::<Gouraud, FrustumClip, true>("full", FrustumClip))
     }
 }

@@ -45,6 +45,6 @@ mod firmware {
     pub fn main() -> ! {
         // The minimal build is only valid for scenes the analysis proved need no clipping.
         const { assert!(!scene::NEEDS_CLIPPING) };
-        super::measure::exit(lean::run::<Flat, NoClip, true>("minimal", NoClip))
+        super::lean::exit(lean::run::<Flat, NoClip, true>("minimal", NoClip))
     }
 }

@@ -1,5 +1,5 @@
 //! Measurements shared by the firmware examples: static RAM, stack high-water mark by
-//! painting, and a check of the instruction counter; plus the exit status and panic handler.
+//! painting, and a check of the instruction counter.
 
 use crate::arch;
 use semihosting::println;
@@ -64,21 +64,4 @@ pub fn calibrate() -> Result<(), &'static str> {
         return Err("instruction counter is not 1 per instruction (run QEMU with -icount shift=0)");
     }
     Ok(())
-}
-
-/// Exits QEMU with status 0, or prints the error and exits with 1.
-pub fn exit(result: Result<(), &'static str>) -> ! {
-    match result {
-        Ok(()) => semihosting::process::exit(0),
-        Err(e) => {
-            println!("error: {}", e);
-            semihosting::process::exit(1)
-        }
-    }
-}
-
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    println!("panic: {}", info);
-    semihosting::process::exit(1)
 }
