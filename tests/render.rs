@@ -45,17 +45,22 @@ fn interpenetrating_triangles_resolve_per_pixel() {
 
 /// A ground quad under a camera standing on it: some triangles have one or two vertices behind
 /// the eye and must be clipped at the near plane, not vanish or explode.
-#[test]
-fn near_plane_crossing_triangles_render() {
-    let verts = [
+/// A 40×40 ground square as a fan around a vertex just in front of the cameras' feet: with the
+/// cameras below, its far corners lie behind the eye, so it crosses the near plane.
+fn ground_fan() -> (Vec<[f64; 3]>, Vec<[u16; 3]>) {
+    let verts = vec![
         [-20.0, 0.0, 20.0],
         [20.0, 0.0, 20.0],
         [20.0, 0.0, -20.0],
         [-20.0, 0.0, -20.0],
         [0.0, 0.0, 1.0],
     ];
-    // A fan around a vertex just in front of the camera's feet.
-    let tris = [[4, 0, 1], [4, 1, 2], [4, 2, 3], [4, 3, 0]];
+    (verts, vec![[4, 0, 1], [4, 1, 2], [4, 2, 3], [4, 3, 0]])
+}
+
+#[test]
+fn near_plane_crossing_triangles_render() {
+    let (verts, tris) = ground_fan();
     let data = mesh_data(&verts, &tris);
     let mesh = data.mesh().unwrap();
     let cam = CameraSpec::looking_at([0.0, 1.0, 2.0], [0.0, 0.0, -3.0], 70.0, 0.2, 60.0);
@@ -88,17 +93,10 @@ fn near_plane_crossing_triangles_render() {
 
 #[test]
 fn without_clipping_crossing_triangles_are_skipped_and_counted_never_drawn_wrong() {
-    let verts = [
-        [-20.0, 0.0, 20.0],
-        [20.0, 0.0, 20.0],
-        [20.0, 0.0, -20.0],
-        [-20.0, 0.0, -20.0],
-        [0.0, 0.0, 1.0],
-    ];
-    // The near-plane fan above plus a small triangle well inside the view volume (id 4).
-    let mut verts = verts.to_vec();
+    // The near-plane fan plus a small triangle well inside the view volume (id 4).
+    let (mut verts, mut tris) = ground_fan();
     verts.extend([[-0.5, 0.5, -3.0], [0.5, 0.5, -3.0], [0.0, 1.2, -3.0]]);
-    let tris = [[4, 0, 1], [4, 1, 2], [4, 2, 3], [4, 3, 0], [5, 6, 7]];
+    tris.push([5, 6, 7]);
     let data = mesh_data(&verts, &tris);
     let mesh = data.mesh().unwrap();
     let cam = CameraSpec::looking_at([0.0, 1.0, 2.0], [0.0, 0.0, -3.0], 70.0, 0.2, 60.0);
