@@ -108,13 +108,28 @@ fn install() -> Result<(), String> {
             cmd
         };
         run(&mut apt(&["update", "-qq"]))?;
-        run(&mut apt(&[
+        let install = [
             "install",
             "-y",
             "-qq",
             "qemu-system-arm",
             "qemu-system-misc",
-        ]))?;
+        ];
+        if run(&mut apt(&install)).is_err() {
+            // Some images carry a newer qemu-utils (from backports) that breaks the release's
+            // qemu-system-common: take the release's own qemu-utils with it.
+            let codename = std::fs::read_to_string("/etc/os-release")
+                .ok()
+                .and_then(|s| {
+                    s.lines()
+                        .find_map(|l| l.strip_prefix("VERSION_CODENAME=").map(str::to_owned))
+                })
+                .unwrap_or_else(|| "stable".to_owned());
+            let utils = format!("qemu-utils/{codename}");
+            run(&mut apt(
+                &[&install[..], &["--allow-downgrades", &utils]].concat()
+            ))?;
+        }
     }
     Ok(())
 }
