@@ -87,6 +87,7 @@ pub mod math;
 pub mod project;
 pub mod raster;
 pub mod render;
+pub mod resolve;
 pub mod scene;
 pub mod shading;
 pub mod sink;

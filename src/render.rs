@@ -231,15 +231,121 @@ impl<E: core::fmt::Debug> core::fmt::Display for RenderError<E> {
 
 impl<E: core::fmt::Debug> core::error::Error for RenderError<E> {}
 
-/// A triangle on the active list.
+/// A triangle on the active list. `K` is the sort key of depth-sorting methods (`()` for the
+/// others, so it costs nothing there).
 #[derive(Clone, Copy, Debug)]
-struct ActiveTri<T> {
-    walk: TriangleWalk,
-    depth: DepthPlane,
-    payload: T,
+pub(crate) struct ActiveTri<T, K = ()> {
+    pub(crate) walk: TriangleWalk,
+    pub(crate) depth: DepthPlane,
+    pub(crate) payload: T,
+    pub(crate) key: K,
 }
 
-const NO_ENTRY: u16 = u16::MAX;
+/// A per-triangle sort key: `u32` for depth sorting, `()` where the order is activation order.
+pub(crate) trait SortKey: Copy + Ord {
+    /// Whether pass 1 computes keys and activation keeps the active list sorted.
+    const SORTED: bool;
+    fn from_raw(raw: u32) -> Self;
+}
+
+impl SortKey for () {
+    const SORTED: bool = false;
+    fn from_raw(_: u32) -> Self {}
+}
+
+impl SortKey for u32 {
+    const SORTED: bool = true;
+    fn from_raw(raw: u32) -> Self {
+        raw
+    }
+}
+
+/// The hidden-surface step: what becomes of the spans the active triangles produce. The
+/// span z-buffer, band z-buffers, span sorting and depth sorting differ only here; transform,
+/// clipping, projection, bucketing and the edge walk are shared.
+pub(crate) trait Resolve<P: RowPixel, S: Shading> {
+    /// The per-triangle sort key (`()` unless the method sorts by depth).
+    type Key: SortKey;
+    /// Rows resolved together: 1 for row-at-a-time methods, `B` for a band z-buffer.
+    fn band_rows(&self) -> usize;
+    /// Starts rows `y0 .. y0 + rows`: everything background, nothing covered.
+    fn begin_band(&mut self, y0: i32, rows: usize);
+    /// Takes triangle `t`'s span on row `y`, columns `[l, r)` (on screen, non-empty); `order`
+    /// is `t`'s position on the active list (activation order). Returns pixels written now.
+    fn span(
+        &mut self,
+        t: &ActiveTri<S::Payload<P>, Self::Key>,
+        order: usize,
+        y: i32,
+        l: i32,
+        r: i32,
+    ) -> u32;
+    /// Finishes row `y`: its pixels, its depth (empty for methods without depth memory),
+    /// the spans it received, and pixels written while finishing.
+    fn finish_row(&mut self, y: i32) -> FinishedRow<'_, P>;
+}
+
+/// What [`Resolve::finish_row`] hands back.
+pub(crate) struct FinishedRow<'a, P> {
+    pub(crate) pixels: &'a [P],
+    pub(crate) depth: &'a [Depth],
+    pub(crate) spans: u16,
+    pub(crate) written: u32,
+}
+
+/// The span z-buffer: one row of depth, spans depth-tested as they come.
+struct SpanZBuffer<'a, P> {
+    depth: &'a mut [Depth],
+    pixels: &'a mut [P],
+    background: P,
+    spans: u16,
+}
+
+impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanZBuffer<'_, P> {
+    type Key = ();
+    fn band_rows(&self) -> usize {
+        1
+    }
+    fn begin_band(&mut self, _: i32, _: usize) {
+        self.depth.fill(Depth::ZERO);
+        self.pixels.fill(self.background);
+        self.spans = 0;
+    }
+    #[inline]
+    fn span(&mut self, t: &ActiveTri<S::Payload<P>>, _: usize, y: i32, l: i32, r: i32) -> u32 {
+        self.spans += 1;
+        fill_span::<P, S, ()>(t, y, l, r, self.depth, self.pixels)
+    }
+    fn finish_row(&mut self, _: i32) -> FinishedRow<'_, P> {
+        FinishedRow {
+            pixels: self.pixels,
+            depth: self.depth,
+            spans: self.spans,
+            written: 0,
+        }
+    }
+}
+
+/// Depth-tests and writes `t`'s span `[l, r)` of row `y` into one row of depth and pixels.
+#[inline]
+pub(crate) fn fill_span<P: RowPixel, S: Shading, K>(
+    t: &ActiveTri<S::Payload<P>, K>,
+    y: i32,
+    l: i32,
+    r: i32,
+    depth: &mut [Depth],
+    pixels: &mut [P],
+) -> u32 {
+    let (q, dq) = t.depth.span_start(l, y);
+    let span = SpanDepth { x0: l, y, q, dq };
+    let cols = l as usize..r as usize;
+    match (depth.get_mut(cols.clone()), pixels.get_mut(cols)) {
+        (Some(d), Some(p)) => S::fill(&t.payload, t.depth.origin(), span, d, p),
+        _ => 0,
+    }
+}
+
+pub(crate) const NO_ENTRY: u16 = u16::MAX;
 
 /// All the memory a render needs, sized at compile time.
 ///
@@ -313,15 +419,31 @@ pub const fn workspace_bytes<P: RowPixel, S: Shading>(
     unpadded.div_ceil(align) * align
 }
 
-/// The workspace as slices, so the driver is not generic over the capacities.
-struct View<'a, P: RowPixel, S: Shading> {
-    depth: &'a mut [Depth],
-    pixels: &'a mut [P],
-    background: P,
-    heads: &'a mut [u16],
-    next: &'a mut [u16],
-    refs: &'a mut [u16],
-    active: &'a mut VecView<ActiveTri<S::Payload<P>>>,
+/// Buckets and active list as slices, so the driver is not generic over the capacities.
+pub(crate) struct Frame<'a, T, K> {
+    pub(crate) heads: &'a mut [u16],
+    pub(crate) next: &'a mut [u16],
+    pub(crate) refs: &'a mut [u16],
+    /// One sort key per bucket entry; empty unless `K::SORTED`.
+    pub(crate) keys: &'a mut [u32],
+    pub(crate) active: &'a mut VecView<ActiveTri<T, K>>,
+}
+
+/// Checks a `width × height` target against a workspace of `max_w × max_h` and builds its
+/// viewport.
+pub(crate) fn viewport<const SUB: u32, E>(
+    width: usize,
+    height: usize,
+    max_w: usize,
+    max_h: usize,
+    scene: &Scene<'_>,
+) -> Result<Viewport<SUB>, RenderError<E>> {
+    if width == 0 || height == 0 || width > max_w || height > max_h {
+        return Err(RenderError::InvalidTarget);
+    }
+    let camera = &scene.camera;
+    Viewport::<SUB>::new(width, height, camera.focal(), camera.near(), camera.far())
+        .ok_or(RenderError::InvalidTarget)
 }
 
 impl<
@@ -435,13 +557,7 @@ impl<
         options: &RenderOptions<SUB_BITS, C>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
-        if width == 0 || height == 0 || width > W || height > H {
-            return Err(RenderError::InvalidTarget);
-        }
-        let camera = &scene.camera;
-        let vp =
-            Viewport::<SUB_BITS>::new(width, height, camera.focal(), camera.near(), camera.far())
-                .ok_or(RenderError::InvalidTarget)?;
+        let vp = viewport::<SUB_BITS, K::Error>(width, height, W, H, scene)?;
         let (Some(depth), Some(pixels), Some(heads)) = (
             self.depth.get_mut(..width),
             self.pixels.get_mut(..width),
@@ -449,16 +565,20 @@ impl<
         ) else {
             return Err(RenderError::InvalidTarget);
         };
-        let view = View::<P, S> {
-            depth,
-            pixels,
-            background: self.background,
+        let frame = Frame {
             heads,
             next: &mut self.next,
             refs: &mut self.refs,
+            keys: &mut [],
             active: self.active.as_mut_view(),
         };
-        render_frame::<P, S, SUB_BITS, C, K, INSTANCES>(view, scene, options, &vp, sink)
+        let mut resolve = SpanZBuffer {
+            depth,
+            pixels,
+            background: self.background,
+            spans: 0,
+        };
+        drive::<P, S, SUB_BITS, C, K, INSTANCES, _>(frame, &mut resolve, scene, options, &vp, sink)
     }
 }
 
@@ -621,15 +741,19 @@ fn locate<'s, 'a>(
         .map(|s| (s, (id - s.first_id) as usize))
 }
 
-fn render_frame<
+/// Renders one frame: pass 1 files triangles in row buckets, pass 2 walks the rows band by band,
+/// handing spans to `resolve` and finished rows to `sink`.
+pub(crate) fn drive<
     P: RowPixel,
     S: Shading,
     const SUB: u32,
     C: Clipping,
     K: RowSink<P>,
     const INSTANCES: usize,
+    R: Resolve<P, S>,
 >(
-    ws: View<'_, P, S>,
+    ws: Frame<'_, S::Payload<P>, R::Key>,
+    resolve: &mut R,
     scene: &Scene<'_>,
     options: &RenderOptions<SUB, C>,
     vp: &Viewport<SUB>,
@@ -637,19 +761,29 @@ fn render_frame<
 ) -> Result<FrameStats, RenderError<K::Error>> {
     let setups = setup_instances::<K::Error, INSTANCES>(scene)?;
     let mut stats = FrameStats::default();
-    let (width, height) = (ws.depth.len().min(ws.pixels.len()), ws.heads.len());
+    let height = ws.heads.len();
+    let width = vp.width as i32;
     let capacity = ws.refs.len().min(ws.next.len());
+    let sorted = <R::Key as SortKey>::SORTED;
 
     // Pass 1: file every visible triangle under its first row. Iterating in reverse and pushing
-    // at the head leaves each row's list in ascending id order.
+    // at the head leaves each row's list in ascending id order. Depth sorting also keeps a key
+    // per triangle: the mean depth of its (clipped) vertices, larger = nearer.
     ws.heads.fill(NO_ENTRY);
     let mut filed = 0usize;
     for setup in setups.iter().rev() {
         let n = setup.instance.mesh.triangles().len();
         stats.triangles_in += n as u32;
         for tri in (0..n).rev() {
-            match setup.screen_triangles::<SUB, C>(tri, vp, options.cull_back_faces, false, |_| {})
-            {
+            let (mut q_sum, mut q_count) = (0u64, 0u64);
+            let fate =
+                setup.screen_triangles::<SUB, C>(tri, vp, options.cull_back_faces, false, |s| {
+                    if sorted {
+                        q_sum += s.iter().map(|v| v.q.to_bits().max(0) as u64).sum::<u64>();
+                        q_count += 3;
+                    }
+                });
+            match fate {
                 Fate::Culled => stats.culled += 1,
                 Fate::Rejected => stats.rejected += 1,
                 Fate::Unclipped => stats.unclipped += 1,
@@ -668,6 +802,9 @@ fn render_frame<
                             *next = *head;
                             *head = filed as u16;
                         }
+                        if let Some(k) = ws.keys.get_mut(filed) {
+                            *k = (q_sum / q_count.max(1)) as u32;
+                        }
                     }
                     filed += 1;
                 }
@@ -682,53 +819,86 @@ fn render_frame<
         });
     }
 
-    // Pass 2: rows top to bottom.
-    ws.active.clear();
+    // Pass 2: bands of rows top to bottom (a band is one row except for band z-buffers).
+    let band = resolve.band_rows().max(1);
+    let active = ws.active;
+    active.clear();
     // Last row covered by any dropped piece so far: rows up to it are incomplete.
     let mut lost_until = -1i32;
-    for row in 0..height {
-        let y = row as i32;
-        // Activate this row's bucket.
-        let mut entry = ws.heads.get(row).copied().unwrap_or(NO_ENTRY);
-        while entry != NO_ENTRY {
-            let e = entry as usize;
-            entry = ws.next.get(e).copied().unwrap_or(NO_ENTRY);
-            let Some(&id) = ws.refs.get(e) else { continue };
-            let Some((setup, tri)) = locate(&setups, id as u32) else {
-                continue;
-            };
-            let Some(&idx) = setup.instance.mesh.triangles().get(tri) else {
-                continue;
-            };
-            let face = if S::PER_VERTEX {
-                Rgb888::new(0, 0, 0)
-            } else {
-                setup.face_color(tri, idx)
-            };
-            let active = &mut *ws.active;
-            setup.screen_triangles::<SUB, C>(
-                tri,
-                vp,
-                options.cull_back_faces,
-                S::PER_VERTEX,
-                |s| {
-                    let (Some(walk), Some(solver)) = (
-                        TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32),
-                        PlaneSolver::new(&s),
-                    ) else {
-                        return;
-                    };
-                    let tri_state = ActiveTri {
-                        walk,
-                        depth: DepthPlane::new(&solver, &s),
-                        payload: S::payload::<P, SUB>(face, id as u32, &solver, &s),
-                    };
-                    let (first_row, last_row) =
-                        (tri_state.walk.row(), tri_state.walk.end_row() - 1);
-                    if active.push(tri_state).is_ok() {
+    let mut y0 = 0usize;
+    while y0 < height {
+        let y1 = (y0 + band).min(height);
+        resolve.begin_band(y0 as i32, y1 - y0);
+        if band > 1 {
+            // Triangles carried over from earlier bands come first, in activation order.
+            let mut order = 0;
+            active.retain_mut(|t| {
+                order += 1;
+                walk_band::<P, S, SUB, R>(t, order - 1, y1 as i32, width, resolve, &mut stats)
+            });
+        }
+        for row in y0..y1 {
+            let y = row as i32;
+            // Activate this row's bucket.
+            let mut entry = ws.heads.get(row).copied().unwrap_or(NO_ENTRY);
+            while entry != NO_ENTRY {
+                let e = entry as usize;
+                entry = ws.next.get(e).copied().unwrap_or(NO_ENTRY);
+                let Some(&id) = ws.refs.get(e) else { continue };
+                let key = R::Key::from_raw(ws.keys.get(e).copied().unwrap_or(0));
+                let Some((setup, tri)) = locate(&setups, id as u32) else {
+                    continue;
+                };
+                let Some(&idx) = setup.instance.mesh.triangles().get(tri) else {
+                    continue;
+                };
+                let face = if S::PER_VERTEX {
+                    Rgb888::new(0, 0, 0)
+                } else {
+                    setup.face_color(tri, idx)
+                };
+                setup.screen_triangles::<SUB, C>(
+                    tri,
+                    vp,
+                    options.cull_back_faces,
+                    S::PER_VERTEX,
+                    |s| {
+                        let (Some(walk), Some(solver)) = (
+                            TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32),
+                            PlaneSolver::new(&s),
+                        ) else {
+                            return;
+                        };
+                        let mut tri_state = ActiveTri {
+                            walk,
+                            depth: DepthPlane::new(&solver, &s),
+                            payload: S::payload::<P, SUB>(face, id as u32, &solver, &s),
+                            key,
+                        };
                         stats.activated += 1;
-                    } else {
-                        // Degrade deterministically: this piece is lost, everything else is drawn.
+                        let (first_row, last_row) =
+                            (tri_state.walk.row(), tri_state.walk.end_row() - 1);
+                        if band > 1 {
+                            // Band z-buffer: draw it into the band now; keep it only if it
+                            // reaches the next band (so a full z-buffer keeps nothing).
+                            let order = active.len();
+                            let alive = walk_band::<P, S, SUB, R>(
+                                &mut tri_state,
+                                order,
+                                y1 as i32,
+                                width,
+                                resolve,
+                                &mut stats,
+                            );
+                            if !alive || active.push(tri_state).is_ok() {
+                                return;
+                            }
+                        } else if insert(active, tri_state) {
+                            return;
+                        }
+                        // Degrade deterministically: this piece (or its rest) is lost,
+                        // everything else is drawn.
+                        stats.activated -= 1;
                         let piece = DroppedPiece {
                             triangle: id as u32,
                             first_row: first_row as u16,
@@ -739,50 +909,84 @@ fn render_frame<
                         }
                         stats.dropped += 1;
                         lost_until = lost_until.max(last_row);
-                    }
-                },
-            );
+                    },
+                );
+            }
+            if band == 1 {
+                stats.peak_active = stats.peak_active.max(active.len() as u16);
+                let mut order = 0;
+                active.retain_mut(|t| {
+                    order += 1;
+                    walk_band::<P, S, SUB, R>(t, order - 1, y + 1, width, resolve, &mut stats)
+                });
+            }
         }
-        stats.peak_active = stats.peak_active.max(ws.active.len() as u16);
+        if band > 1 {
+            stats.peak_active = stats.peak_active.max(active.len() as u16);
+        }
 
-        // Resolve the row.
-        ws.depth.fill(Depth::ZERO);
-        ws.pixels.fill(ws.background);
-        let (depth, pixels) = (&mut *ws.depth, &mut *ws.pixels);
-        let mut spans = 0u16;
-        ws.active.retain_mut(|t| {
-            if t.walk.row() > y {
-                return true; // a clipped piece that starts lower down
-            }
-            let (l, r) = t.walk.span();
-            let (l, r) = (l.max(0), r.min(width as i32));
-            if l < r {
-                let (q, dq) = t.depth.span_start(l, y);
-                let span = SpanDepth { x0: l, y, q, dq };
-                let cols = l as usize..r as usize;
-                if let (Some(d), Some(p)) = (depth.get_mut(cols.clone()), pixels.get_mut(cols)) {
-                    spans += 1;
-                    stats.fragments += (r - l) as u32;
-                    stats.pixels_written += S::fill(&t.payload, t.depth.origin(), span, d, p);
-                }
-            }
-            t.walk.advance::<SUB>()
-        });
-        stats.spans += spans as u32;
-        stats.peak_spans = stats.peak_spans.max(spans);
-        let complete = y > lost_until;
-        stats.incomplete_rows += !complete as u16;
-        sink.write_row(Row {
-            y: row as u16,
-            pixels: ws.pixels,
-            depth: ws.depth,
-            complete,
-        })
-        .map_err(|error| RenderError::Sink {
-            row: row as u16,
-            error,
-        })?;
-        stats.rows += 1;
+        for row in y0..y1 {
+            let y = row as i32;
+            let done = resolve.finish_row(y);
+            stats.spans += done.spans as u32;
+            stats.peak_spans = stats.peak_spans.max(done.spans);
+            stats.pixels_written += done.written;
+            let complete = y > lost_until;
+            stats.incomplete_rows += !complete as u16;
+            sink.write_row(Row {
+                y: row as u16,
+                pixels: done.pixels,
+                depth: done.depth,
+                complete,
+            })
+            .map_err(|error| RenderError::Sink {
+                row: row as u16,
+                error,
+            })?;
+            stats.rows += 1;
+        }
+        y0 = y1;
     }
     Ok(stats)
+}
+
+/// Puts a newly set-up triangle on the active list: at the end (activation order), or for
+/// depth sorting before the first nearer one, so the list stays sorted far to near and, among
+/// equal keys, the triangle activated first is drawn last and keeps the pixel (the same tie
+/// rule as the z-buffers). `false` if the list is full.
+fn insert<T, K: SortKey>(active: &mut VecView<ActiveTri<T, K>>, t: ActiveTri<T, K>) -> bool {
+    if !K::SORTED {
+        return active.push(t).is_ok();
+    }
+    let at = active
+        .iter()
+        .position(|a| a.key >= t.key)
+        .unwrap_or(active.len());
+    active.insert(at, t).is_ok()
+}
+
+/// Walks triangle `t` down to row `y1` (exclusive), handing each on-screen span to `resolve`.
+/// Returns whether the triangle continues below `y1`.
+#[inline]
+fn walk_band<P: RowPixel, S: Shading, const SUB: u32, R: Resolve<P, S>>(
+    t: &mut ActiveTri<S::Payload<P>, R::Key>,
+    order: usize,
+    y1: i32,
+    width: i32,
+    resolve: &mut R,
+    stats: &mut FrameStats,
+) -> bool {
+    while t.walk.row() < y1 {
+        let y = t.walk.row();
+        let (l, r) = t.walk.span();
+        let (l, r) = (l.max(0), r.min(width));
+        if l < r {
+            stats.fragments += (r - l) as u32;
+            stats.pixels_written += resolve.span(t, order, y, l, r);
+        }
+        if !t.walk.advance::<SUB>() {
+            return false;
+        }
+    }
+    true
 }

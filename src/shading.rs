@@ -52,6 +52,17 @@ pub trait Shading: sealed::Sealed + Copy + Default {
         depth: &mut [Depth],
         pixels: &mut [P],
     ) -> u32;
+
+    /// Writes the span starting at column `x0` of row `y` without a depth test, for methods
+    /// that settle visibility before painting (span sorting, depth sorting); `pixels` is
+    /// exactly the span's columns.
+    fn paint<P: RowPixel>(
+        payload: &Self::Payload<P>,
+        origin: &PixelOrigin,
+        x0: i32,
+        y: i32,
+        pixels: &mut [P],
+    );
 }
 
 /// Flat shading: one Lambert + ambient colour per face.
@@ -103,6 +114,11 @@ impl Shading for Flat {
         }
         written
     }
+
+    #[inline]
+    fn paint<P: RowPixel>(color: &P, _: &PixelOrigin, _: i32, _: i32, pixels: &mut [P]) {
+        pixels.fill(*color);
+    }
 }
 
 /// Per-triangle data for [`Gouraud`].
@@ -152,5 +168,23 @@ impl Shading for Gouraud {
             }
         }
         written
+    }
+
+    #[inline]
+    fn paint<P: RowPixel>(
+        payload: &GouraudPayload,
+        origin: &PixelOrigin,
+        x0: i32,
+        y: i32,
+        pixels: &mut [P],
+    ) {
+        let (mut c, dc) = payload.planes.span_start(origin, x0, y);
+        for p in pixels.iter_mut() {
+            let rgb = Rgb888::new(channel(c[0]), channel(c[1]), channel(c[2]));
+            *p = P::from_shade(rgb, payload.id);
+            for k in 0..3 {
+                c[k] = c[k].wrapping_add(dc[k]);
+            }
+        }
     }
 }

@@ -171,6 +171,30 @@ pub fn all() -> Vec<CorpusScene> {
         ],
         vec![[0, 1, 2], [3, 4, 5]],
     );
+    // Three long triangles in cyclic overlap: each lies over the next and under the one
+    // before, so no order of whole triangles is right (the painter's algorithm's classic
+    // failure; their mean depths are equal, too).
+    let mut sticks = Vec::new();
+    let mut stick_tris = Vec::new();
+    for k in 0..3u16 {
+        let a = TAU * k as f64 / 3.0;
+        let (d, n) = ([a.cos(), a.sin()], [-a.sin(), a.cos()]);
+        let (r, half_len, half_width, slope) = (0.5, 1.3, 0.3, 0.3);
+        let at = |t: f64, s: f64| {
+            [
+                r * n[0] + t * d[0] + s * n[0],
+                r * n[1] + t * d[1] + s * n[1],
+                slope * t,
+            ]
+        };
+        sticks.extend([
+            at(-half_len, 0.0),
+            at(half_len, -half_width),
+            at(half_len, half_width),
+        ]);
+        stick_tris.push([3 * k, 3 * k + 1, 3 * k + 2]);
+    }
+    let cyclic = mesh(&sticks, stick_tris);
     vec![
         CorpusScene {
             name: "cube",
@@ -251,6 +275,16 @@ pub fn all() -> Vec<CorpusScene> {
             mesh: pawn(),
             cameras: orbit(4.0, 1.2, 3, 50.0),
             cull_back_faces: true,
+        },
+        CorpusScene {
+            name: "cyclic",
+            about: "three triangles in cyclic overlap, no two interpenetrating",
+            mesh: cyclic,
+            cameras: vec![
+                CameraSpec::looking_at([0.0, 0.0, 4.0], [0.0; 3], 45.0, 0.5, 20.0),
+                CameraSpec::looking_at([0.4, -0.3, 3.5], [0.0; 3], 50.0, 0.5, 20.0),
+            ],
+            cull_back_faces: false,
         },
     ]
 }

@@ -36,7 +36,19 @@ pub fn accuracy(
     h: usize,
     sub_bits: u32,
 ) -> Result<(Metrics, scene::FixedRender, reference::Image), String> {
-    let fixed = spec.render_fixed(w, h, sub_bits)?;
+    accuracy_with(spec, w, h, sub_bits, scene::Algorithm::SpanZBuffer)
+}
+
+#[cfg(not(target_os = "none"))]
+/// [`accuracy`] for any hidden-surface method.
+pub fn accuracy_with(
+    spec: &SceneSpec,
+    w: usize,
+    h: usize,
+    sub_bits: u32,
+    algorithm: scene::Algorithm,
+) -> Result<(Metrics, scene::FixedRender, reference::Image), String> {
+    let fixed = spec.render_fixed_with(w, h, sub_bits, algorithm)?;
     let reference = spec.reference()?;
     let ref_image = reference.render(w, h);
     let bound = ErrorBound {

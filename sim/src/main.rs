@@ -7,8 +7,8 @@
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use scanline3d_sim::metrics::{self, ErrorBound};
 use scanline3d_sim::reference::Image;
-use scanline3d_sim::scene::{self, CameraSpec, LightSpec, MeshData, SceneSpec};
-use scanline3d_sim::{accuracy, analyze, corpus};
+use scanline3d_sim::scene::{self, Algorithm, CameraSpec, LightSpec, MeshData, SceneSpec};
+use scanline3d_sim::{accuracy, accuracy_with, analyze, corpus};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -138,6 +138,24 @@ struct View {
     /// Draw back faces too (open surfaces).
     #[arg(long)]
     no_cull: bool,
+    /// Hidden-surface method: span-zbuffer (default), zbuffer, band:N (N = 1, 2, 4, ..., 128),
+    /// depth-sort, span-sort, or raycast (the f64 reference ray caster).
+    #[arg(long, value_parser = method, default_value = "span-zbuffer")]
+    algorithm: Method,
+}
+
+/// What `--algorithm` selects: a fixed-point method, or the f64 ray caster.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Method {
+    Fixed(Algorithm),
+    Raycast,
+}
+
+fn method(s: &str) -> Result<Method, String> {
+    match s {
+        "raycast" => Ok(Method::Raycast),
+        _ => s.parse().map(Method::Fixed),
+    }
 }
 
 #[derive(Args, Debug)]
@@ -395,17 +413,21 @@ fn spec_from(path: &Path, v: &View) -> Result<SceneSpec, String> {
 fn render(a: RenderArgs) -> Result<(), String> {
     let spec = spec_from(&a.scene, &a.view)?;
     let (w, h) = a.view.size;
-    let (image, stats_json) = match a.renderer {
-        Renderer::Fixed => {
-            let r = spec.render_fixed(w, h, a.view.sub_pixel_bits)?;
+    let renderer = match (a.renderer, a.view.algorithm) {
+        (Renderer::Reference, _) | (_, Method::Raycast) => None,
+        (Renderer::Fixed, Method::Fixed(algorithm)) => Some(algorithm),
+    };
+    let (image, stats_json) = match renderer {
+        Some(algorithm) => {
+            let r = spec.render_fixed_with(w, h, a.view.sub_pixel_bits, algorithm)?;
             let s = r.stats;
             let json = format!(
-                "{{\"renderer\": \"fixed\", \"sub_pixel_bits\": {}, \"width\": {w}, \"height\": {h}, \"triangles_in\": {}, \"culled\": {}, \"clipped\": {}, \"rejected\": {}, \"drawn\": {}, \"spans\": {}, \"fragments\": {}, \"pixels_written\": {}, \"peak_active\": {}, \"dropped\": {}}}\n",
+                "{{\"renderer\": \"fixed\", \"algorithm\": \"{algorithm}\", \"sub_pixel_bits\": {}, \"width\": {w}, \"height\": {h}, \"triangles_in\": {}, \"culled\": {}, \"clipped\": {}, \"rejected\": {}, \"drawn\": {}, \"spans\": {}, \"fragments\": {}, \"pixels_written\": {}, \"peak_active\": {}, \"dropped\": {}}}\n",
                 a.view.sub_pixel_bits, s.triangles_in, s.culled, s.clipped, s.rejected, s.activated, s.spans, s.fragments, s.pixels_written, s.peak_active, s.dropped
             );
             (r.image, json)
         }
-        Renderer::Reference => {
+        None => {
             let start = std::time::Instant::now();
             let img = spec.reference()?.render(w, h);
             let covered = img.ids.iter().filter(|&&i| i >= 0).count();
@@ -460,9 +482,12 @@ fn compare(a: CompareArgs) -> Result<(), String> {
     let (w, h) = a.view.size;
     if let Some(path) = &a.scene {
         let spec = spec_from(path, &a.view)?;
-        let (m, fixed, reference) = accuracy(&spec, w, h, a.view.sub_pixel_bits)?;
+        let Method::Fixed(algorithm) = a.view.algorithm else {
+            return Err("raycast is the reference itself: choose a fixed-point --algorithm".into());
+        };
+        let (m, fixed, reference) = accuracy_with(&spec, w, h, a.view.sub_pixel_bits, algorithm)?;
         say!(
-            "{} at {w}x{h}, {} sub-pixel bits, fixed-point vs f64 reference:",
+            "{} at {w}x{h}, {} sub-pixel bits, {algorithm}, fixed-point vs f64 reference:",
             path.display(),
             a.view.sub_pixel_bits
         );

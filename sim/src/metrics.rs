@@ -138,7 +138,8 @@ pub fn compare_images(a: &Image, b: &Image) -> Metrics {
         if fa != fb {
             m.id_mismatches += 1;
             m.coverage_mismatches += ((fa >= 0) != (fb >= 0)) as usize;
-        } else if fa >= 0 {
+        } else if fa >= 0 && !a.depth[i].is_nan() && !b.depth[i].is_nan() {
+            // (NaN: a method without depth memory has no depth to compare.)
             let (da, db) = (a.depth[i] as f64, b.depth[i] as f64);
             let rel = (da - db).abs() / db;
             m.depth_max_rel = m.depth_max_rel.max(rel);
@@ -229,7 +230,8 @@ pub fn compare(
         if f == r {
             // Depth check against the per-pixel bound: the format's resolution plus how far the
             // surface's depth moves within the position bound (a steep surface moves a lot).
-            if f >= 0 {
+            // Methods without depth memory report NaN: nothing to check.
+            if f >= 0 && !fixed.depth[i].is_nan() {
                 let (df, dr) = (fixed.depth[i] as f64, reference.depth[i] as f64);
                 let eps = bound.position_px(dr);
                 let slope = ring(p, eps)

@@ -4,9 +4,11 @@
 use crate::reference::{self, Image};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::I16F16;
+use scanline3d::resolve::{BandWorkspace, DepthSortWorkspace, SpanSortWorkspace, ZBufferWorkspace};
 use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
-use scanline3d::sink::{FnSink, Row, TriangleId};
-use scanline3d::{Depth, Flat, FrameStats, RenderOptions, Workspace};
+use scanline3d::sink::{FnSink, Row, RowPixel, RowSink, TriangleId};
+use scanline3d::{Flat, FrameStats, RenderOptions, Workspace};
+use std::convert::Infallible;
 use std::path::Path;
 
 /// Camera parameters (`gluLookAt` + `gluPerspective`).
@@ -269,27 +271,6 @@ pub struct FixedRender {
 
 /// Largest target `sim` renders (the library's limit).
 pub const MAX_SIZE: usize = 2048;
-type ColorWs = Workspace<Rgb888, Flat, MAX_SIZE, MAX_SIZE, 65534, 4096>;
-type IdWs = Workspace<TriangleId, Flat, MAX_SIZE, MAX_SIZE, 65534, 4096>;
-
-fn render_pass<P: scanline3d::sink::RowPixel, const S: u32, const T: usize, const A: usize>(
-    ws: &mut Workspace<P, Flat, MAX_SIZE, MAX_SIZE, T, A>,
-    scene: &Scene<'_>,
-    cull: bool,
-    w: usize,
-    h: usize,
-    mut f: impl FnMut(usize, &[P], &[Depth]),
-) -> Result<FrameStats, String> {
-    let options = RenderOptions::default()
-        .with_back_face_culling(cull)
-        .with_sub_pixel_bits::<S>();
-    let mut sink = FnSink(|row: Row<'_, P>| -> Result<(), std::convert::Infallible> {
-        f(row.y as usize, row.pixels, row.depth);
-        Ok(())
-    });
-    ws.render_sized(w, h, scene, &options, &mut sink)
-        .map_err(|e| e.to_string())
-}
 
 impl SceneSpec {
     /// One mesh with the identity transform.
@@ -392,15 +373,30 @@ impl SceneSpec {
     }
 
     /// Renders with the fixed-point renderer at `sub_bits` (0, 2, 4 or 8) into id, depth and
-    /// colour images (an id pass and a colour pass through the same pipeline).
+    /// colour images (an id pass and a colour pass through the same pipeline), with the span
+    /// z-buffer.
     pub fn render_fixed(&self, w: usize, h: usize, sub_bits: u32) -> Result<FixedRender, String> {
+        self.render_fixed_with(w, h, sub_bits, Algorithm::SpanZBuffer)
+    }
+
+    /// [`Self::render_fixed`] with another hidden-surface method. Methods without depth memory
+    /// leave the depth image NaN where a surface is shown (there is no depth to report).
+    pub fn render_fixed_with(
+        &self,
+        w: usize,
+        h: usize,
+        sub_bits: u32,
+        algorithm: Algorithm,
+    ) -> Result<FixedRender, String> {
         // The host workspaces are large (capacity for 2048×2048 and 65534 triangles) and the
         // library builds them by value, which in debug builds goes through the stack: render on
         // a thread with room for that.
         std::thread::scope(|scope| {
             std::thread::Builder::new()
-                .stack_size(64 << 20)
-                .spawn_scoped(scope, || self.render_fixed_on_this_thread(w, h, sub_bits))
+                .stack_size(256 << 20)
+                .spawn_scoped(scope, || {
+                    self.render_fixed_on_this_thread(w, h, sub_bits, algorithm)
+                })
                 .map_err(|e| format!("cannot start render thread: {e}"))?
                 .join()
                 .map_err(|_| "render thread panicked".to_string())?
@@ -461,21 +457,30 @@ impl SceneSpec {
         w: usize,
         h: usize,
         sub_bits: u32,
+        algorithm: Algorithm,
     ) -> Result<FixedRender, String> {
         match sub_bits {
-            0 => self.render_fixed_s::<0>(w, h),
-            2 => self.render_fixed_s::<2>(w, h),
-            4 => self.render_fixed_s::<4>(w, h),
-            8 => self.render_fixed_s::<8>(w, h),
+            0 => self.render_fixed_s::<0>(w, h, algorithm),
+            2 => self.render_fixed_s::<2>(w, h, algorithm),
+            4 => self.render_fixed_s::<4>(w, h, algorithm),
+            8 => self.render_fixed_s::<8>(w, h, algorithm),
             _ => Err(format!(
                 "sub-pixel bits must be one of {SUB_PIXEL_CHOICES:?}"
             )),
         }
     }
 
-    fn render_fixed_s<const S: u32>(&self, w: usize, h: usize) -> Result<FixedRender, String> {
-        if w == 0 || h == 0 || w > MAX_SIZE || h > MAX_SIZE {
-            return Err(format!("size {w}x{h} outside 1x1..{MAX_SIZE}x{MAX_SIZE}"));
+    fn render_fixed_s<const S: u32>(
+        &self,
+        w: usize,
+        h: usize,
+        algorithm: Algorithm,
+    ) -> Result<FixedRender, String> {
+        let max = algorithm.max_size();
+        if w == 0 || h == 0 || w > max || h > max {
+            return Err(format!(
+                "size {w}x{h} outside 1x1..{max}x{max} for {algorithm}"
+            ));
         }
         let meshes = self.meshes()?;
         let instances = self.library_instances(&meshes);
@@ -492,7 +497,9 @@ impl SceneSpec {
             depth: vec![f32::INFINITY; w * h],
             color: vec![[0; 3]; w * h],
         };
-        let mut ws: Box<ColorWs> = Box::new(Workspace::new(Rgb888::BLACK));
+        let options = RenderOptions::default()
+            .with_back_face_culling(self.cull_back_faces)
+            .with_sub_pixel_bits::<S>();
         let mut target = RgbImage {
             width: w,
             height: h,
@@ -500,37 +507,159 @@ impl SceneSpec {
         };
         let stats = {
             let mut display = scanline3d::sink::DrawTargetSink::new(&mut target);
-            let options = RenderOptions::default()
-                .with_back_face_culling(self.cull_back_faces)
-                .with_sub_pixel_bits::<S>();
-            // Record each row's depth, then hand the row to the draw target.
             let mut sink = FnSink(|row: Row<'_, Rgb888>| {
-                for (x, q) in row.depth.iter().enumerate() {
-                    image.depth[row.y as usize * w + x] =
-                        camera.eye_distance(*q).unwrap_or(f32::INFINITY);
-                }
                 scanline3d::sink::RowSink::write_row(&mut display, row)
             });
-            ws.render_sized(w, h, &scene, &options, &mut sink)
-                .map_err(|e| e.to_string())?
+            render_with(algorithm, Rgb888::BLACK, w, h, &scene, &options, &mut sink)?
         };
         image.color = target.pixels;
-        drop(ws);
-        let mut ws: Box<IdWs> = Box::new(Workspace::new(TriangleId::NONE));
-        render_pass::<_, S, 65534, 4096>(
-            &mut ws,
-            &scene,
-            self.cull_back_faces,
+        // The id pass also records depth (NaN over surfaces where the method keeps none).
+        let mut sink = FnSink(|row: Row<'_, TriangleId>| -> Result<(), Infallible> {
+            let at = row.y as usize * w;
+            for (x, id) in row.pixels.iter().enumerate() {
+                image.ids[at + x] = id.0;
+                image.depth[at + x] = match row.depth.get(x) {
+                    Some(q) => camera.eye_distance(*q).unwrap_or(f32::INFINITY),
+                    None if id.0 >= 0 => f32::NAN,
+                    None => f32::INFINITY,
+                };
+            }
+            Ok(())
+        });
+        render_with(
+            algorithm,
+            TriangleId::NONE,
             w,
             h,
-            |y, px, _| {
-                for (x, id) in px.iter().enumerate() {
-                    image.ids[y * w + x] = id.0;
-                }
-            },
+            &scene,
+            &options,
+            &mut sink,
         )?;
         Ok(FixedRender { image, stats })
     }
+}
+
+/// A hidden-surface method of the fixed-point pipeline, as `sim render --algorithm` names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Algorithm {
+    /// One row of depth ([`Workspace`]): the default.
+    SpanZBuffer,
+    /// Full-frame z-buffer ([`ZBufferWorkspace`]).
+    ZBuffer,
+    /// Z-buffer over bands of this many rows ([`BandWorkspace`]), one of [`BAND_CHOICES`].
+    Band(usize),
+    /// Painter's algorithm by mean depth ([`DepthSortWorkspace`]).
+    DepthSort,
+    /// Span sorting, no depth memory ([`SpanSortWorkspace`]).
+    SpanSort,
+}
+
+/// Band heights `band:N` accepts (the band is a compile-time capacity).
+pub const BAND_CHOICES: [usize; 8] = [1, 2, 4, 8, 16, 32, 64, 128];
+/// Largest target of the full-frame z-buffer in `sim` (its depth and pixels are W·H each).
+pub const ZBUFFER_MAX_SIZE: usize = 1024;
+
+impl Algorithm {
+    /// Every method `sim` offers (bands at 16 rows), for tables and tests.
+    pub const ALL: [Algorithm; 5] = [
+        Algorithm::SpanZBuffer,
+        Algorithm::ZBuffer,
+        Algorithm::Band(16),
+        Algorithm::DepthSort,
+        Algorithm::SpanSort,
+    ];
+
+    /// Whether the method is exact by design (all but the simple depth sort).
+    pub fn is_exact(self) -> bool {
+        self != Algorithm::DepthSort
+    }
+
+    fn max_size(self) -> usize {
+        match self {
+            Algorithm::ZBuffer => ZBUFFER_MAX_SIZE,
+            _ => MAX_SIZE,
+        }
+    }
+}
+
+impl std::fmt::Display for Algorithm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Algorithm::SpanZBuffer => write!(f, "span-zbuffer"),
+            Algorithm::ZBuffer => write!(f, "zbuffer"),
+            Algorithm::Band(n) => write!(f, "band:{n}"),
+            Algorithm::DepthSort => write!(f, "depth-sort"),
+            Algorithm::SpanSort => write!(f, "span-sort"),
+        }
+    }
+}
+
+impl std::str::FromStr for Algorithm {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let choices = "span-zbuffer, zbuffer, band:N (N in 1,2,4,...,128), depth-sort, span-sort, raycast (the f64 reference)";
+        match s {
+            "span-zbuffer" => Ok(Algorithm::SpanZBuffer),
+            "zbuffer" => Ok(Algorithm::ZBuffer),
+            "depth-sort" => Ok(Algorithm::DepthSort),
+            "span-sort" => Ok(Algorithm::SpanSort),
+            "newell" | "bsp" | "warnock" => Err(format!(
+                "'{s}' is not implemented yet; choose one of {choices}"
+            )),
+            _ => match s.strip_prefix("band:").map(str::parse::<usize>) {
+                Some(Ok(n)) if BAND_CHOICES.contains(&n) => Ok(Algorithm::Band(n)),
+                Some(_) => Err(format!("band height must be one of {BAND_CHOICES:?}")),
+                None => Err(format!("unknown algorithm '{s}'; choose one of {choices}")),
+            },
+        }
+    }
+}
+
+// Host capacities: up to 65534 triangles, 4096 crossing one row.
+const TRIS: usize = 65534;
+const ACTIVE: usize = 4096;
+
+/// Renders through the workspace of `algorithm` (built here, with host-sized capacities).
+fn render_with<P: RowPixel, const S: u32, K: RowSink<P>>(
+    algorithm: Algorithm,
+    background: P,
+    w: usize,
+    h: usize,
+    scene: &Scene<'_>,
+    options: &RenderOptions<S>,
+    sink: &mut K,
+) -> Result<FrameStats, String>
+where
+    K::Error: std::fmt::Debug,
+{
+    const M: usize = MAX_SIZE;
+    const Z: usize = ZBUFFER_MAX_SIZE;
+    macro_rules! with {
+        ($ws:ty) => {{
+            let mut ws: Box<$ws> = Box::new(<$ws>::new(background));
+            ws.render_sized(w, h, scene, options, sink)
+        }};
+    }
+    match algorithm {
+        Algorithm::SpanZBuffer => with!(Workspace<P, Flat, M, M, TRIS, ACTIVE>),
+        Algorithm::ZBuffer => with!(ZBufferWorkspace<P, Flat, Z, Z, TRIS>),
+        Algorithm::Band(1) => with!(BandWorkspace<P, Flat, M, M, 1, TRIS, ACTIVE>),
+        Algorithm::Band(2) => with!(BandWorkspace<P, Flat, M, M, 2, TRIS, ACTIVE>),
+        Algorithm::Band(4) => with!(BandWorkspace<P, Flat, M, M, 4, TRIS, ACTIVE>),
+        Algorithm::Band(8) => with!(BandWorkspace<P, Flat, M, M, 8, TRIS, ACTIVE>),
+        Algorithm::Band(16) => with!(BandWorkspace<P, Flat, M, M, 16, TRIS, ACTIVE>),
+        Algorithm::Band(32) => with!(BandWorkspace<P, Flat, M, M, 32, TRIS, ACTIVE>),
+        Algorithm::Band(64) => with!(BandWorkspace<P, Flat, M, M, 64, TRIS, ACTIVE>),
+        Algorithm::Band(128) => with!(BandWorkspace<P, Flat, M, M, 128, TRIS, ACTIVE>),
+        Algorithm::Band(n) => {
+            return Err(format!(
+                "band height must be one of {BAND_CHOICES:?}, not {n}"
+            ))
+        }
+        Algorithm::DepthSort => with!(DepthSortWorkspace<P, Flat, M, M, TRIS, ACTIVE>),
+        Algorithm::SpanSort => with!(SpanSortWorkspace<P, Flat, M, M, TRIS, ACTIVE>),
+    }
+    .map_err(|e| e.to_string())
 }
 
 /// An RGB image as an embedded-graphics `DrawTarget`: the colour pass reaches it through

@@ -173,3 +173,64 @@ fn committed_corpus_files_match_the_generator() {
         assert_eq!(corners(&loaded), corners(&scene.mesh), "{}", scene.name);
     }
 }
+
+#[test]
+fn every_algorithm_renders_the_same_ids_where_it_is_exact() {
+    let dir = scratch("algorithms");
+    let ids = |algorithm: &str| {
+        let file = format!("{}.ids", algorithm.replace(':', "-"));
+        let args = [
+            "render",
+            &corpus("interpenetrating"),
+            "--eye",
+            "0.3,0.2,4",
+            "--no-cull",
+            "--size",
+            "64x48",
+            "--ids",
+            &file,
+            "--algorithm",
+            algorithm,
+        ];
+        let (code, stdout, stderr) = sim(&args, &dir);
+        assert_eq!(code, 0, "{algorithm}: {stderr}");
+        if algorithm != "raycast" {
+            assert!(
+                stdout.contains(&format!("\"algorithm\": \"{algorithm}\"")),
+                "{stdout}"
+            );
+        }
+        std::fs::read(dir.join(file)).unwrap()
+    };
+    let span = ids("span-zbuffer");
+    for exact in ["zbuffer", "band:4", "span-sort"] {
+        assert_eq!(ids(exact), span, "{exact}");
+    }
+    // Depth sort draws the two crossing triangles in one order: wrong on one side.
+    assert_ne!(ids("depth-sort"), span);
+    assert_eq!(ids("raycast").len(), span.len());
+}
+
+#[test]
+fn unknown_or_unfinished_algorithms_are_one_line_errors() {
+    let dir = scratch("bad-algorithm");
+    for (bad, says) in [
+        ("painter", "unknown algorithm"),
+        ("band:3", "band height must be one of"),
+        ("warnock", "not implemented yet"),
+    ] {
+        let (code, _, stderr) = sim(
+            &[
+                "render",
+                &corpus("cube"),
+                "--algorithm",
+                bad,
+                "--size",
+                "8x8",
+            ],
+            &dir,
+        );
+        assert_eq!(code, 2, "{bad}: {stderr}");
+        assert!(stderr.contains(says), "{bad}: {stderr}");
+    }
+}
