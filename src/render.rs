@@ -267,7 +267,9 @@ pub(crate) trait Resolve<P: RowPixel, S: Shading> {
     /// The per-triangle sort key (`()` unless the method sorts by depth).
     type Key: SortKey;
     /// Rows resolved together: 1 for row-at-a-time methods, `B` for a band z-buffer.
-    fn band_rows(&self) -> usize;
+    fn band_rows(&self) -> usize {
+        1
+    }
     /// Starts rows `y0 .. y0 + rows`: everything background, nothing covered.
     fn begin_band(&mut self, y0: i32, rows: usize);
     /// Takes triangle `t`'s span on row `y`, columns `[l, r)` (on screen, non-empty); `order`
@@ -303,15 +305,12 @@ struct SpanZBuffer<'a, P> {
 
 impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanZBuffer<'_, P> {
     type Key = ();
-    fn band_rows(&self) -> usize {
-        1
-    }
     fn begin_band(&mut self, _: i32, _: usize) {
         self.depth.fill(Depth::ZERO);
         self.pixels.fill(self.background);
         self.spans = 0;
     }
-    #[inline]
+    #[inline(always)]
     fn span(&mut self, t: &ActiveTri<S::Payload<P>>, _: usize, y: i32, l: i32, r: i32) -> u32 {
         self.spans += 1;
         fill_span::<P, S, ()>(t, y, l, r, self.depth, self.pixels)
@@ -327,7 +326,7 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanZBuffer<'_, P> {
 }
 
 /// Depth-tests and writes `t`'s span `[l, r)` of row `y` into one row of depth and pixels.
-#[inline]
+#[inline(always)]
 pub(crate) fn fill_span<P: RowPixel, S: Shading, K>(
     t: &ActiveTri<S::Payload<P>, K>,
     y: i32,
@@ -761,7 +760,6 @@ pub(crate) fn drive<
 ) -> Result<FrameStats, RenderError<K::Error>> {
     let setups = setup_instances::<K::Error, INSTANCES>(scene)?;
     let mut stats = FrameStats::default();
-    let height = ws.heads.len();
     let width = vp.width as i32;
     let capacity = ws.refs.len().min(ws.next.len());
     let sorted = <R::Key as SortKey>::SORTED;
@@ -819,9 +817,89 @@ pub(crate) fn drive<
         });
     }
 
-    // Pass 2: bands of rows top to bottom (a band is one row except for band z-buffers).
+    // Pass 2: the rows, with pieces made by transforming the bucketed triangles again.
+    let pieces = MeshPieces {
+        setups: &setups,
+        refs: ws.refs,
+        keys: ws.keys,
+        vp,
+        cull: options.cull_back_faces,
+        clipping: core::marker::PhantomData::<C>,
+    };
+    walk_rows::<P, S, SUB, K, R>(
+        ws.heads, ws.next, ws.active, &pieces, resolve, width, sink, stats,
+    )
+}
+
+/// Where pass 2 gets the pieces of a bucket entry from.
+pub(crate) trait ActivePieces<const SUB: u32> {
+    /// Calls `f(vertices, face colour, triangle id, sort key)` for each screen piece of bucket
+    /// entry `entry` (a clipped triangle may have several).
+    fn each_piece<S: Shading>(
+        &self,
+        entry: usize,
+        f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    );
+}
+
+/// Pieces of mesh triangles, transformed, clipped and projected again on activation.
+struct MeshPieces<'a, 's, const SUB: u32, C> {
+    setups: &'a [InstanceSetup<'s>],
+    refs: &'a [u16],
+    keys: &'a [u32],
+    vp: &'a Viewport<SUB>,
+    cull: bool,
+    clipping: core::marker::PhantomData<C>,
+}
+
+impl<const SUB: u32, C: Clipping> ActivePieces<SUB> for MeshPieces<'_, '_, SUB, C> {
+    #[inline(always)]
+    fn each_piece<S: Shading>(
+        &self,
+        e: usize,
+        mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        let Some(&id) = self.refs.get(e) else { return };
+        let key = self.keys.get(e).copied().unwrap_or(0);
+        let Some((setup, tri)) = locate(self.setups, id as u32) else {
+            return;
+        };
+        let Some(&idx) = setup.instance.mesh.triangles().get(tri) else {
+            return;
+        };
+        let face = if S::PER_VERTEX {
+            Rgb888::new(0, 0, 0)
+        } else {
+            setup.face_color(tri, idx)
+        };
+        setup.screen_triangles::<SUB, C>(tri, self.vp, self.cull, S::PER_VERTEX, |s| {
+            f(s, face, id as u32, key)
+        });
+    }
+}
+
+/// Walks the rows top to bottom in bands (one row except for band z-buffers): activates each
+/// row's bucket through `pieces`, hands the active triangles' spans to `resolve` and the
+/// finished rows to `sink`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn walk_rows<
+    P: RowPixel,
+    S: Shading,
+    const SUB: u32,
+    K: RowSink<P>,
+    R: Resolve<P, S>,
+>(
+    heads: &[u16],
+    next: &[u16],
+    active: &mut VecView<ActiveTri<S::Payload<P>, R::Key>>,
+    pieces: &impl ActivePieces<SUB>,
+    resolve: &mut R,
+    width: i32,
+    sink: &mut K,
+    mut stats: FrameStats,
+) -> Result<FrameStats, RenderError<K::Error>> {
+    let height = heads.len();
     let band = resolve.band_rows().max(1);
-    let active = ws.active;
     active.clear();
     // Last row covered by any dropped piece so far: rows up to it are incomplete.
     let mut lost_until = -1i32;
@@ -840,77 +918,59 @@ pub(crate) fn drive<
         for row in y0..y1 {
             let y = row as i32;
             // Activate this row's bucket.
-            let mut entry = ws.heads.get(row).copied().unwrap_or(NO_ENTRY);
+            let mut entry = heads.get(row).copied().unwrap_or(NO_ENTRY);
             while entry != NO_ENTRY {
                 let e = entry as usize;
-                entry = ws.next.get(e).copied().unwrap_or(NO_ENTRY);
-                let Some(&id) = ws.refs.get(e) else { continue };
-                let key = R::Key::from_raw(ws.keys.get(e).copied().unwrap_or(0));
-                let Some((setup, tri)) = locate(&setups, id as u32) else {
-                    continue;
-                };
-                let Some(&idx) = setup.instance.mesh.triangles().get(tri) else {
-                    continue;
-                };
-                let face = if S::PER_VERTEX {
-                    Rgb888::new(0, 0, 0)
-                } else {
-                    setup.face_color(tri, idx)
-                };
-                setup.screen_triangles::<SUB, C>(
-                    tri,
-                    vp,
-                    options.cull_back_faces,
-                    S::PER_VERTEX,
-                    |s| {
-                        let (Some(walk), Some(solver)) = (
-                            TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32),
-                            PlaneSolver::new(&s),
-                        ) else {
-                            return;
-                        };
-                        let mut tri_state = ActiveTri {
-                            walk,
-                            depth: DepthPlane::new(&solver, &s),
-                            payload: S::payload::<P, SUB>(face, id as u32, &solver, &s),
-                            key,
-                        };
+                entry = next.get(e).copied().unwrap_or(NO_ENTRY);
+                pieces.each_piece::<S>(e, |s, face, id, key| {
+                    let (Some(walk), Some(solver)) = (
+                        TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32),
+                        PlaneSolver::new(&s),
+                    ) else {
+                        return;
+                    };
+                    let mut tri_state = ActiveTri {
+                        walk,
+                        depth: DepthPlane::new(&solver, &s),
+                        payload: S::payload::<P, SUB>(face, id, &solver, &s),
+                        key: R::Key::from_raw(key),
+                    };
+                    let (first_row, last_row) =
+                        (tri_state.walk.row(), tri_state.walk.end_row() - 1);
+                    let kept = if band > 1 {
+                        // Band z-buffer: draw it into the band now; keep it only if it reaches
+                        // the next band (so a full z-buffer keeps nothing).
+                        let order = active.len();
+                        !walk_band::<P, S, SUB, R>(
+                            &mut tri_state,
+                            order,
+                            y1 as i32,
+                            width,
+                            resolve,
+                            &mut stats,
+                        ) || active.push(tri_state).is_ok()
+                    } else if <R::Key as SortKey>::SORTED {
+                        insert_sorted(active, tri_state)
+                    } else {
+                        active.push(tri_state).is_ok()
+                    };
+                    if kept {
                         stats.activated += 1;
-                        let (first_row, last_row) =
-                            (tri_state.walk.row(), tri_state.walk.end_row() - 1);
-                        if band > 1 {
-                            // Band z-buffer: draw it into the band now; keep it only if it
-                            // reaches the next band (so a full z-buffer keeps nothing).
-                            let order = active.len();
-                            let alive = walk_band::<P, S, SUB, R>(
-                                &mut tri_state,
-                                order,
-                                y1 as i32,
-                                width,
-                                resolve,
-                                &mut stats,
-                            );
-                            if !alive || active.push(tri_state).is_ok() {
-                                return;
-                            }
-                        } else if insert(active, tri_state) {
-                            return;
-                        }
-                        // Degrade deterministically: this piece (or its rest) is lost,
-                        // everything else is drawn.
-                        stats.activated -= 1;
-                        let piece = DroppedPiece {
-                            triangle: id as u32,
-                            first_row: first_row as u16,
-                            last_row: last_row as u16,
-                        };
-                        if let Some(slot) = stats.dropped_pieces.get_mut(stats.dropped as usize) {
-                            *slot = Some(piece);
-                        }
-                        stats.dropped += 1;
-                        lost_until = lost_until.max(last_row);
-                    },
-                );
+                        return;
+                    }
+                    // Degrade deterministically: this piece (or its rest) is lost, everything
+                    // else is drawn.
+                    let piece = DroppedPiece {
+                        triangle: id,
+                        first_row: first_row as u16,
+                        last_row: last_row as u16,
+                    };
+                    if let Some(slot) = stats.dropped_pieces.get_mut(stats.dropped as usize) {
+                        *slot = Some(piece);
+                    }
+                    stats.dropped += 1;
+                    lost_until = lost_until.max(last_row);
+                });
             }
             if band == 1 {
                 stats.peak_active = stats.peak_active.max(active.len() as u16);
@@ -950,14 +1010,10 @@ pub(crate) fn drive<
     Ok(stats)
 }
 
-/// Puts a newly set-up triangle on the active list: at the end (activation order), or for
-/// depth sorting before the first nearer one, so the list stays sorted far to near and, among
-/// equal keys, the triangle activated first is drawn last and keeps the pixel (the same tie
-/// rule as the z-buffers). `false` if the list is full.
-fn insert<T, K: SortKey>(active: &mut VecView<ActiveTri<T, K>>, t: ActiveTri<T, K>) -> bool {
-    if !K::SORTED {
-        return active.push(t).is_ok();
-    }
+/// Puts a newly set-up triangle on a depth-sorted active list, before the first nearer one,
+/// so the list stays sorted far to near and, among equal keys, the triangle activated first is
+/// drawn last and keeps the pixel (the same tie rule as the z-buffers). `false` if it is full.
+fn insert_sorted<T, K: SortKey>(active: &mut VecView<ActiveTri<T, K>>, t: ActiveTri<T, K>) -> bool {
     let at = active
         .iter()
         .position(|a| a.key >= t.key)
@@ -967,7 +1023,7 @@ fn insert<T, K: SortKey>(active: &mut VecView<ActiveTri<T, K>>, t: ActiveTri<T, 
 
 /// Walks triangle `t` down to row `y1` (exclusive), handing each on-screen span to `resolve`.
 /// Returns whether the triangle continues below `y1`.
-#[inline]
+#[inline(always)]
 fn walk_band<P: RowPixel, S: Shading, const SUB: u32, R: Resolve<P, S>>(
     t: &mut ActiveTri<S::Payload<P>, R::Key>,
     order: usize,
@@ -976,8 +1032,11 @@ fn walk_band<P: RowPixel, S: Shading, const SUB: u32, R: Resolve<P, S>>(
     resolve: &mut R,
     stats: &mut FrameStats,
 ) -> bool {
-    while t.walk.row() < y1 {
+    loop {
         let y = t.walk.row();
+        if y >= y1 {
+            return true; // (a clipped piece may start below the band)
+        }
         let (l, r) = t.walk.span();
         let (l, r) = (l.max(0), r.min(width));
         if l < r {
@@ -988,5 +1047,4 @@ fn walk_band<P: RowPixel, S: Shading, const SUB: u32, R: Resolve<P, S>>(
             return false;
         }
     }
-    true
 }

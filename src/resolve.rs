@@ -314,9 +314,6 @@ struct SpanSort<'a, P, T> {
 
 impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanSort<'_, P, S::Payload<P>> {
     type Key = ();
-    fn band_rows(&self) -> usize {
-        1
-    }
     fn begin_band(&mut self, _: i32, _: usize) {
         self.pixels.fill(self.background);
         self.spans.clear();
@@ -542,9 +539,6 @@ struct Painter<'a, P> {
 
 impl<P: RowPixel, S: Shading> Resolve<P, S> for Painter<'_, P> {
     type Key = u32;
-    fn band_rows(&self) -> usize {
-        1
-    }
     fn begin_band(&mut self, _: i32, _: usize) {
         self.pixels.fill(self.background);
         self.spans = 0;
