@@ -172,6 +172,8 @@ pub enum CapacityKind {
     Triangles,
     /// The workspace's `INSTANCES` (default [`MAX_INSTANCES`]): mesh instances in the scene.
     Instances,
+    /// Screen triangles kept for a whole-frame method (clipped pieces count one each).
+    Pieces,
 }
 
 /// Why a frame could not be rendered.
@@ -1047,4 +1049,53 @@ fn walk_band<P: RowPixel, S: Shading, const SUB: u32, R: Resolve<P, S>>(
             return false;
         }
     }
+}
+
+/// Transforms, clips, projects and culls every triangle of `scene` (lit per vertex if `S`
+/// needs it) and calls `f(vertices, face colour, id)` for each visible screen piece, in id
+/// order: the set-up of whole-frame methods, which keep every piece.
+#[allow(dead_code)] // (used by the whole-frame methods of the next commits)
+pub(crate) fn for_each_screen_piece<
+    S: Shading,
+    const SUB: u32,
+    C: Clipping,
+    E,
+    const INSTANCES: usize,
+>(
+    scene: &Scene<'_>,
+    options: &RenderOptions<SUB, C>,
+    vp: &Viewport<SUB>,
+    mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32),
+) -> Result<FrameStats, RenderError<E>> {
+    let setups = setup_instances::<E, INSTANCES>(scene)?;
+    let mut stats = FrameStats::default();
+    for setup in &setups {
+        let triangles = setup.instance.mesh.triangles();
+        stats.triangles_in += triangles.len() as u32;
+        for (tri, &idx) in triangles.iter().enumerate() {
+            let id = setup.first_id + tri as u32;
+            let face = if S::PER_VERTEX {
+                Rgb888::new(0, 0, 0)
+            } else {
+                setup.face_color(tri, idx)
+            };
+            let fate = setup.screen_triangles::<SUB, C>(
+                tri,
+                vp,
+                options.cull_back_faces,
+                S::PER_VERTEX,
+                |s| f(s, face, id),
+            );
+            match fate {
+                Fate::Culled => stats.culled += 1,
+                Fate::Rejected => stats.rejected += 1,
+                Fate::Unclipped => stats.unclipped += 1,
+                Fate::Visible { clipped, .. } => {
+                    stats.clipped += clipped as u32;
+                    stats.bucketed += 1;
+                }
+            }
+        }
+    }
+    Ok(stats)
 }

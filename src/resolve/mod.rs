@@ -34,6 +34,8 @@ use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
 use heapless::{Vec, VecView};
 
+pub mod store;
+
 /// Compile-time checks shared by the workspaces.
 const fn check_sizes(w: usize, h: usize, tris: usize) {
     assert!(
