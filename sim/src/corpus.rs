@@ -53,7 +53,7 @@ pub fn icosphere(n: u32) -> MeshData {
 
 /// An `n × n` grid of quads over [-4, 4]² with smooth hills, facing +y.
 fn heightfield(n: usize) -> MeshData {
-    from_shape(meshgen::grid(n, 4.0, |x, z| {
+    from_shape(meshgen::grid([n, n], [4.0, 4.0], |x, z| {
         0.6 * (0.9 * x).sin() * (0.7 * z).cos() + 0.25 * (2.3 * x + 1.1 * z).sin()
     }))
 }

@@ -14,6 +14,8 @@ pub mod export;
 #[cfg(not(target_os = "none"))]
 pub mod fuzz;
 #[cfg(not(target_os = "none"))]
+pub mod hsr;
+#[cfg(not(target_os = "none"))]
 pub mod meshgen;
 #[cfg(not(target_os = "none"))]
 pub mod metrics;

@@ -101,23 +101,106 @@ pub fn cube() -> Shape {
     (v, f)
 }
 
-/// An `n × n` grid of quads over [−half, half]² in the x-z plane, facing +y, with heights
-/// `height(x, z)`; two triangles per quad, row by row.
-pub fn grid(n: usize, half: f64, height: impl Fn(f64, f64) -> f64) -> Shape {
+/// An `n[0] × n[1]` grid of quads over [−half[0], half[0]] × [−half[1], half[1]] in the x-z
+/// plane, facing +y, with heights `height(x, z)`; two triangles per quad, row by row.
+pub fn grid(n: [usize; 2], half: [f64; 2], height: impl Fn(f64, f64) -> f64) -> Shape {
+    let s = |k: usize, axis: usize| -half[axis] + 2.0 * half[axis] * k as f64 / n[axis] as f64;
     let mut v = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let s = |k: usize| -half + 2.0 * half * k as f64 / n as f64;
-            v.push([s(i), height(s(i), s(j)), s(j)]);
+    for j in 0..=n[1] {
+        for i in 0..=n[0] {
+            v.push([s(i, 0), height(s(i, 0), s(j, 1)), s(j, 1)]);
         }
     }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u16;
+    let id = |i: usize, j: usize| (j * (n[0] + 1) + i) as u16;
     let mut f = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
+    for j in 0..n[1] {
+        for i in 0..n[0] {
             f.push([id(i, j), id(i, j + 1), id(i + 1, j + 1)]);
             f.push([id(i, j), id(i + 1, j + 1), id(i + 1, j)]);
         }
     }
     (v, f)
+}
+
+/// Torus around the z axis: `n` segments around the ring of radius `major`, `m` around the tube
+/// of radius `minor`; `2·n·m` triangles on `n·m` vertices.
+pub fn torus(n: usize, m: usize, major: f64, minor: f64) -> Shape {
+    use std::f64::consts::TAU;
+    let mut v = Vec::with_capacity(n * m);
+    for i in 0..n {
+        let u = TAU * i as f64 / n as f64;
+        for j in 0..m {
+            let w = TAU * j as f64 / m as f64;
+            let r = major + minor * w.cos();
+            v.push([r * u.cos(), r * u.sin(), minor * w.sin()]);
+        }
+    }
+    let id = |i: usize, j: usize| ((i % n) * m + j % m) as u16;
+    let mut f = Vec::with_capacity(2 * n * m);
+    for i in 0..n {
+        for j in 0..m {
+            // Stepping i then j turns counter-clockwise seen from outside the tube.
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            f.extend([[a, b, c], [a, c, d]]);
+        }
+    }
+    (v, f)
+}
+
+/// Rotates `shape` by `angle` radians about the x axis, then about the y axis by `yaw`, then
+/// moves it by `offset` (a proper rotation, so faces keep their orientation).
+fn place(shape: Shape, angle: f64, yaw: f64, offset: [f64; 3]) -> Shape {
+    let (v, f) = shape;
+    let (sa, ca, sy, cy) = (angle.sin(), angle.cos(), yaw.sin(), yaw.cos());
+    let v = v
+        .into_iter()
+        .map(|[x, y, z]| {
+            let (y, z) = (ca * y - sa * z, sa * y + ca * z);
+            let (x, z) = (cy * x + sy * z, -sy * x + cy * z);
+            [x + offset[0], y + offset[1], z + offset[2]]
+        })
+        .collect();
+    (v, f)
+}
+
+/// Polygon counts of the hidden-surface test scenes, as in the lecture's table (Sutherland,
+/// Sproull and Schumacker 1974): the same scene, tessellated ever finer.
+pub const HSR_POLYGONS: [usize; 3] = [100, 2500, 60_000];
+
+/// Tessellation per level: torus (ring segments, tube segments) and ground (cells in x, z),
+/// chosen so that 3 tori + ground have exactly [`HSR_POLYGONS`] triangles, half or more of them
+/// on the tori.
+const HSR_TESSELLATION: [([usize; 2], [usize; 2]); 3] = [
+    ([4, 3], [2, 7]),
+    ([20, 10], [25, 26]),
+    ([100, 50], [120, 125]),
+];
+
+/// An object of a hidden-surface test scene: world-space shape and RGB colour.
+pub type HsrObject = (Shape, [u8; 3]);
+
+/// The hidden-surface test scene at `level` (0, 1, 2: [`HSR_POLYGONS`] triangles): a chain of
+/// three tori (lying, standing, lying) receding from the camera over a ground plane that the
+/// standing one sinks into. Surfaces hide each other, pass through each other's holes and
+/// intersect the ground.
+pub fn hsr_scene(level: usize) -> Vec<HsrObject> {
+    let ([n, m], cells) = HSR_TESSELLATION[level];
+    let (major, minor, yaw) = (1.0, 0.28, 0.75f64);
+    // Each ring passes through its neighbours' centres, one radius apart along the chain.
+    let step = [major * yaw.cos(), 0.0, -major * yaw.sin()];
+    let centre = |k: f64| [-1.0 + k * step[0], -0.35, 0.5 + k * step[2]];
+    let lying = -std::f64::consts::FRAC_PI_2;
+    let ring = |angle, k| place(torus(n, m, major, minor), angle, yaw, centre(k));
+    vec![
+        (ring(lying, 0.0), [230, 150, 60]),
+        (ring(0.0, 1.0), [70, 170, 210]),
+        (ring(lying, 2.0), [200, 90, 160]),
+        (grid(cells, [4.0, 4.0], |_, _| -1.5), [170, 170, 160]),
+    ]
+}
+
+/// I16F16 bits of `v`, rounded to nearest (how generated firmware data and host scenes both
+/// convert, so they hold identical vertices).
+pub fn fixed_bits(v: f64) -> i32 {
+    (v * 65536.0).round() as i32
 }

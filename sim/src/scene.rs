@@ -337,6 +337,59 @@ impl SceneSpec {
         })
     }
 
+    /// The hidden-surface test scene at `level` ([`crate::hsr`]), with vertices rounded exactly
+    /// as `build.rs` rounds the firmware's copy ([`crate::meshgen::fixed_bits`]).
+    pub fn hsr(level: usize) -> Result<Self, String> {
+        let instances = crate::meshgen::hsr_scene(level)
+            .into_iter()
+            .map(|((v, triangles), [r, g, b])| MeshInstance {
+                mesh: MeshData {
+                    vertices: v
+                        .iter()
+                        .map(|p| p.map(|c| I16F16::from_bits(crate::meshgen::fixed_bits(c))))
+                        .collect(),
+                    colors: vec![Rgb888::new(r, g, b); triangles.len()],
+                    triangles,
+                },
+                transform: Transform::IDENTITY,
+            })
+            .collect();
+        let (eye, target, up, fovy, near, far) = crate::hsr::CAMERA;
+        let f = |v: [f32; 3]| v.map(f64::from);
+        let (dir, ambient, diffuse) = scanline3d::demo::LIGHT;
+        Ok(SceneSpec {
+            instances,
+            camera: CameraSpec {
+                eye: f(eye),
+                target: f(target),
+                up: f(up),
+                fovy: fovy as f64,
+                near: near as f64,
+                far: far as f64,
+            },
+            light: LightSpec {
+                direction: f(dir),
+                ambient: ambient as f64,
+                diffuse: diffuse as f64,
+            },
+            cull_back_faces: true,
+        })
+    }
+
+    /// Calls `f` with this scene as the library sees it (for rendering it through any
+    /// workspace). The camera and light are built from the specs as [`Self::render_fixed`]
+    /// builds them.
+    pub fn with_scene<R>(&self, f: impl FnOnce(&Scene<'_>) -> R) -> Result<R, String> {
+        let meshes = self.meshes()?;
+        let instances = self.library_instances(&meshes);
+        let scene = Scene {
+            instances: &instances,
+            camera: self.camera.fixed()?,
+            light: self.light.fixed()?,
+        };
+        Ok(f(&scene))
+    }
+
     /// Largest |model coordinate| over all meshes.
     pub fn max_model_coord(&self) -> f64 {
         self.instances

@@ -1,0 +1,169 @@
+//! The hidden-surface comparison behind `docs/hsr-table.md` (`cargo xtask hsr-table`): the
+//! scene parameters and the list of methods, in one place for the firmware
+//! (`examples/hsr_table.rs` includes this file with `#[path]`, so it is `no_std`: `core` and the
+//! library only), the bench (`benches/hsr.rs`) and xtask.
+//!
+//! The scenes are [`crate::meshgen::hsr_scene`] at each level: the same objects tessellated
+//! into 100, 2,500 and 60,000 triangles, seen at 240×240 with flat shading, 4 sub-pixel bits
+//! and back-face culling, into RGB565 on black.
+//!
+//! Adding a method takes two lines here: a [`method!`] declaration and a line in
+//! [`for_each`].
+
+use scanline3d::render::{FrameStats, RenderError, RenderOptions};
+use scanline3d::scene::{Camera, Instance, Light, Mesh, Scene, SceneError, Transform};
+use scanline3d::sink::{RowPixel, RowSink};
+use scanline3d::Flat;
+
+/// Target width.
+pub const WIDTH: usize = 240;
+/// Target height.
+pub const HEIGHT: usize = 240;
+/// Mesh instances per scene: three tori and the ground.
+pub const INSTANCES: usize = 4;
+
+/// One scene size and the capacities its frame needs.
+pub struct Level {
+    /// Triangles in the scene.
+    pub polygons: usize,
+    /// Triangles that survive culling and clipping (the span z-buffer's `TRIS`), as measured.
+    pub tris: usize,
+    /// Triangles crossing one row at most (the span z-buffer's `ACTIVE`), as measured.
+    pub active: usize,
+}
+
+/// The three sizes of the lecture's table. The capacities are what the span z-buffer's frame
+/// needed (`FrameStats::bucketed`, `peak_active`); `cargo xtask hsr-table` fails if a frame
+/// does not fit.
+pub const LEVELS: [Level; 3] = [
+    Level {
+        polygons: 100,
+        tris: 60,
+        active: 23,
+    },
+    Level {
+        polygons: 2500,
+        tris: 1309,
+        active: 106,
+    },
+    Level {
+        polygons: 60_000,
+        tris: 29_476,
+        active: 495,
+    },
+];
+
+/// Camera: eye, target, up, vertical field of view in degrees, near, far.
+pub const CAMERA: ([f32; 3], [f32; 3], [f32; 3], f32, f32, f32) = (
+    [-1.3, 2.7, 3.5],
+    [-0.1, -0.75, -0.3],
+    [0.0, 1.0, 0.0],
+    50.0,
+    0.5,
+    20.0,
+);
+
+/// The scenes' camera.
+pub fn camera() -> Result<Camera, SceneError> {
+    let (eye, target, up, fovy, near, far) = CAMERA;
+    Camera::look_at(eye, target, up)?.perspective(fovy, near, far)
+}
+
+/// The demo's light.
+pub fn light() -> Result<Light, SceneError> {
+    scanline3d::demo::light()
+}
+
+/// The scene's instances over `meshes` (in [`crate::meshgen::hsr_scene`] order, already in
+/// world coordinates).
+pub fn instances<'a>(meshes: &'a [Mesh<'a>; INSTANCES]) -> [Instance<'a>; INSTANCES] {
+    meshes.each_ref().map(|mesh| Instance {
+        mesh,
+        transform: Transform::IDENTITY,
+    })
+}
+
+/// The scene over `instances`.
+pub fn scene<'a>(instances: &'a [Instance<'a>]) -> Result<Scene<'a>, SceneError> {
+    Ok(Scene {
+        instances,
+        camera: camera()?,
+        light: light()?,
+    })
+}
+
+/// A method's workspace for pixels `P`, as the measurements use it.
+pub trait Resolve<P: RowPixel>: Sized {
+    /// The workspace's size in bytes.
+    const BYTES: usize;
+    /// An empty workspace with background `background`.
+    fn new(background: P) -> Self;
+    /// Renders `scene` with the table's options (default: 4 sub-pixel bits, culling on).
+    fn frame<K: RowSink<P>>(
+        &mut self,
+        scene: &Scene<'_>,
+        sink: &mut K,
+    ) -> Result<FrameStats, RenderError<K::Error>>;
+}
+
+/// A hidden-surface method: its name in the table and its workspace for pixel type `P` and a
+/// level's capacities.
+pub trait Method {
+    /// Name in the table.
+    const NAME: &'static str;
+    /// The workspace.
+    type Ws<P: RowPixel, const TRIS: usize, const ACTIVE: usize>: Resolve<P>;
+}
+
+/// Declares a method: `method!(Marker, "name", <P, TRIS, ACTIVE> WorkspaceType)`, where the
+/// workspace type may use `P`, `TRIS` and `ACTIVE` and has the library's workspace API
+/// (`new(background)`, `render(&scene, &options, &mut sink)`, `BYTES`).
+macro_rules! method {
+    ($marker:ident, $name:literal, <$p:ident, $t:ident, $a:ident> $ws:ty) => {
+        #[doc = concat!("The `", $name, "` method.")]
+        pub struct $marker;
+        impl Method for $marker {
+            const NAME: &'static str = $name;
+            type Ws<$p: RowPixel, const $t: usize, const $a: usize> = $ws;
+        }
+        impl<$p: RowPixel, const $t: usize, const $a: usize> Resolve<$p> for $ws {
+            const BYTES: usize = <$ws>::BYTES;
+            fn new(background: $p) -> Self {
+                <$ws>::new(background)
+            }
+            fn frame<K: RowSink<$p>>(
+                &mut self,
+                scene: &Scene<'_>,
+                sink: &mut K,
+            ) -> Result<FrameStats, RenderError<K::Error>> {
+                self.render(scene, &RenderOptions::default(), sink)
+            }
+        }
+    };
+}
+
+method!(SpanZBuffer, "span-zbuffer", <P, TRIS, ACTIVE>
+    scanline3d::Workspace<P, Flat, WIDTH, HEIGHT, TRIS, ACTIVE, INSTANCES>);
+
+/// Work done for each (method, level): `visit` gets the method and the level's capacities.
+pub trait Visit {
+    /// Why a visit failed.
+    type Error;
+    /// Measures method `M` at level `level` (an index into [`LEVELS`]).
+    fn visit<M: Method, const TRIS: usize, const ACTIVE: usize>(
+        &mut self,
+        level: usize,
+    ) -> Result<(), Self::Error>;
+}
+
+/// Visits every method at every level, in table order; stops at the first error.
+pub fn for_each<V: Visit>(v: &mut V) -> Result<(), V::Error> {
+    levels::<SpanZBuffer, V>(v)?;
+    Ok(())
+}
+
+fn levels<M: Method, V: Visit>(v: &mut V) -> Result<(), V::Error> {
+    v.visit::<M, { LEVELS[0].tris }, { LEVELS[0].active }>(0)?;
+    v.visit::<M, { LEVELS[1].tris }, { LEVELS[1].active }>(1)?;
+    v.visit::<M, { LEVELS[2].tris }, { LEVELS[2].active }>(2)
+}
