@@ -1016,10 +1016,7 @@ pub(crate) fn walk_rows<
 /// so the list stays sorted far to near and, among equal keys, the triangle activated first is
 /// drawn last and keeps the pixel (the same tie rule as the z-buffers). `false` if it is full.
 fn insert_sorted<T, K: SortKey>(active: &mut VecView<ActiveTri<T, K>>, t: ActiveTri<T, K>) -> bool {
-    let at = active
-        .iter()
-        .position(|a| a.key >= t.key)
-        .unwrap_or(active.len());
+    let at = active.partition_point(|a| a.key < t.key);
     active.insert(at, t).is_ok()
 }
 

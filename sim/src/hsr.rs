@@ -120,30 +120,56 @@ pub trait Method {
 /// (`new(background)`, `render(&scene, &options, &mut sink)`, `BYTES`).
 macro_rules! method {
     ($marker:ident, $name:literal, <$p:ident, $t:ident, $a:ident> $ws:ty) => {
+        method!(@ $marker, $name, <$p, $t, $a> [$p, $t, $a] $ws);
+    };
+    // A workspace without an active list (the full-frame z-buffer) ignores `ACTIVE`.
+    ($marker:ident, $name:literal, <$p:ident, $t:ident, _> $ws:ty) => {
+        method!(@ $marker, $name, <$p, $t, ACTIVE> [$p, $t] $ws);
+    };
+    (@ $marker:ident, $name:literal, <$p:ident, $t:ident, $a:ident> [$($g:ident),*] $ws:ty) => {
         #[doc = concat!("The `", $name, "` method.")]
         pub struct $marker;
         impl Method for $marker {
             const NAME: &'static str = $name;
             type Ws<$p: RowPixel, const $t: usize, const $a: usize> = $ws;
         }
+        method!(@impl [$($g),*] $ws);
+    };
+    (@impl [$p:ident, $t:ident, $a:ident] $ws:ty) => {
         impl<$p: RowPixel, const $t: usize, const $a: usize> Resolve<$p> for $ws {
-            const BYTES: usize = <$ws>::BYTES;
-            fn new(background: $p) -> Self {
-                <$ws>::new(background)
-            }
-            fn frame<K: RowSink<$p>>(
-                &mut self,
-                scene: &Scene<'_>,
-                sink: &mut K,
-            ) -> Result<FrameStats, RenderError<K::Error>> {
-                self.render(scene, &RenderOptions::default(), sink)
-            }
+            method!(@body $p, $ws);
+        }
+    };
+    (@impl [$p:ident, $t:ident] $ws:ty) => {
+        impl<$p: RowPixel, const $t: usize> Resolve<$p> for $ws {
+            method!(@body $p, $ws);
+        }
+    };
+    (@body $p:ident, $ws:ty) => {
+        const BYTES: usize = <$ws>::BYTES;
+        fn new(background: $p) -> Self {
+            <$ws>::new(background)
+        }
+        fn frame<K: RowSink<$p>>(
+            &mut self,
+            scene: &Scene<'_>,
+            sink: &mut K,
+        ) -> Result<FrameStats, RenderError<K::Error>> {
+            self.render(scene, &RenderOptions::default(), sink)
         }
     };
 }
 
 method!(SpanZBuffer, "span-zbuffer", <P, TRIS, ACTIVE>
     scanline3d::Workspace<P, Flat, WIDTH, HEIGHT, TRIS, ACTIVE, INSTANCES>);
+method!(ZBuffer, "zbuffer", <P, TRIS, _>
+    scanline3d::resolve::ZBufferWorkspace<P, Flat, WIDTH, HEIGHT, TRIS, INSTANCES>);
+method!(Band16, "band:16", <P, TRIS, ACTIVE>
+    scanline3d::resolve::BandWorkspace<P, Flat, WIDTH, HEIGHT, 16, TRIS, ACTIVE, INSTANCES>);
+method!(SpanSort, "span-sort", <P, TRIS, ACTIVE>
+    scanline3d::resolve::SpanSortWorkspace<P, Flat, WIDTH, HEIGHT, TRIS, ACTIVE, INSTANCES>);
+method!(DepthSort, "depth-sort", <P, TRIS, ACTIVE>
+    scanline3d::resolve::DepthSortWorkspace<P, Flat, WIDTH, HEIGHT, TRIS, ACTIVE, INSTANCES>);
 
 /// Work done for each (method, level): `visit` gets the method and the level's capacities.
 pub trait Visit {
@@ -159,6 +185,10 @@ pub trait Visit {
 /// Visits every method at every level, in table order; stops at the first error.
 pub fn for_each<V: Visit>(v: &mut V) -> Result<(), V::Error> {
     levels::<SpanZBuffer, V>(v)?;
+    levels::<ZBuffer, V>(v)?;
+    levels::<Band16, V>(v)?;
+    levels::<SpanSort, V>(v)?;
+    levels::<DepthSort, V>(v)?;
     Ok(())
 }
 
