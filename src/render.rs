@@ -174,6 +174,9 @@ pub enum CapacityKind {
     Instances,
     /// Screen triangles kept for a whole-frame method (clipped pieces count one each).
     Pieces,
+    /// The traversal stack of a BSP tree (`STACK` of a
+    /// [`BspWorkspace`](crate::resolve::bsp::BspWorkspace)).
+    BspStack,
 }
 
 /// Why a frame could not be rendered.
@@ -189,6 +192,9 @@ pub enum RenderError<E> {
         /// What was wrong.
         error: TransformError,
     },
+    /// The BSP tree was built for another mesh, or the scene does not have exactly one
+    /// instance (its mesh) for it.
+    TreeMismatch,
     /// A capacity was exceeded before any row was sent (the sink received nothing).
     Capacity {
         /// Which buffer.
@@ -227,6 +233,7 @@ impl<E: core::fmt::Debug> core::fmt::Display for RenderError<E> {
                 )
             }
             Self::Sink { row, error } => write!(f, "sink failed on row {row}: {error:?}"),
+            Self::TreeMismatch => write!(f, "the BSP tree does not match the scene's mesh"),
         }
     }
 }
@@ -579,12 +586,20 @@ impl<
             background: self.background,
             spans: 0,
         };
-        drive::<P, S, SUB_BITS, C, K, INSTANCES, _>(frame, &mut resolve, scene, options, &vp, sink)
+        drive::<P, S, SUB_BITS, C, K, INSTANCES, _>(
+            frame,
+            &mut resolve,
+            &mut IdOrder,
+            scene,
+            options,
+            &vp,
+            sink,
+        )
     }
 }
 
 /// Per-instance constants for one frame.
-struct InstanceSetup<'a> {
+pub(crate) struct InstanceSetup<'a> {
     instance: &'a Instance<'a>,
     mv: ModelView,
     lighting: Lighting,
@@ -742,6 +757,36 @@ fn locate<'s, 'a>(
         .map(|s| (s, (id - s.first_id) as usize))
 }
 
+/// The order in which pass 1 visits the scene's triangles.
+pub(crate) trait TriangleOrder {
+    /// Calls `f(instance, triangle, rank)` for every triangle to draw; `rank` is its place in a
+    /// far-to-near drawing order, if this order is one.
+    fn visit<'s, E>(
+        &mut self,
+        setups: &[InstanceSetup<'s>],
+        f: impl FnMut(&InstanceSetup<'s>, usize, Option<u32>),
+    ) -> Result<(), RenderError<E>>;
+}
+
+/// Every triangle of every instance, in reverse id order.
+pub(crate) struct IdOrder;
+
+impl TriangleOrder for IdOrder {
+    #[inline(always)]
+    fn visit<'s, E>(
+        &mut self,
+        setups: &[InstanceSetup<'s>],
+        mut f: impl FnMut(&InstanceSetup<'s>, usize, Option<u32>),
+    ) -> Result<(), RenderError<E>> {
+        for setup in setups.iter().rev() {
+            for tri in (0..setup.instance.mesh.triangles().len()).rev() {
+                f(setup, tri, None);
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Renders one frame: pass 1 files triangles in row buckets, pass 2 walks the rows band by band,
 /// handing spans to `resolve` and finished rows to `sink`.
 pub(crate) fn drive<
@@ -755,6 +800,7 @@ pub(crate) fn drive<
 >(
     ws: Frame<'_, S::Payload<P>, R::Key>,
     resolve: &mut R,
+    order: &mut impl TriangleOrder,
     scene: &Scene<'_>,
     options: &RenderOptions<SUB, C>,
     vp: &Viewport<SUB>,
@@ -766,51 +812,50 @@ pub(crate) fn drive<
     let capacity = ws.refs.len().min(ws.next.len());
     let sorted = <R::Key as SortKey>::SORTED;
 
-    // Pass 1: file every visible triangle under its first row. Iterating in reverse and pushing
-    // at the head leaves each row's list in ascending id order. Depth sorting also keeps a key
-    // per triangle: the mean depth of its (clipped) vertices, larger = nearer.
+    // Pass 1: file every visible triangle under its first row, in the order `order` gives
+    // (reverse id order, which leaves each row's list in ascending id order, as pushing is at
+    // the head). Depth sorting also keeps a key per triangle: its rank in `order` if that is a
+    // drawing order (BSP), else the mean depth of its (clipped) vertices, larger = nearer.
     ws.heads.fill(NO_ENTRY);
     let mut filed = 0usize;
-    for setup in setups.iter().rev() {
-        let n = setup.instance.mesh.triangles().len();
-        stats.triangles_in += n as u32;
-        for tri in (0..n).rev() {
-            let (mut q_sum, mut q_count) = (0u64, 0u64);
-            let fate =
-                setup.screen_triangles::<SUB, C>(tri, vp, options.cull_back_faces, false, |s| {
-                    if sorted {
-                        q_sum += s.iter().map(|v| v.q.to_bits().max(0) as u64).sum::<u64>();
-                        q_count += 3;
+    for setup in &setups {
+        stats.triangles_in += setup.instance.mesh.triangles().len() as u32;
+    }
+    order.visit(&setups, |setup, tri, rank| {
+        let (mut q_sum, mut q_count) = (0u64, 0u64);
+        let fate = setup.screen_triangles::<SUB, C>(tri, vp, options.cull_back_faces, false, |s| {
+            if sorted && rank.is_none() {
+                q_sum += s.iter().map(|v| v.q.to_bits().max(0) as u64).sum::<u64>();
+                q_count += 3;
+            }
+        });
+        match fate {
+            Fate::Culled => stats.culled += 1,
+            Fate::Rejected => stats.rejected += 1,
+            Fate::Unclipped => stats.unclipped += 1,
+            Fate::Visible { first_row, clipped } => {
+                stats.clipped += clipped as u32;
+                stats.bucketed += 1;
+                if filed < capacity {
+                    let id = setup.first_id + tri as u32;
+                    let row = first_row as usize;
+                    if let (Some(head), Some(next), Some(r)) = (
+                        ws.heads.get_mut(row),
+                        ws.next.get_mut(filed),
+                        ws.refs.get_mut(filed),
+                    ) {
+                        *r = id as u16;
+                        *next = *head;
+                        *head = filed as u16;
                     }
-                });
-            match fate {
-                Fate::Culled => stats.culled += 1,
-                Fate::Rejected => stats.rejected += 1,
-                Fate::Unclipped => stats.unclipped += 1,
-                Fate::Visible { first_row, clipped } => {
-                    stats.clipped += clipped as u32;
-                    stats.bucketed += 1;
-                    if filed < capacity {
-                        let id = setup.first_id + tri as u32;
-                        let row = first_row as usize;
-                        if let (Some(head), Some(next), Some(r)) = (
-                            ws.heads.get_mut(row),
-                            ws.next.get_mut(filed),
-                            ws.refs.get_mut(filed),
-                        ) {
-                            *r = id as u16;
-                            *next = *head;
-                            *head = filed as u16;
-                        }
-                        if let Some(k) = ws.keys.get_mut(filed) {
-                            *k = (q_sum / q_count.max(1)) as u32;
-                        }
+                    if let Some(k) = ws.keys.get_mut(filed) {
+                        *k = rank.unwrap_or((q_sum / q_count.max(1)) as u32);
                     }
-                    filed += 1;
                 }
+                filed += 1;
             }
         }
-    }
+    })?;
     if filed > capacity {
         return Err(RenderError::Capacity {
             what: CapacityKind::Triangles,

@@ -8,6 +8,8 @@
 #[cfg(not(target_os = "none"))]
 pub mod analyze;
 #[cfg(not(target_os = "none"))]
+pub mod bsp;
+#[cfg(not(target_os = "none"))]
 pub mod corpus;
 #[cfg(not(target_os = "none"))]
 pub mod export;

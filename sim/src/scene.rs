@@ -4,6 +4,7 @@
 use crate::reference::{self, Image};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::I16F16;
+use scanline3d::resolve::bsp::{BspTree, BspWorkspace};
 use scanline3d::resolve::{BandWorkspace, DepthSortWorkspace, SpanSortWorkspace, ZBufferWorkspace};
 use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
 use scanline3d::sink::{FnSink, Row, RowPixel, RowSink, TriangleId};
@@ -535,7 +536,27 @@ impl SceneSpec {
                 "size {w}x{h} outside 1x1..{max}x{max} for {algorithm}"
             ));
         }
-        let meshes = self.meshes()?;
+        // BSP order renders the split mesh of a tree built here, then maps ids back.
+        let bsp = match algorithm {
+            Algorithm::Bsp => {
+                let [instance] = self.instances.as_slice() else {
+                    return Err("bsp renders scenes of one mesh".into());
+                };
+                Some(crate::bsp::build(&instance.mesh)?)
+            }
+            _ => None,
+        };
+        let tree = match &bsp {
+            Some(b) => Some(
+                BspTree::new(&b.nodes, b.mesh.triangles.len())
+                    .map_err(|e| format!("BSP tree: {e:?}"))?,
+            ),
+            None => None,
+        };
+        let meshes = match &bsp {
+            Some(b) => vec![b.mesh.mesh()?],
+            None => self.meshes()?,
+        };
         let instances = self.library_instances(&meshes);
         let camera = self.camera.fixed()?;
         let scene = Scene {
@@ -563,7 +584,16 @@ impl SceneSpec {
             let mut sink = FnSink(|row: Row<'_, Rgb888>| {
                 scanline3d::sink::RowSink::write_row(&mut display, row)
             });
-            render_with(algorithm, Rgb888::BLACK, w, h, &scene, &options, &mut sink)?
+            render_with(
+                algorithm,
+                tree.as_ref(),
+                Rgb888::BLACK,
+                w,
+                h,
+                &scene,
+                &options,
+                &mut sink,
+            )?
         };
         image.color = target.pixels;
         // The id pass also records depth (NaN over surfaces where the method keeps none).
@@ -581,6 +611,7 @@ impl SceneSpec {
         });
         render_with(
             algorithm,
+            tree.as_ref(),
             TriangleId::NONE,
             w,
             h,
@@ -588,6 +619,11 @@ impl SceneSpec {
             &options,
             &mut sink,
         )?;
+        if let Some(b) = &bsp {
+            for id in image.ids.iter_mut().filter(|id| **id >= 0) {
+                *id = b.origin[*id as usize] as i32;
+            }
+        }
         Ok(FixedRender { image, stats })
     }
 }
@@ -605,6 +641,9 @@ pub enum Algorithm {
     DepthSort,
     /// Span sorting, no depth memory ([`SpanSortWorkspace`]).
     SpanSort,
+    /// Painter's algorithm in the order of a BSP tree built for the scene's one mesh
+    /// ([`BspWorkspace`], tree from [`crate::bsp::build`]).
+    Bsp,
 }
 
 /// Band heights `band:N` accepts (the band is a compile-time capacity).
@@ -614,12 +653,13 @@ pub const ZBUFFER_MAX_SIZE: usize = 1024;
 
 impl Algorithm {
     /// Every method `sim` offers (bands at 16 rows), for tables and tests.
-    pub const ALL: [Algorithm; 5] = [
+    pub const ALL: [Algorithm; 6] = [
         Algorithm::SpanZBuffer,
         Algorithm::ZBuffer,
         Algorithm::Band(16),
         Algorithm::DepthSort,
         Algorithm::SpanSort,
+        Algorithm::Bsp,
     ];
 
     /// Whether the method is exact by design (all but the simple depth sort).
@@ -643,6 +683,7 @@ impl std::fmt::Display for Algorithm {
             Algorithm::Band(n) => write!(f, "band:{n}"),
             Algorithm::DepthSort => write!(f, "depth-sort"),
             Algorithm::SpanSort => write!(f, "span-sort"),
+            Algorithm::Bsp => write!(f, "bsp"),
         }
     }
 }
@@ -650,13 +691,14 @@ impl std::fmt::Display for Algorithm {
 impl std::str::FromStr for Algorithm {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        let choices = "span-zbuffer, zbuffer, band:N (N in 1,2,4,...,128), depth-sort, span-sort, raycast (the f64 reference)";
+        let choices = "span-zbuffer, zbuffer, band:N (N in 1,2,4,...,128), depth-sort, bsp, span-sort, raycast (the f64 reference)";
         match s {
             "span-zbuffer" => Ok(Algorithm::SpanZBuffer),
             "zbuffer" => Ok(Algorithm::ZBuffer),
             "depth-sort" => Ok(Algorithm::DepthSort),
             "span-sort" => Ok(Algorithm::SpanSort),
-            "newell" | "bsp" | "warnock" => Err(format!(
+            "bsp" => Ok(Algorithm::Bsp),
+            "newell" | "warnock" => Err(format!(
                 "'{s}' is not implemented yet; choose one of {choices}"
             )),
             _ => match s.strip_prefix("band:").map(str::parse::<usize>) {
@@ -671,10 +713,14 @@ impl std::str::FromStr for Algorithm {
 // Host capacities: up to 65534 triangles, 4096 crossing one row.
 const TRIS: usize = 65534;
 const ACTIVE: usize = 4096;
+/// BSP traversal stack: enough for a chain as deep as the largest mesh.
+const BSP_STACK: usize = 2 * 65535 + 1;
 
 /// Renders through the workspace of `algorithm` (built here, with host-sized capacities).
+#[allow(clippy::too_many_arguments)]
 fn render_with<P: RowPixel, const S: u32, K: RowSink<P>>(
     algorithm: Algorithm,
+    tree: Option<&BspTree<'_>>,
     background: P,
     w: usize,
     h: usize,
@@ -711,6 +757,12 @@ where
         }
         Algorithm::DepthSort => with!(DepthSortWorkspace<P, Flat, M, M, TRIS, ACTIVE>),
         Algorithm::SpanSort => with!(SpanSortWorkspace<P, Flat, M, M, TRIS, ACTIVE>),
+        Algorithm::Bsp => {
+            let tree = tree.ok_or("bsp needs a tree")?;
+            type Ws<P> = BspWorkspace<P, Flat, M, M, TRIS, ACTIVE, BSP_STACK>;
+            let mut ws: Box<Ws<P>> = Box::new(Ws::new(background));
+            ws.render_sized(w, h, scene, tree, options, sink)
+        }
     }
     .map_err(|e| e.to_string())
 }

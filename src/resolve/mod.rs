@@ -26,7 +26,7 @@ use crate::clip::Clipping;
 use crate::project::Depth;
 use crate::raster::PixelOrigin;
 use crate::render::{
-    drive, fill_span, viewport, ActiveTri, FinishedRow, Frame, FrameStats, RenderError,
+    drive, fill_span, viewport, ActiveTri, FinishedRow, Frame, FrameStats, IdOrder, RenderError,
     RenderOptions, Resolve, MAX_INSTANCES, NO_ENTRY,
 };
 use crate::scene::Scene;
@@ -34,6 +34,7 @@ use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
 use heapless::{Vec, VecView};
 
+pub mod bsp;
 pub mod store;
 
 /// Compile-time checks shared by the workspaces.
@@ -237,7 +238,15 @@ impl<
             width,
             y0: 0,
         };
-        drive::<P, S, SUB_BITS, C, K, INSTANCES, _>(frame, &mut band, scene, options, &vp, sink)
+        drive::<P, S, SUB_BITS, C, K, INSTANCES, _>(
+            frame,
+            &mut band,
+            &mut IdOrder,
+            scene,
+            options,
+            &vp,
+            sink,
+        )
     }
 }
 
@@ -488,7 +497,15 @@ impl<
             background: self.background,
             spans: self.spans.as_mut_view(),
         };
-        drive::<P, S, SUB_BITS, C, K, INSTANCES, _>(frame, &mut resolve, scene, options, &vp, sink)
+        drive::<P, S, SUB_BITS, C, K, INSTANCES, _>(
+            frame,
+            &mut resolve,
+            &mut IdOrder,
+            scene,
+            options,
+            &vp,
+            sink,
+        )
     }
 }
 
@@ -634,6 +651,14 @@ impl<
             background: self.background,
             spans: 0,
         };
-        drive::<P, S, SUB_BITS, C, K, INSTANCES, _>(frame, &mut resolve, scene, options, &vp, sink)
+        drive::<P, S, SUB_BITS, C, K, INSTANCES, _>(
+            frame,
+            &mut resolve,
+            &mut IdOrder,
+            scene,
+            options,
+            &vp,
+            sink,
+        )
     }
 }

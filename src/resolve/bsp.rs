@@ -1,0 +1,376 @@
+//! BSP tree ordering (Fuchs, Kedem and Naylor): a painter's algorithm whose order is right for
+//! every eye position.
+//!
+//! A binary space partitioning tree of a static mesh is built once, ahead of time (on the host:
+//! `scanline3d_sim::bsp::build`, exportable as `static` data). Every node holds a plane and the
+//! triangles lying in it; the triangles in front of the plane are in one subtree, those behind
+//! in the other, and triangles that straddle a plane were split when the tree was built. For
+//! any eye position, visiting the subtree on the far side of a node's plane, then the node's
+//! triangles, then the near subtree draws far to near, so painting in that order is correct:
+//! interpenetrating and cyclically overlapping triangles were split apart by the build.
+//!
+//! Per frame the tree is traversed once (one plane test per node, with an explicit stack of
+//! `STACK` entries: no recursion), each triangle's place in the order becomes its sort key,
+//! and the rows are painted like the depth sort's, far to near.
+
+use crate::clip::Clipping;
+use crate::render::{
+    drive, viewport, ActiveTri, CapacityKind, Frame, FrameStats, InstanceSetup, RenderError,
+    RenderOptions, TriangleOrder, NO_ENTRY,
+};
+use crate::scene::{Scene, Transform};
+use crate::shading::Shading;
+use crate::sink::{RowPixel, RowSink};
+use heapless::Vec;
+
+use super::{check_sizes, Painter};
+
+/// No child.
+pub const NO_CHILD: u16 = u16::MAX;
+
+/// One node of a BSP tree.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BspNode {
+    /// The plane `a·x + b·y + c·z + d = 0` in model coordinates; its front side is where the
+    /// expression is positive.
+    pub plane: [f32; 4],
+    /// The subtree in front of the plane ([`NO_CHILD`] if empty).
+    pub front: u16,
+    /// The subtree behind the plane ([`NO_CHILD`] if empty).
+    pub back: u16,
+    /// The node's triangles (those in its plane) are the mesh's `first .. first + count`.
+    pub first: u16,
+    /// How many.
+    pub count: u16,
+}
+
+/// Why a BSP tree was rejected.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BspError {
+    /// The tree has no nodes.
+    Empty,
+    /// Node `node` names a child that is not after it in the node list, or out of range (nodes
+    /// are in pre-order, which also rules out cycles).
+    BadChild {
+        /// The node.
+        node: usize,
+    },
+    /// Node `node`'s triangle range is not the next one: ranges must follow each other in node
+    /// order and end at the mesh's last triangle, so each triangle is drawn exactly once.
+    BadRange {
+        /// The node.
+        node: usize,
+    },
+    /// A plane is not finite.
+    BadPlane {
+        /// The node.
+        node: usize,
+    },
+}
+
+/// A BSP tree over one mesh, validated: node 0 is the root and every child comes after its
+/// parent.
+#[derive(Clone, Copy, Debug)]
+pub struct BspTree<'a> {
+    nodes: &'a [BspNode],
+}
+
+impl<'a> BspTree<'a> {
+    /// Checks `nodes` against a mesh of `triangles` triangles.
+    ///
+    /// ```
+    /// use scanline3d::resolve::bsp::{BspError, BspNode, BspTree, NO_CHILD};
+    /// let leaf = BspNode { plane: [0.0, 0.0, 1.0, 0.0], front: NO_CHILD, back: NO_CHILD, first: 0, count: 2 };
+    /// assert!(BspTree::new(&[leaf], 2).is_ok());
+    /// assert_eq!(BspTree::new(&[leaf], 1).unwrap_err(), BspError::BadRange { node: 0 });
+    /// let cycle = BspNode { front: 0, ..leaf };
+    /// assert_eq!(BspTree::new(&[cycle], 2).unwrap_err(), BspError::BadChild { node: 0 });
+    /// ```
+    pub fn new(nodes: &'a [BspNode], triangles: usize) -> Result<Self, BspError> {
+        if nodes.is_empty() {
+            return Err(BspError::Empty);
+        }
+        let mut next_first = 0usize;
+        for (i, n) in nodes.iter().enumerate() {
+            let child_ok = |c: u16| c == NO_CHILD || (c as usize > i && (c as usize) < nodes.len());
+            if !child_ok(n.front) || !child_ok(n.back) {
+                return Err(BspError::BadChild { node: i });
+            }
+            if n.first as usize != next_first || next_first + n.count as usize > triangles {
+                return Err(BspError::BadRange { node: i });
+            }
+            next_first += n.count as usize;
+            if !n.plane.iter().all(|v| v.is_finite()) {
+                return Err(BspError::BadPlane { node: i });
+            }
+        }
+        if next_first != triangles {
+            return Err(BspError::BadRange {
+                node: nodes.len() - 1,
+            });
+        }
+        Ok(BspTree { nodes })
+    }
+
+    /// Triangles of the mesh the tree orders.
+    pub fn triangles(&self) -> usize {
+        self.nodes.iter().map(|n| n.count as usize).sum()
+    }
+
+    /// The nodes.
+    pub fn nodes(&self) -> &'a [BspNode] {
+        self.nodes
+    }
+
+    /// Calls `f(first, count)` for each node's triangle range, far to near as seen from
+    /// `eye` (model coordinates). `Err(needed)` if `stack` is too small for this tree and eye.
+    pub fn back_to_front(
+        &self,
+        eye: [f32; 3],
+        stack: &mut [u32],
+        mut f: impl FnMut(u16, u16),
+    ) -> Result<(), usize> {
+        // Entries are node indices; the high bit marks "draw this node's triangles now".
+        const DRAW: u32 = 1 << 31;
+        let mut top = 0usize;
+        let push = |stack: &mut [u32], top: &mut usize, v: u32| match stack.get_mut(*top) {
+            Some(slot) => {
+                *slot = v;
+                *top += 1;
+                Ok(())
+            }
+            None => Err(*top + 1),
+        };
+        push(stack, &mut top, 0)?;
+        while top > 0 {
+            top -= 1;
+            let entry = stack.get(top).copied().unwrap_or(0);
+            let Some(node) = self.nodes.get((entry & !DRAW) as usize) else {
+                continue;
+            };
+            if entry & DRAW != 0 {
+                f(node.first, node.count);
+                continue;
+            }
+            let [a, b, c, d] = node.plane;
+            let in_front = a * eye[0] + b * eye[1] + c * eye[2] + d >= 0.0;
+            let (near, far) = if in_front {
+                (node.front, node.back)
+            } else {
+                (node.back, node.front)
+            };
+            // Popped in reverse: far subtree, then this node, then the near subtree.
+            if near != NO_CHILD {
+                push(stack, &mut top, near as u32)?;
+            }
+            push(stack, &mut top, entry | DRAW)?;
+            if far != NO_CHILD {
+                push(stack, &mut top, far as u32)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `p` in the coordinates of `t`'s model space (`t` maps model to world), or `None` if `t`
+/// is singular.
+fn to_model(t: &Transform, p: [f32; 3]) -> Option<[f32; 3]> {
+    let m = t.m;
+    let v = [p[0] - m[0][3], p[1] - m[1][3], p[2] - m[2][3]];
+    // Cramer's rule on the 3×3 part.
+    let col = |j: usize| [m[0][j], m[1][j], m[2][j]];
+    let cross = |a: [f32; 3], b: [f32; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let (c0, c1, c2) = (col(0), col(1), col(2));
+    let det = dot(c0, cross(c1, c2));
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    Some([
+        dot(v, cross(c1, c2)) / det,
+        dot(c0, cross(v, c2)) / det,
+        dot(c0, cross(c1, v)) / det,
+    ])
+}
+
+/// Pass 1's order for a BSP scene: the tree's back-to-front order over instance 0's mesh.
+struct BspOrder<'t, 'w> {
+    tree: &'t BspTree<'t>,
+    eye: [f32; 3],
+    stack: &'w mut [u32],
+}
+
+impl TriangleOrder for BspOrder<'_, '_> {
+    fn visit<'s, E>(
+        &mut self,
+        setups: &[InstanceSetup<'s>],
+        mut f: impl FnMut(&InstanceSetup<'s>, usize, Option<u32>),
+    ) -> Result<(), RenderError<E>> {
+        let Some(setup) = setups.first() else {
+            return Ok(());
+        };
+        let capacity = self.stack.len();
+        // One rank per node: its triangles are coplanar, so where two overlap their depths tie
+        // exactly, and equal keys give the z-buffers' tie rule (first activated is drawn last).
+        // Visiting them in reverse keeps each row's bucket in index order, as for the others.
+        let mut rank = 0u32;
+        self.tree
+            .back_to_front(self.eye, self.stack, |first, count| {
+                for tri in (first as usize..first as usize + count as usize).rev() {
+                    f(setup, tri, Some(rank));
+                }
+                rank += 1;
+            })
+            .map_err(|needed| RenderError::Capacity {
+                what: CapacityKind::BspStack,
+                needed,
+                capacity,
+            })
+    }
+}
+
+/// Painter's algorithm in BSP order: correct for every eye position, with the tree built ahead
+/// of time. The scene must have exactly one instance, whose mesh is the one the tree was built
+/// for (its transform may change from frame to frame). `STACK` bounds the traversal: about
+/// twice the tree's depth (`scanline3d_sim::bsp` reports the depth).
+///
+/// ```
+/// use embedded_graphics::pixelcolor::Gray8;
+/// use scanline3d::resolve::bsp::{BspNode, BspTree, BspWorkspace, NO_CHILD};
+/// use scanline3d::{scene::*, sink::HashSink, Flat, RenderOptions};
+/// use fixed::types::I16F16;
+/// // Two triangles in the plane z = 0: one node.
+/// let v = |x: f32, y: f32| [I16F16::from_num(x), I16F16::from_num(y), I16F16::ZERO];
+/// let verts = [v(-1.0, -1.0), v(1.0, -1.0), v(-1.0, 1.0), v(1.0, 1.0)];
+/// let tris = [[0u16, 1, 2], [2, 1, 3]];
+/// let mesh = Mesh::new(&verts, &tris, MeshColors::Uniform(embedded_graphics::pixelcolor::Rgb888::new(200, 200, 200)), None)?;
+/// let nodes = [BspNode { plane: [0.0, 0.0, 1.0, 0.0], front: NO_CHILD, back: NO_CHILD, first: 0, count: 2 }];
+/// let tree = BspTree::new(&nodes, tris.len()).unwrap();
+/// let instances = [Instance { mesh: &mesh, transform: Transform::IDENTITY }];
+/// let camera = Camera::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0])?.perspective(60.0, 0.5, 10.0)?;
+/// let scene = Scene { instances: &instances, camera, light: Light::new([0.0, 0.0, 1.0], 0.2, 0.8)? };
+/// let mut ws: Box<BspWorkspace<Gray8, Flat, 32, 32, 8, 8, 8>> = Box::new(BspWorkspace::new(Gray8::new(0)));
+/// let stats = ws.render(&scene, &tree, &RenderOptions::default(), &mut HashSink::new()).unwrap();
+/// assert_eq!(stats.activated, 2);
+/// # Ok::<(), scanline3d::scene::SceneError>(())
+/// ```
+pub struct BspWorkspace<
+    P: RowPixel,
+    S: Shading,
+    const W: usize,
+    const H: usize,
+    const TRIS: usize = 1024,
+    const ACTIVE: usize = 64,
+    const STACK: usize = 256,
+> {
+    pixels: [P; W],
+    background: P,
+    heads: [u16; H],
+    next: [u16; TRIS],
+    refs: [u16; TRIS],
+    keys: [u32; TRIS],
+    stack: [u32; STACK],
+    active: Vec<ActiveTri<S::Payload<P>, u32>, ACTIVE>,
+}
+
+impl<
+        P: RowPixel,
+        S: Shading,
+        const W: usize,
+        const H: usize,
+        const TRIS: usize,
+        const ACTIVE: usize,
+        const STACK: usize,
+    > BspWorkspace<P, S, W, H, TRIS, ACTIVE, STACK>
+{
+    /// Size of this workspace in bytes.
+    pub const BYTES: usize = core::mem::size_of::<Self>();
+
+    const VALID: () = check_sizes(W, H, TRIS);
+
+    /// An empty workspace whose background pixels are `background`.
+    pub const fn new(background: P) -> Self {
+        #[allow(clippy::let_unit_value)]
+        let () = Self::VALID;
+        BspWorkspace {
+            pixels: [background; W],
+            background,
+            heads: [NO_ENTRY; H],
+            next: [NO_ENTRY; TRIS],
+            refs: [0; TRIS],
+            keys: [0; TRIS],
+            stack: [0; STACK],
+            active: Vec::new(),
+        }
+    }
+
+    /// Renders `scene` (one instance, the mesh `tree` was built for) in BSP order.
+    pub fn render<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+        &mut self,
+        scene: &Scene<'_>,
+        tree: &BspTree<'_>,
+        options: &RenderOptions<SUB_BITS, C>,
+        sink: &mut K,
+    ) -> Result<FrameStats, RenderError<K::Error>> {
+        self.render_sized(W, H, scene, tree, options, sink)
+    }
+
+    /// Renders a `width × height` target (at most `W × H`); see
+    /// [`Workspace::render_sized`](crate::Workspace::render_sized).
+    pub fn render_sized<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+        &mut self,
+        width: usize,
+        height: usize,
+        scene: &Scene<'_>,
+        tree: &BspTree<'_>,
+        options: &RenderOptions<SUB_BITS, C>,
+        sink: &mut K,
+    ) -> Result<FrameStats, RenderError<K::Error>> {
+        let vp = viewport::<SUB_BITS, K::Error>(width, height, W, H, scene)?;
+        let [instance] = scene.instances else {
+            return Err(RenderError::TreeMismatch);
+        };
+        if tree.triangles() != instance.mesh.triangles().len() {
+            return Err(RenderError::TreeMismatch);
+        }
+        let eye = to_model(&instance.transform, scene.camera.view().eye)
+            .ok_or(RenderError::InvalidTarget)?;
+        let (Some(pixels), Some(heads)) =
+            (self.pixels.get_mut(..width), self.heads.get_mut(..height))
+        else {
+            return Err(RenderError::InvalidTarget);
+        };
+        let frame = Frame {
+            heads,
+            next: &mut self.next,
+            refs: &mut self.refs,
+            keys: &mut self.keys,
+            active: self.active.as_mut_view(),
+        };
+        let mut resolve = Painter {
+            pixels,
+            background: self.background,
+            spans: 0,
+        };
+        let mut order = BspOrder {
+            tree,
+            eye,
+            stack: &mut self.stack,
+        };
+        drive::<P, S, SUB_BITS, C, K, 1, _>(
+            frame,
+            &mut resolve,
+            &mut order,
+            scene,
+            options,
+            &vp,
+            sink,
+        )
+    }
+}
