@@ -174,6 +174,10 @@ pub enum CapacityKind {
     Instances,
     /// Screen triangles kept for a whole-frame method (clipped pieces count one each).
     Pieces,
+    /// The window stack of Warnock's area subdivision
+    /// ([`WarnockWorkspace`](crate::resolve::WarnockWorkspace)), which depends on the target
+    /// size only ([`stack_needed`](crate::resolve::warnock::stack_needed)).
+    WindowStack,
 }
 
 /// Why a frame could not be rendered.
@@ -1054,7 +1058,6 @@ fn walk_band<P: RowPixel, S: Shading, const SUB: u32, R: Resolve<P, S>>(
 /// Transforms, clips, projects and culls every triangle of `scene` (lit per vertex if `S`
 /// needs it) and calls `f(vertices, face colour, id)` for each visible screen piece, in id
 /// order: the set-up of whole-frame methods, which keep every piece.
-#[allow(dead_code)] // (used by the whole-frame methods of the next commits)
 pub(crate) fn for_each_screen_piece<
     S: Shading,
     const SUB: u32,
