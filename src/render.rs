@@ -177,6 +177,10 @@ pub enum CapacityKind {
     /// The traversal stack of a BSP tree (`STACK` of a
     /// [`BspWorkspace`](crate::resolve::bsp::BspWorkspace)).
     BspStack,
+    /// The window stack of Warnock's area subdivision
+    /// ([`WarnockWorkspace`](crate::resolve::WarnockWorkspace)), which depends on the target
+    /// size only ([`stack_needed`](crate::resolve::warnock::stack_needed)).
+    WindowStack,
 }
 
 /// Why a frame could not be rendered.
@@ -1096,7 +1100,6 @@ fn walk_band<P: RowPixel, S: Shading, const SUB: u32, R: Resolve<P, S>>(
 /// Transforms, clips, projects and culls every triangle of `scene` (lit per vertex if `S`
 /// needs it) and calls `f(vertices, face colour, id)` for each visible screen piece, in id
 /// order: the set-up of whole-frame methods, which keep every piece.
-#[allow(dead_code)] // (used by the whole-frame methods of the next commits)
 pub(crate) fn for_each_screen_piece<
     S: Shading,
     const SUB: u32,

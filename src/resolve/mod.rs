@@ -11,8 +11,9 @@
 //! | [`ZBufferWorkspace`] | full-frame z-buffer: a band of `H` rows | `H·W` depth + `H·W` pixels | same |
 //! | [`SpanSortWorkspace`] | span sorting (Watkins): visible segments from depths at span ends | one row of pixels, a span list; no depth | each pixel once |
 //! | [`DepthSortWorkspace`] | depth sort / painter's: far to near by mean depth, overwriting | one row of pixels, a key per triangle; no depth | every covered pixel (overdraw) |
+//! | [`WarnockWorkspace`] | area subdivision (Warnock): windows split until simple | every kept piece, a frame of pixels, a window stack and index buffer; no depth | each pixel once |
 //!
-//! The z-buffers and span sorting render bit-identical frames to the span z-buffer: they
+//! The z-buffers, span sorting and area subdivision render bit-identical frames to the span z-buffer: they
 //! apply the same rule (strictly nearer wins; on an exact tie, the triangle activated first,
 //! that is the one with the higher first row, then the lower id). The depth sort is the
 //! fast baseline that is wrong where one mean depth per triangle cannot order two surfaces
@@ -36,6 +37,8 @@ use heapless::{Vec, VecView};
 
 pub mod bsp;
 pub mod store;
+pub mod warnock;
+pub use warnock::WarnockWorkspace;
 
 /// Compile-time checks shared by the workspaces.
 const fn check_sizes(w: usize, h: usize, tris: usize) {
