@@ -21,6 +21,8 @@ pub const WIDTH: usize = 240;
 pub const HEIGHT: usize = 240;
 /// Mesh instances per scene: three tori and the ground.
 pub const INSTANCES: usize = 4;
+/// Warnock's window stack for the target.
+const WARNOCK_STACK: usize = scanline3d::resolve::warnock::stack_needed(WIDTH, HEIGHT);
 
 /// One scene size and the capacities its frame needs.
 pub struct Level {
@@ -170,6 +172,10 @@ method!(SpanSort, "span-sort", <P, TRIS, ACTIVE>
     scanline3d::resolve::SpanSortWorkspace<P, Flat, WIDTH, HEIGHT, TRIS, ACTIVE, INSTANCES>);
 method!(DepthSort, "depth-sort", <P, TRIS, ACTIVE>
     scanline3d::resolve::DepthSortWorkspace<P, Flat, WIDTH, HEIGHT, TRIS, ACTIVE, INSTANCES>);
+// Warnock keeps every piece (`TRIS`, as no triangle of these scenes is clipped into several),
+// a window list of up to one entry per piece, and the window stack the target size needs.
+method!(Warnock, "warnock", <P, TRIS, _>
+    scanline3d::resolve::WarnockWorkspace<P, Flat, WIDTH, HEIGHT, TRIS, TRIS, WARNOCK_STACK, INSTANCES>);
 
 /// Work done for each (method, level): `visit` gets the method and the level's capacities.
 pub trait Visit {
@@ -189,6 +195,7 @@ pub fn for_each<V: Visit>(v: &mut V) -> Result<(), V::Error> {
     levels::<Band16, V>(v)?;
     levels::<SpanSort, V>(v)?;
     levels::<DepthSort, V>(v)?;
+    levels::<Warnock, V>(v)?;
     Ok(())
 }
 

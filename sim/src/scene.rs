@@ -5,7 +5,10 @@ use crate::reference::{self, Image};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::I16F16;
 use scanline3d::resolve::bsp::{BspTree, BspWorkspace};
-use scanline3d::resolve::{BandWorkspace, DepthSortWorkspace, SpanSortWorkspace, ZBufferWorkspace};
+use scanline3d::resolve::{
+    warnock, BandWorkspace, DepthSortWorkspace, SpanSortWorkspace, WarnockWorkspace,
+    ZBufferWorkspace,
+};
 use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
 use scanline3d::sink::{FnSink, Row, RowPixel, RowSink, TriangleId};
 use scanline3d::{Flat, FrameStats, RenderOptions, Workspace};
@@ -644,22 +647,25 @@ pub enum Algorithm {
     /// Painter's algorithm in the order of a BSP tree built for the scene's one mesh
     /// ([`BspWorkspace`], tree from [`crate::bsp::build`]).
     Bsp,
+    /// Warnock's area subdivision ([`WarnockWorkspace`]).
+    Warnock,
 }
 
 /// Band heights `band:N` accepts (the band is a compile-time capacity).
 pub const BAND_CHOICES: [usize; 8] = [1, 2, 4, 8, 16, 32, 64, 128];
-/// Largest target of the full-frame z-buffer in `sim` (its depth and pixels are W·H each).
+/// Largest target of the full-frame z-buffer and Warnock in `sim` (they keep W·H pixels).
 pub const ZBUFFER_MAX_SIZE: usize = 1024;
 
 impl Algorithm {
     /// Every method `sim` offers (bands at 16 rows), for tables and tests.
-    pub const ALL: [Algorithm; 6] = [
+    pub const ALL: [Algorithm; 7] = [
         Algorithm::SpanZBuffer,
         Algorithm::ZBuffer,
         Algorithm::Band(16),
         Algorithm::DepthSort,
         Algorithm::SpanSort,
         Algorithm::Bsp,
+        Algorithm::Warnock,
     ];
 
     /// Whether the method is exact by design (all but the simple depth sort).
@@ -669,7 +675,7 @@ impl Algorithm {
 
     fn max_size(self) -> usize {
         match self {
-            Algorithm::ZBuffer => ZBUFFER_MAX_SIZE,
+            Algorithm::ZBuffer | Algorithm::Warnock => ZBUFFER_MAX_SIZE,
             _ => MAX_SIZE,
         }
     }
@@ -684,6 +690,7 @@ impl std::fmt::Display for Algorithm {
             Algorithm::DepthSort => write!(f, "depth-sort"),
             Algorithm::SpanSort => write!(f, "span-sort"),
             Algorithm::Bsp => write!(f, "bsp"),
+            Algorithm::Warnock => write!(f, "warnock"),
         }
     }
 }
@@ -691,14 +698,15 @@ impl std::fmt::Display for Algorithm {
 impl std::str::FromStr for Algorithm {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        let choices = "span-zbuffer, zbuffer, band:N (N in 1,2,4,...,128), depth-sort, bsp, span-sort, raycast (the f64 reference)";
+        let choices = "span-zbuffer, zbuffer, band:N (N in 1,2,4,...,128), depth-sort, bsp, span-sort, warnock, raycast (the f64 reference)";
         match s {
             "span-zbuffer" => Ok(Algorithm::SpanZBuffer),
             "zbuffer" => Ok(Algorithm::ZBuffer),
             "depth-sort" => Ok(Algorithm::DepthSort),
             "span-sort" => Ok(Algorithm::SpanSort),
             "bsp" => Ok(Algorithm::Bsp),
-            "newell" | "warnock" => Err(format!(
+            "warnock" => Ok(Algorithm::Warnock),
+            "newell" => Err(format!(
                 "'{s}' is not implemented yet; choose one of {choices}"
             )),
             _ => match s.strip_prefix("band:").map(str::parse::<usize>) {
@@ -762,6 +770,10 @@ where
             type Ws<P> = BspWorkspace<P, Flat, M, M, TRIS, ACTIVE, BSP_STACK>;
             let mut ws: Box<Ws<P>> = Box::new(Ws::new(background));
             ws.render_sized(w, h, scene, tree, options, sink)
+        }
+        Algorithm::Warnock => {
+            const STACK: usize = warnock::stack_needed(Z, Z);
+            with!(WarnockWorkspace<P, Flat, Z, Z, TRIS, ACTIVE, STACK>)
         }
     }
     .map_err(|e| e.to_string())
