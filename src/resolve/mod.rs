@@ -348,7 +348,7 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanSort<'_, P, S::Payload<P>> {
         0
     }
     fn finish_row(&mut self, y: i32) -> FinishedRow<'_, P> {
-        let written = sweep::<P, S>(self.spans, y, self.pixels);
+        let written = sweep::<P, S>(self.spans.as_mut_slice(), y, self.pixels);
         FinishedRow {
             pixels: self.pixels,
             depth: &[],
@@ -362,55 +362,73 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanSort<'_, P, S::Payload<P>> {
 /// spans present does not change; within it, the nearest span at the segment's first column
 /// stays nearest until the first column where another span's depth (linear in the column)
 /// overtakes it, which is computed exactly. Returns the pixels written.
+///
+/// The spans are sorted by first column; those present ("live") are kept at the front of the
+/// slice, so each segment looks only at the few spans over it, not at the whole row.
 fn sweep<P: RowPixel, S: Shading>(
-    spans: &[SortSpan<S::Payload<P>>],
+    spans: &mut [SortSpan<S::Payload<P>>],
     y: i32,
     pixels: &mut [P],
 ) -> u32 {
+    spans.sort_unstable_by_key(|s| s.l);
     let width = pixels.len() as i32;
     let mut written = 0u32;
-    let mut x = spans.iter().map(|s| s.l).min().unwrap_or(width);
+    // spans[..live] are present at x, spans[live..next] have ended, spans[next..] start later.
+    let (mut live, mut next) = (0usize, 0usize);
+    let mut x = spans.first().map_or(width, |s| s.l);
     while x < width {
-        // The spans present at x, the end of the segment, and the nearest span.
-        let mut end = width;
-        let mut front: Option<&SortSpan<S::Payload<P>>> = None;
-        for s in spans {
-            if s.l > x {
-                end = end.min(s.l);
-            } else if x < s.r {
-                end = end.min(s.r);
-                if front.is_none_or(|f| s.beats(f, x)) {
-                    front = Some(s);
-                }
+        while spans.get(next).is_some_and(|s| s.l <= x) {
+            spans.swap(live, next);
+            live += 1;
+            next += 1;
+        }
+        let mut i = 0;
+        while i < live {
+            if spans.get(i).is_some_and(|s| s.r <= x) {
+                live -= 1;
+                spans.swap(i, live);
+            } else {
+                i += 1;
             }
         }
-        let Some(front) = front.filter(|f| f.depth_at(x) > 0 || f.order < 0) else {
-            // Nothing in front of the background here: find where the first span starts or
-            // rises above depth 0.
-            x = next_change(spans, x, end, None);
-            continue;
-        };
-        let end = next_change(spans, x, end, Some(front));
-        if let Some(out) = pixels.get_mut(x as usize..end as usize) {
-            S::paint(&front.payload, &front.origin, x, y, out);
+        let present = spans.get(..live).unwrap_or(&[]);
+        // The end of the segment: the first span end or span start after x.
+        let mut end = spans.get(next).map_or(width, |s| s.l.min(width));
+        let mut front: Option<usize> = None;
+        for (k, s) in present.iter().enumerate() {
+            end = end.min(s.r);
+            if front.is_none_or(|f| present.get(f).is_none_or(|f| s.beats(f, x))) {
+                front = Some(k);
+            }
+        }
+        let front = front.filter(|&f| present.get(f).is_some_and(|f| f.depth_at(x) > 0));
+        let end = next_change(present, x, end, front);
+        if let (Some(f), Some(out)) = (
+            front.and_then(|f| present.get(f)),
+            pixels.get_mut(x as usize..end as usize),
+        ) {
+            S::paint(&f.payload, &f.origin, x, y, out);
             written += (end - x) as u32;
         }
+        // end > x: present spans end after x and the next one starts after it.
         x = end;
     }
     written
 }
 
-/// The first column in `(x, end)` where another span present at `x` overtakes `front` (or,
-/// for `None`, rises above the background at depth 0); `end` if none does.
+/// The first column in `(x, end)` where another span in `present` overtakes the one at index
+/// `front` (or, for `None`, rises above the background at depth 0); `end` if none does.
 ///
 /// Depths are linear in the column and, inside a triangle, never near the `i32` limits, so
 /// the stepped (wrapping) depths equal the exact linear ones used here.
-fn next_change<T>(spans: &[SortSpan<T>], x: i32, end: i32, front: Option<&SortSpan<T>>) -> i32 {
+fn next_change<T>(present: &[SortSpan<T>], x: i32, end: i32, front: Option<usize>) -> i32 {
     // The background is order −1 at depth 0 (it wins ties, like a cleared z-buffer).
-    let (f_q, f_dq, f_order) = front.map_or((0, 0, -1), |f| (f.depth_at(x), f.dq, f.order));
+    let (f_q, f_dq, f_order) = front
+        .and_then(|f| present.get(f))
+        .map_or((0, 0, -1), |f| (f.depth_at(x), f.dq, f.order));
     let mut change = end;
-    for s in spans.iter().filter(|s| s.l <= x && x < s.r) {
-        if front.is_some_and(|f| core::ptr::eq(f, s)) {
+    for (k, s) in present.iter().enumerate() {
+        if Some(k) == front {
             continue;
         }
         // s − front is linear in the column: d0 ≤ 0 at x, then `slope` per column. It can
