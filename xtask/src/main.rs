@@ -692,7 +692,8 @@ fn hsr_table() -> Result<(), String> {
 /// Where each method's own code is (the shared pipeline is not counted): file, and the lines
 /// from the first containing `from` up to the first after it containing `to` (`""`: to the
 /// end or the tests).
-const METHOD_CODE: [(&str, &[(&str, &str, &str)]); 9] = [
+type CodeRange = (&'static str, &'static str, &'static str);
+const METHOD_CODE: [(&str, &[CodeRange]); 9] = [
     (
         "span-zbuffer",
         &[(
