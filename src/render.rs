@@ -181,6 +181,10 @@ pub enum CapacityKind {
     /// ([`WarnockWorkspace`](crate::resolve::WarnockWorkspace)), which depends on the target
     /// size only ([`stack_needed`](crate::resolve::warnock::stack_needed)).
     WindowStack,
+    /// The work bound of Newell's depth sort
+    /// ([`NewellWorkspace`](crate::resolve::NewellWorkspace)): list steps (outputs, moves and
+    /// splits), at most [`newell::step_limit`](crate::resolve::newell::step_limit)`(PIECES)`.
+    SortSteps,
 }
 
 /// Why a frame could not be rendered.

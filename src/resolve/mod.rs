@@ -11,6 +11,7 @@
 //! | [`ZBufferWorkspace`] | full-frame z-buffer: a band of `H` rows | `H·W` depth + `H·W` pixels | same |
 //! | [`SpanSortWorkspace`] | span sorting (Watkins): visible segments from depths at span ends | one row of pixels, a span list; no depth | each pixel once |
 //! | [`DepthSortWorkspace`] | depth sort / painter's: far to near by mean depth, overwriting | one row of pixels, a key per triangle; no depth | every covered pixel (overdraw) |
+//! | [`NewellWorkspace`] | depth sort (Newell, Newell and Sancha): far to near, overlaps resolved by plane and projection tests, splitting cycles and interpenetration | every kept piece and its order, one row of pixels; no depth | every covered pixel (overdraw) |
 //! | [`WarnockWorkspace`] | area subdivision (Warnock): windows split until simple | every kept piece, a frame of pixels, a window stack and index buffer; no depth | each pixel once |
 //!
 //! The z-buffers, span sorting and area subdivision render bit-identical frames to the span z-buffer: they
@@ -18,6 +19,10 @@
 //! that is the one with the higher first row, then the lower id). The depth sort is the
 //! fast baseline that is wrong where one mean depth per triangle cannot order two surfaces
 //! (interpenetration, cyclic overlap, long surfaces beside short ones).
+//!
+//! Newell's depth sort paints far to near like the depth sort, but orders overlapping pieces
+//! by exact plane and projection tests and splits cycles and interpenetration, so it differs
+//! from the span z-buffer only on a few pixels where two surfaces meet (see [`newell`]).
 //!
 //! Methods without depth memory hand rows to the sink with an empty [`Row::depth`].
 //!
@@ -36,8 +41,10 @@ use crate::sink::{RowPixel, RowSink};
 use heapless::{Vec, VecView};
 
 pub mod bsp;
+pub mod newell;
 pub mod store;
 pub mod warnock;
+pub use newell::NewellWorkspace;
 pub use warnock::WarnockWorkspace;
 
 /// Compile-time checks shared by the workspaces.

@@ -6,9 +6,6 @@
 //! plane stays a plane in `(x, y, q)`: depth comparisons and splits are exact linear algebra
 //! there, and the eye is at `q = +∞` (larger `q` is nearer).
 
-// The whole-frame methods that use this land in the next commits.
-#![allow(dead_code)]
-
 use crate::clip::Clipping;
 use crate::project::{Depth, ScreenVertex, SubPx, Viewport};
 use crate::raster::{channel, color_channels, first_row};

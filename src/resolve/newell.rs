@@ -1,0 +1,813 @@
+//! The Newell–Newell–Sancha depth sort on the shared pipeline.
+//!
+//! # The algorithm
+//!
+//! Every visible screen piece of the frame is kept (the [`store`] module: transform, clipping,
+//! projection and culling are the shared ones). The work is done in screen space: `x`, `y` in
+//! sub-pixels and `q = near/w` in I2F30 bits. Projection there is orthographic along `q` and
+//! the eye is at `q = +∞` (larger `q` is nearer), and a triangle's plane stays a plane, so
+//! every plane test below is exact integer arithmetic (`i128`) on the snapped vertices.
+//!
+//! The pieces are sorted by their farthest depth (smallest `q`), far first. Then the head of
+//! the list, `P`, is compared with every other piece `Q` whose depth range reaches `P`'s
+//! (`Q`'s smallest `q` at most `P`'s largest). `P` may be drawn before `Q` when
+//!
+//! 1. their `x` extents are disjoint, or
+//! 2. their `y` extents are disjoint, or
+//! 3. `P` lies entirely behind `Q`'s plane (on the side away from the eye), or
+//! 4. `Q` lies entirely in front of `P`'s plane, or
+//! 5. their projections do not overlap (an edge line of one has the other entirely on its
+//!    outside: exact edge functions of the snapped triangles).
+//!
+//! Extents and projections that only touch count as disjoint: with the top-left fill rule two
+//! triangles whose interiors are disjoint never cover the same pixel centre. If every `Q`
+//! passes, `P` is final and the next piece becomes the head. If `Q` fails but the reversed
+//! tests 3 and 4 say `Q` may be drawn before `P`, `Q` is moved to the head of the list and
+//! marked. A marked piece that would be moved again closes a cycle: it is split by `P`'s
+//! plane (or `P` by its plane, whichever straddles the other), as is `Q` when neither order
+//! can be shown (interpenetration). The pieces of a split replace it in the list and the
+//! search goes on.
+//!
+//! # Splitting and tolerances
+//!
+//! A piece is cut where its edges cross the other's plane. The new vertices are rounded to
+//! the sub-pixel grid (and `q` to an I2F30 step) and shared by the pieces on both sides, so
+//! the cut is watertight (the outer edges move by at most half a sub-pixel where a cut meets
+//! them). Rounded vertices are no longer exactly on the cutting plane, so tests 3 and 4 count
+//! a vertex as on a plane when the plane passes through its rounding cell (`±½` in `x`, `y`
+//! and `q`): `2·|n·(v − a)| ≤ |n_x| + |n_y| + |n_q|`. The pieces of a split then always pass
+//! against the plane that cut them, so no cut is repeated. The price is that a piece may stick
+//! out of another's plane by less than that cell and still be drawn behind it: the pixels
+//! affected lie within about half a sub-pixel of where the two planes meet, where the depth
+//! gap is below the renderer's error bound.
+//!
+//! # Ties
+//!
+//! When both orders pass tests 3 or 4 (coplanar pieces, or pieces within the rounding cell of
+//! each other's planes) and the projections overlap, the span z-buffer's tie rule decides: the
+//! piece whose triangle is activated first (lower first row, then lower id) keeps the pixel,
+//! so it is drawn last. A piece already moved once is not moved again for a tie (either order
+//! is right up to the rounding cell, and a second move would only close a cycle that no split
+//! can break).
+//!
+//! # Termination
+//!
+//! Each step of the search outputs the head, moves one piece to the head, or splits one.
+//! An unmarked piece is moved at most once, splits are bounded by `PIECES` (each needs a free
+//! store entry, and running out is a [`RenderError::Capacity`] error with
+//! [`CapacityKind::Pieces`]), and a marked piece that neither splitting plane cuts (a cycle
+//! closed by other pieces) is moved again at most `PIECES` times in a frame. On top of that
+//! the search takes at most [`step_limit`]`(PIECES)` steps (each scans part of the list),
+//! after which the frame fails with [`CapacityKind::SortSteps`] instead of looping. Nothing
+//! reaches the sink before the order is complete.
+//!
+//! # Painting
+//!
+//! The final order is handed to the shared row walker as a key per piece (its position), and
+//! spans are painted far to near into one row of pixels with the depth sort's painter, so rows
+//! reach the sink one at a time and [`Row::depth`](crate::sink::Row::depth) is empty. Pieces
+//! carry their vertex colours rounded to 8 bits a channel (split vertices interpolate them),
+//! so Gouraud colours may differ from the span z-buffer's by rounding.
+//!
+//! # Memory
+//!
+//! A [`NewellWorkspace`] holds, in bytes:
+//!
+//! * `PIECES · 61`: the kept pieces ([`StoredTriangle`], 52), the list (2), a key per piece
+//!   (4: its activation rank while sorting, then its position), a mark (1) and a bucket link (2);
+//! * `2·H` bucket heads, `size_of::<P>()·W` for one row of pixels and `ACTIVE` active
+//!   triangles (about 104 bytes each for flat shading).
+//!
+//! [`NewellWorkspace::BYTES`] gives the total.
+
+use crate::clip::Clipping;
+use crate::render::{
+    viewport, walk_rows, ActiveTri, CapacityKind, FrameStats, RenderError, RenderOptions,
+    MAX_INSTANCES, NO_ENTRY,
+};
+use crate::resolve::store::{self, StoredPieces, StoredTriangle};
+use crate::resolve::{check_sizes, Painter};
+use crate::scene::Scene;
+use crate::shading::Shading;
+use crate::sink::{RowPixel, RowSink};
+use core::cmp::Reverse;
+use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
+use heapless::Vec;
+
+/// Most search steps a frame may take with room for `pieces` pieces: `8 · pieces + 64`. Each
+/// step outputs, moves or splits one piece (see the [module docs](self)).
+///
+/// ```
+/// assert_eq!(scanline3d::resolve::newell::step_limit(1024), 8256);
+/// ```
+pub const fn step_limit(pieces: usize) -> usize {
+    8 * pieces + 64
+}
+
+/// What one frame's sort did (see [`NewellWorkspace::sort_stats`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SortStats {
+    /// Pieces kept from the pipeline (on screen).
+    pub pieces_in: u32,
+    /// Pieces painted (after splitting).
+    pub pieces_out: u32,
+    /// Pairs compared.
+    pub comparisons: u32,
+    /// Pieces moved to the head of the list.
+    pub moves: u32,
+    /// Marked pieces moved again because neither plane of the pair cuts the other.
+    pub re_moves: u32,
+    /// Pieces split (cyclic overlap or interpenetration).
+    pub splits: u32,
+    /// Parts of a split that have no screen area once their new vertices are rounded (they
+    /// cover nothing, so leaving them out changes no pixel).
+    pub dropped_slivers: u32,
+    /// Search steps taken.
+    pub steps: u32,
+}
+
+/// Depth sort after Newell, Newell and Sancha: pieces are ordered far to near, overlapping
+/// depth ranges are resolved with exact plane and projection tests, and cyclic overlap or
+/// interpenetration is resolved by splitting. Then the pieces are painted far to near, row by
+/// row. Unlike [`DepthSortWorkspace`](crate::resolve::DepthSortWorkspace), the order is right
+/// wherever two pieces overlap (see the [module docs](self) for the tests, the splitting, the
+/// work bound and the memory).
+///
+/// * `PIECES`: screen pieces per frame, including those made by splitting (≤ 65535);
+/// * `ACTIVE`: pieces that may cross one row (more are dropped and reported, as for the
+///   other row walkers).
+///
+/// ```
+/// use embedded_graphics::pixelcolor::Rgb565;
+/// use scanline3d::{demo, resolve::NewellWorkspace, sink::HashSink, Flat, RenderOptions};
+/// let mut ws: Box<NewellWorkspace<Rgb565, Flat, 240, 240, 1280, 96>> =
+///     Box::new(NewellWorkspace::new(Rgb565::new(0, 0, 0)));
+/// let instances = demo::instances();
+/// let scene = demo::scene(&instances, 0, demo::ORBIT_FRAMES)?;
+/// let stats = ws.render(&scene, &RenderOptions::default(), &mut HashSink::new()).unwrap();
+/// assert!(stats.is_complete());
+/// // Every covered pixel is painted, hidden ones too.
+/// assert_eq!(stats.pixels_written, stats.fragments);
+/// assert!(ws.sort_stats().pieces_out >= ws.sort_stats().pieces_in);
+/// # Ok::<(), scanline3d::scene::SceneError>(())
+/// ```
+pub struct NewellWorkspace<
+    P: RowPixel,
+    S: Shading,
+    const W: usize,
+    const H: usize,
+    const PIECES: usize = 1024,
+    const ACTIVE: usize = 64,
+    const INSTANCES: usize = MAX_INSTANCES,
+> {
+    store: [StoredTriangle; PIECES],
+    list: [u16; PIECES],
+    keys: [u32; PIECES],
+    marked: [bool; PIECES],
+    next: [u16; PIECES],
+    heads: [u16; H],
+    pixels: [P; W],
+    background: P,
+    active: Vec<ActiveTri<S::Payload<P>, u32>, ACTIVE>,
+    last: SortStats,
+}
+
+impl<
+        P: RowPixel,
+        S: Shading,
+        const W: usize,
+        const H: usize,
+        const PIECES: usize,
+        const ACTIVE: usize,
+        const INSTANCES: usize,
+    > NewellWorkspace<P, S, W, H, PIECES, ACTIVE, INSTANCES>
+{
+    /// Size of this workspace in bytes.
+    pub const BYTES: usize = core::mem::size_of::<Self>();
+
+    const VALID: () = {
+        check_sizes(W, H, 0);
+        // Pieces are named by `u16` indices in the list and the buckets.
+        assert!(PIECES < NO_ENTRY as usize, "PIECES must be below 65535");
+    };
+
+    /// An empty workspace whose background pixels are `background`.
+    pub const fn new(background: P) -> Self {
+        #[allow(clippy::let_unit_value)]
+        let () = Self::VALID;
+        NewellWorkspace {
+            store: [StoredTriangle::EMPTY; PIECES],
+            list: [0; PIECES],
+            keys: [0; PIECES],
+            marked: [false; PIECES],
+            next: [NO_ENTRY; PIECES],
+            heads: [NO_ENTRY; H],
+            pixels: [background; W],
+            background,
+            active: Vec::new(),
+            last: SortStats {
+                pieces_in: 0,
+                pieces_out: 0,
+                comparisons: 0,
+                moves: 0,
+                re_moves: 0,
+                splits: 0,
+                dropped_slivers: 0,
+                steps: 0,
+            },
+        }
+    }
+
+    /// What the last frame's sort did.
+    pub fn sort_stats(&self) -> SortStats {
+        self.last
+    }
+
+    /// Renders `scene`, handing each of the `H` rows to `sink` once, top to bottom.
+    pub fn render<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+        &mut self,
+        scene: &Scene<'_>,
+        options: &RenderOptions<SUB_BITS, C>,
+        sink: &mut K,
+    ) -> Result<FrameStats, RenderError<K::Error>> {
+        self.render_sized(W, H, scene, options, sink)
+    }
+
+    /// Renders a `width × height` target (at most `W × H`); see
+    /// [`Workspace::render_sized`](crate::Workspace::render_sized). More pieces than `PIECES`
+    /// (before or after splitting) or more than [`step_limit`]`(PIECES)` search steps is a
+    /// [`RenderError::Capacity`] error before any row is sent.
+    pub fn render_sized<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+        &mut self,
+        width: usize,
+        height: usize,
+        scene: &Scene<'_>,
+        options: &RenderOptions<SUB_BITS, C>,
+        sink: &mut K,
+    ) -> Result<FrameStats, RenderError<K::Error>> {
+        let vp = viewport::<SUB_BITS, K::Error>(width, height, W, H, scene)?;
+        let (Some(pixels), Some(heads)) =
+            (self.pixels.get_mut(..width), self.heads.get_mut(..height))
+        else {
+            return Err(RenderError::InvalidTarget);
+        };
+        let (n, stats) = store::collect::<S, SUB_BITS, C, K::Error, INSTANCES>(
+            scene,
+            options,
+            &vp,
+            &mut self.store,
+        )?;
+        let mut sort = Sort {
+            store: &mut self.store,
+            keys: &mut self.keys,
+            marked: &mut self.marked,
+            list: &mut self.list,
+            n,
+            len: 0,
+            stats: SortStats::default(),
+        };
+        sort.ranks::<SUB_BITS>(vp.width as i32, vp.height as i32);
+        let result = sort.run();
+        let (n, len) = (sort.n, sort.len);
+        sort.stats.pieces_out = len as u32;
+        self.last = sort.stats;
+        result?;
+
+        // Key = position in the final order: the row walker's painter draws ascending keys.
+        for (k, &i) in self.list.iter().take(len).enumerate() {
+            if let Some(key) = self.keys.get_mut(i as usize) {
+                *key = k as u32;
+            }
+        }
+        let store = self.store.get(..n).unwrap_or(&[]);
+        store::bucket(store, &vp, heads, &mut self.next);
+        let pieces = StoredPieces {
+            store,
+            keys: self.keys.get(..n).unwrap_or(&[]),
+        };
+        let mut painter = Painter {
+            pixels,
+            background: self.background,
+            spans: 0,
+        };
+        walk_rows::<P, S, SUB_BITS, K, _>(
+            heads,
+            &self.next,
+            self.active.as_mut_view(),
+            &pieces,
+            &mut painter,
+            width as i32,
+            sink,
+            stats,
+        )
+    }
+}
+
+/// A piece's plane in `(x, y, q)`: `s(v) = n·v − d`, oriented so that `n_q > 0` (positive
+/// `s` is in front, towards the eye). `tol` is `|n_x| + |n_y| + n_q`: a vertex is on the plane
+/// when `2·|s(v)| ≤ tol`, i.e. the plane passes through its rounding cell.
+///
+/// Bit budget: coordinates are below 2^22 sub-pixels and `q` below 2^31, so edge differences
+/// are below 2^23 and 2^32, `n` below 2^56 and `s` below 2^90: `i128` holds all of it, and
+/// the split interpolation's products (below 2^115).
+#[derive(Clone, Copy, Debug)]
+struct PlaneEq {
+    n: [i128; 3],
+    d: i128,
+    tol: i128,
+}
+
+impl PlaneEq {
+    fn of(t: &StoredTriangle) -> Option<PlaneEq> {
+        let v = |k: usize| [t.x[k] as i128, t.y[k] as i128, t.q[k] as i128];
+        let (a, b, c) = (v(0), v(1), v(2));
+        let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let mut n = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        if n[2] == 0 {
+            return None; // zero screen area
+        }
+        if n[2] < 0 {
+            n = n.map(|c| -c);
+        }
+        Some(PlaneEq {
+            n,
+            d: n[0] * a[0] + n[1] * a[1] + n[2] * a[2],
+            tol: n[0].abs() + n[1].abs() + n[2],
+        })
+    }
+
+    /// `s` at vertex `k` of `t`.
+    fn at(&self, t: &StoredTriangle, k: usize) -> i128 {
+        self.n[0] * t.x[k] as i128 + self.n[1] * t.y[k] as i128 + self.n[2] * t.q[k] as i128
+            - self.d
+    }
+
+    /// Whether all of `t` is behind this plane or on it.
+    fn all_behind(&self, t: &StoredTriangle) -> bool {
+        (0..3).all(|k| 2 * self.at(t, k) <= self.tol)
+    }
+
+    /// Whether all of `t` is in front of this plane or on it.
+    fn all_in_front(&self, t: &StoredTriangle) -> bool {
+        (0..3).all(|k| 2 * self.at(t, k) >= -self.tol)
+    }
+
+    /// Whether `t` has vertices beyond the tolerance on both sides.
+    fn straddled_by(&self, t: &StoredTriangle) -> bool {
+        !self.all_behind(t) && !self.all_in_front(t)
+    }
+}
+
+fn min_q(t: &StoredTriangle) -> i32 {
+    t.q[0].min(t.q[1]).min(t.q[2])
+}
+
+fn max_q(t: &StoredTriangle) -> i32 {
+    t.q[0].max(t.q[1]).max(t.q[2])
+}
+
+/// Whether the extents `a` and `b` are disjoint or only touch.
+fn disjoint(a: &[i32; 3], b: &[i32; 3]) -> bool {
+    let (a0, a1) = (a[0].min(a[1]).min(a[2]), a[0].max(a[1]).max(a[2]));
+    let (b0, b1) = (b[0].min(b[1]).min(b[2]), b[0].max(b[1]).max(b[2]));
+    a1 <= b0 || b1 <= a0
+}
+
+/// Whether an edge line of `a` has all of `b` on its outside (or on it).
+fn separates(a: &StoredTriangle, b: &StoredTriangle) -> bool {
+    (0..3).any(|k| {
+        let (i, j, o) = (k, (k + 1) % 3, (k + 2) % 3);
+        let (ex, ey) = (a.x[j] as i64 - a.x[i] as i64, a.y[j] as i64 - a.y[i] as i64);
+        let f = |x: i32, y: i32| ex * (y as i64 - a.y[i] as i64) - ey * (x as i64 - a.x[i] as i64);
+        let inside = f(a.x[o], a.y[o]).signum();
+        inside != 0 && (0..3).all(|m| f(b.x[m], b.y[m]) * inside <= 0)
+    })
+}
+
+/// Whether the projections of `a` and `b` may share a pixel centre (exact: a separating line
+/// of two triangles can always be taken through an edge of one of them).
+fn projections_overlap(a: &StoredTriangle, b: &StoredTriangle) -> bool {
+    !separates(a, b) && !separates(b, a)
+}
+
+/// How two pieces must be ordered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Order {
+    /// The head may be drawn before the other.
+    HeadFirst,
+    /// The other must be drawn before the head.
+    OtherFirst,
+    /// Neither order can be shown: split.
+    Split,
+}
+
+/// Rounds `num / den` (with `den > 0`) to the nearest integer, halves up.
+fn div_round(num: i128, den: i128) -> i128 {
+    (2 * num + den).div_euclid(2 * den)
+}
+
+/// The search over one frame's pieces.
+struct Sort<'a> {
+    store: &'a mut [StoredTriangle],
+    /// Per piece: its activation rank while sorting (first row of its triangle << 16 | its
+    /// index in id order), its position in the order afterwards.
+    keys: &'a mut [u32],
+    marked: &'a mut [bool],
+    list: &'a mut [u16],
+    /// Pieces in the store.
+    n: usize,
+    /// Pieces in the list.
+    len: usize,
+    stats: SortStats,
+}
+
+impl Sort<'_> {
+    /// Computes every piece's rank (the span z-buffer's activation order) and lists the
+    /// pieces that are on screen, far first.
+    fn ranks<const SUB: u32>(&mut self, width: i32, height: i32) {
+        let n = self.n;
+        let mut start = 0;
+        while start < n {
+            let id = self.store.get(start).map_or(0, |t| t.id);
+            let end = (start..n)
+                .find(|&i| self.store.get(i).is_none_or(|t| t.id != id))
+                .unwrap_or(n);
+            let row =
+                |t: &StoredTriangle| crate::raster::first_row(&t.screen::<SUB>(), width, height);
+            let first = self
+                .store
+                .get(start..end)
+                .into_iter()
+                .flatten()
+                .filter_map(row)
+                .min();
+            for i in start..end {
+                let on_screen = self.store.get(i).and_then(row).is_some();
+                if let (Some(key), Some(first)) = (self.keys.get_mut(i), first) {
+                    *key = (first as u32) << 16 | i as u32;
+                }
+                if on_screen {
+                    if let (Some(slot), Some(mark)) =
+                        (self.list.get_mut(self.len), self.marked.get_mut(i))
+                    {
+                        *slot = i as u16;
+                        *mark = false;
+                        self.len += 1;
+                    }
+                } else if let Some(t) = self.store.get_mut(i) {
+                    // Not drawn: make sure no bucket picks it up.
+                    *t = StoredTriangle::EMPTY;
+                }
+            }
+            start = end;
+        }
+        self.stats.pieces_in = self.len as u32;
+        let (store, keys) = (&*self.store, &*self.keys);
+        if let Some(list) = self.list.get_mut(..self.len) {
+            list.sort_unstable_by_key(|&i| sort_key(store, keys, i));
+        }
+    }
+
+    fn piece(&self, i: u16) -> &StoredTriangle {
+        self.store.get(i as usize).unwrap_or(&StoredTriangle::EMPTY)
+    }
+
+    fn rank(&self, i: u16) -> u32 {
+        self.keys.get(i as usize).copied().unwrap_or(u32::MAX)
+    }
+
+    fn is_marked(&self, i: u16) -> bool {
+        self.marked.get(i as usize).copied().unwrap_or(false)
+    }
+
+    /// How head `p` and piece `q` (whose depth ranges overlap) must be ordered.
+    fn order(&mut self, p: u16, q: u16) -> Order {
+        self.stats.comparisons += 1;
+        let (pt, qt) = (self.piece(p), self.piece(q));
+        if disjoint(&pt.x, &qt.x) || disjoint(&pt.y, &qt.y) {
+            return Order::HeadFirst;
+        }
+        let (Some(pp), Some(qp)) = (PlaneEq::of(pt), PlaneEq::of(qt)) else {
+            return Order::HeadFirst; // a piece of no area covers nothing
+        };
+        let head_first = qp.all_behind(pt) || pp.all_in_front(qt);
+        let other_first = pp.all_behind(qt) || qp.all_in_front(pt);
+        if head_first && !other_first {
+            return Order::HeadFirst;
+        }
+        if !projections_overlap(pt, qt) {
+            return Order::HeadFirst;
+        }
+        match (head_first, other_first) {
+            // (Nearly) coplanar: the piece activated first keeps the pixel, so is drawn last.
+            // Either order is right up to the rounding cell, so a piece already moved is not
+            // moved again for a tie: that would only close a cycle.
+            (true, true) if self.rank(p) > self.rank(q) || self.is_marked(q) => Order::HeadFirst,
+            (_, true) => Order::OtherFirst,
+            _ => Order::Split,
+        }
+    }
+
+    /// Moves list entry `j` to the head (entry `done`), marking it.
+    fn move_to_head(&mut self, done: usize, j: usize, front: &mut usize) {
+        if let Some(run) = self.list.get_mut(done..=j) {
+            run.rotate_right(1);
+        }
+        if let Some(&q) = self.list.get(done) {
+            if let Some(m) = self.marked.get_mut(q as usize) {
+                *m = true;
+            }
+        }
+        if j >= *front {
+            *front += 1;
+        }
+    }
+
+    /// Runs the search: on success `list[..len]` is the drawing order, far first.
+    fn run<E>(&mut self) -> Result<(), RenderError<E>> {
+        let limit = step_limit(self.store.len());
+        let (mut done, mut front) = (0usize, 0usize);
+        // `list[done..front]` holds moved pieces in no particular order; `list[front..len]`
+        // is sorted far first, so its scan stops at the first piece wholly nearer than P.
+        while done < self.len {
+            self.stats.steps += 1;
+            if self.stats.steps as usize > limit {
+                return Err(RenderError::Capacity {
+                    what: CapacityKind::SortSteps,
+                    needed: limit + 1,
+                    capacity: limit,
+                });
+            }
+            let Some(&p) = self.list.get(done) else { break };
+            let p_max = max_q(self.piece(p));
+            let mut found = None;
+            for j in done + 1..self.len {
+                let Some(&q) = self.list.get(j) else { break };
+                if min_q(self.piece(q)) > p_max {
+                    if j >= front {
+                        break;
+                    }
+                    continue;
+                }
+                match self.order(p, q) {
+                    Order::HeadFirst => {}
+                    order => {
+                        found = Some((j, q, order));
+                        break;
+                    }
+                }
+            }
+            match found {
+                None => {
+                    done += 1;
+                    front = front.max(done);
+                }
+                Some((j, q, Order::OtherFirst)) if !self.is_marked(q) => {
+                    self.stats.moves += 1;
+                    self.move_to_head(done, j, &mut front);
+                }
+                Some((j, q, order)) => {
+                    let (pt, qt) = (*self.piece(p), *self.piece(q));
+                    let (pp, qp) = (PlaneEq::of(&pt), PlaneEq::of(&qt));
+                    match (pp, qp) {
+                        (Some(pp), _) if pp.straddled_by(&qt) => {
+                            self.split(j, pp, &mut front)?;
+                        }
+                        (_, Some(qp)) if qp.straddled_by(&pt) => {
+                            self.split(done, qp, &mut front)?;
+                        }
+                        _ if order == Order::OtherFirst => {
+                            // A cycle closed by other pieces: move it again (bounded).
+                            self.stats.re_moves += 1;
+                            if self.stats.re_moves as usize > self.store.len() {
+                                return Err(RenderError::Capacity {
+                                    what: CapacityKind::SortSteps,
+                                    needed: limit + 1,
+                                    capacity: limit,
+                                });
+                            }
+                            self.move_to_head(done, j, &mut front);
+                        }
+                        // (Not reached: `Split` means each straddles the other's plane.)
+                        _ => {
+                            done += 1;
+                            front = front.max(done);
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Splits list entry `at` by `plane` and files its pieces in the sorted part of the list.
+    fn split<E>(
+        &mut self,
+        at: usize,
+        plane: PlaneEq,
+        front: &mut usize,
+    ) -> Result<(), RenderError<E>> {
+        let Some(&x) = self.list.get(at) else {
+            return Ok(());
+        };
+        let t = *self.piece(x);
+        let (parts, made) = cut(&t, &plane);
+        let count = parts.iter().flatten().count();
+        let extra = count.saturating_sub(1);
+        if self.n + extra > self.store.len() {
+            return Err(RenderError::Capacity {
+                what: CapacityKind::Pieces,
+                needed: self.n + extra,
+                capacity: self.store.len(),
+            });
+        }
+        self.stats.splits += 1;
+        self.stats.dropped_slivers += (made - count) as u32;
+        // Take the piece out of the list.
+        if let Some(rest) = self.list.get_mut(at..self.len) {
+            rest.rotate_left(1);
+        }
+        self.len -= 1;
+        if at < *front {
+            *front -= 1;
+        }
+        let rank = self.rank(x);
+        let mut slot = Some(x as usize);
+        for part in parts.into_iter().flatten() {
+            let i = slot.take().unwrap_or_else(|| {
+                self.n += 1;
+                self.n - 1
+            });
+            if let (Some(s), Some(k), Some(m)) = (
+                self.store.get_mut(i),
+                self.keys.get_mut(i),
+                self.marked.get_mut(i),
+            ) {
+                *s = part;
+                *k = rank;
+                *m = false;
+            }
+            // File it in the sorted part.
+            let (store, keys) = (&*self.store, &*self.keys);
+            let key = sort_key(store, keys, i as u16);
+            let Some(sorted) = self.list.get(*front..self.len) else {
+                continue;
+            };
+            let pos = *front + sorted.partition_point(|&j| sort_key(store, keys, j) <= key);
+            self.len += 1;
+            if let Some(run) = self.list.get_mut(pos..self.len) {
+                run.rotate_right(1);
+                if let Some(first) = run.first_mut() {
+                    *first = i as u16;
+                }
+            }
+        }
+        if let Some(s) = slot.and_then(|i| self.store.get_mut(i)) {
+            // Every part was a sliver: the piece is gone.
+            *s = StoredTriangle::EMPTY;
+        }
+        Ok(())
+    }
+}
+
+/// The sorted part's order: farthest point first; on a tie the later-activated piece first.
+fn sort_key(store: &[StoredTriangle], keys: &[u32], i: u16) -> (i32, Reverse<u32>) {
+    let q = store.get(i as usize).map_or(i32::MAX, min_q);
+    (q, Reverse(keys.get(i as usize).copied().unwrap_or(0)))
+}
+
+/// Cuts `t` by `plane` into up to three triangles of the same orientation, each on one side
+/// of it (within the rounding tolerance), and how many parts the cut made (2 or 3). Parts of
+/// zero screen area are left out (`None`).
+fn cut(t: &StoredTriangle, plane: &PlaneEq) -> ([Option<StoredTriangle>; 3], usize) {
+    let s = [0, 1, 2].map(|k| plane.at(t, k).signum());
+    // Rotate so that vertex 0 is the odd one out: the vertex on the plane when one is, else
+    // the one alone on its side.
+    let lead = if let Some(z) = (0..3).find(|&k| s[k] == 0) {
+        z
+    } else {
+        (0..3)
+            .find(|&k| s[(k + 1) % 3] == s[(k + 2) % 3])
+            .unwrap_or(0)
+    };
+    let v = |k: usize| (lead + k) % 3;
+    let vertex = |k: usize| Vertex::of(t, v(k));
+    let (a, b, c) = (vertex(0), vertex(1), vertex(2));
+    let at = |u: &Vertex, w: &Vertex| {
+        let (su, sw) = (plane.at(t, u.k), plane.at(t, w.k));
+        u.toward(w, su, su - sw)
+    };
+    let tri = |p: [Vertex; 3]| make(t, p);
+    if s[v(0)] == 0 {
+        // b and c lie on opposite sides.
+        let i = at(&b, &c);
+        ([tri([a, b, i]), tri([a, i, c]), None], 2)
+    } else {
+        let (i1, i2) = (at(&a, &b), at(&a, &c));
+        ([tri([a, i1, i2]), tri([i1, b, c]), tri([i1, c, i2])], 3)
+    }
+}
+
+/// A vertex of a piece being cut: position, depth and colour.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    k: usize,
+    x: i32,
+    y: i32,
+    q: i32,
+    color: Rgb888,
+}
+
+impl Vertex {
+    fn of(t: &StoredTriangle, k: usize) -> Vertex {
+        Vertex {
+            k,
+            x: t.x[k],
+            y: t.y[k],
+            q: t.q[k],
+            color: t.colors[k],
+        }
+    }
+
+    /// The point `num/den` of the way from `self` to `w` (`0 < num/den < 1`), rounded to the
+    /// sub-pixel grid, the I2F30 step and whole colour steps.
+    fn toward(&self, w: &Vertex, num: i128, den: i128) -> Vertex {
+        let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
+        let lerp = |a: i32, b: i32| a as i128 + div_round((b as i128 - a as i128) * num, den);
+        let clamp = |v: i128| v.clamp(i32::MIN as i128, i32::MAX as i128) as i32;
+        let channel = |a: u8, b: u8| lerp(a as i32, b as i32).clamp(0, 255) as u8;
+        Vertex {
+            k: self.k,
+            x: clamp(lerp(self.x, w.x)),
+            y: clamp(lerp(self.y, w.y)),
+            q: clamp(lerp(self.q, w.q)),
+            color: Rgb888::new(
+                channel(self.color.r(), w.color.r()),
+                channel(self.color.g(), w.color.g()),
+                channel(self.color.b(), w.color.b()),
+            ),
+        }
+    }
+}
+
+/// The part of `t` with vertices `p`, or `None` if it has no screen area.
+fn make(t: &StoredTriangle, p: [Vertex; 3]) -> Option<StoredTriangle> {
+    let part = StoredTriangle {
+        x: p.map(|v| v.x),
+        y: p.map(|v| v.y),
+        q: p.map(|v| v.q),
+        id: t.id,
+        colors: p.map(|v| v.color),
+    };
+    PlaneEq::of(&part).map(|_| part)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri(x: [i32; 3], y: [i32; 3], q: [i32; 3]) -> StoredTriangle {
+        StoredTriangle {
+            x,
+            y,
+            q,
+            ..StoredTriangle::EMPTY
+        }
+    }
+
+    #[test]
+    fn a_cut_keeps_each_part_on_one_side_and_shares_the_cut() {
+        // A triangle facing the eye at q = 1000, cut by a steep plane through x = 50.
+        let t = tri([0, 100, 0], [0, 50, 100], [1000; 3]);
+        let cutter = tri([50, 51, 50], [0, 50, 100], [0, 5000, 10]);
+        let plane = PlaneEq::of(&cutter).unwrap();
+        assert!(plane.straddled_by(&t));
+        let (parts, made) = cut(&t, &plane);
+        assert_eq!((parts.iter().flatten().count(), made), (3, 3));
+        let area = |p: &StoredTriangle| PlaneEq::of(p).unwrap().n[2];
+        let total: i128 = parts.iter().flatten().map(area).sum();
+        // Up to rounding of the two cut points, the parts tile the triangle.
+        assert!((total - area(&t)).abs() <= 200, "{total} vs {}", area(&t));
+        for p in parts.iter().flatten() {
+            assert!(!plane.straddled_by(p), "{p:?}");
+        }
+    }
+
+    #[test]
+    fn touching_projections_do_not_overlap() {
+        let a = tri([0, 16, 0], [0, 0, 16], [1; 3]);
+        let b = tri([16, 16, 0], [0, 16, 16], [1; 3]);
+        assert!(!projections_overlap(&a, &b));
+        let c = tri([4, 24, 4], [4, 4, 24], [1; 3]);
+        assert!(!projections_overlap(
+            &a,
+            &tri([8, 24, 8], [8, 8, 24], [1; 3])
+        )); // a corner touches
+        assert!(projections_overlap(&a, &c));
+    }
+}
