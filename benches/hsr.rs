@@ -14,11 +14,11 @@ struct Bench<'a, 'c>(&'a mut criterion::BenchmarkGroup<'c, criterion::measuremen
 
 impl Visit for Bench<'_, '_> {
     type Error = String;
-    fn visit<M: Method, const T: usize, const A: usize>(
+    fn visit<M: Method, const T: usize, const A: usize, const K: usize>(
         &mut self,
         level: usize,
     ) -> Result<(), String> {
-        let mut ws = Box::new(M::Ws::<Rgb565, T, A>::new(Rgb565::BLACK));
+        let mut ws = Box::new(M::Ws::<Rgb565, T, A, K>::new(Rgb565::BLACK));
         let id = BenchmarkId::new(M::NAME, hsr::LEVELS[level].polygons);
         SceneSpec::hsr(level)?.with_scene(|scene| {
             self.0.bench_function(id, |b| {

@@ -28,11 +28,11 @@ fn main() -> Result<(), String> {
     struct Timing;
     impl Visit for Timing {
         type Error = String;
-        fn visit<M: Method, const T: usize, const A: usize>(
+        fn visit<M: Method, const T: usize, const A: usize, const K: usize>(
             &mut self,
             level: usize,
         ) -> Result<(), String> {
-            let mut ws = Box::new(M::Ws::<Rgb565, T, A>::new(Rgb565::BLACK));
+            let mut ws = Box::new(M::Ws::<Rgb565, T, A, K>::new(Rgb565::BLACK));
             let (hash, frames, elapsed) = SceneSpec::hsr(level)?.with_scene(|scene| {
                 let start = Instant::now();
                 let mut frames = 0u32;
@@ -145,11 +145,11 @@ mod firmware {
 
     impl Visit for Table {
         type Error = &'static str;
-        fn visit<M: Method, const T: usize, const A: usize>(
+        fn visit<M: Method, const T: usize, const A: usize, const K: usize>(
             &mut self,
             level: usize,
         ) -> Result<(), &'static str> {
-            let l = measure_one::<M::Ws<Rgb565, T, A>>(level)?;
+            let l = measure_one::<M::Ws<Rgb565, T, A, K>>(level)?;
             let s = l.stats;
             if !s.is_complete() {
                 return Err("active list overflowed: raise hsr::LEVELS' capacity");
@@ -160,7 +160,7 @@ mod firmware {
                 hsr::LEVELS[level].polygons,
                 l.instructions,
                 l.hash,
-                M::Ws::<Rgb565, T, A>::BYTES,
+                M::Ws::<Rgb565, T, A, K>::BYTES,
                 l.stack,
                 s.triangles_in,
                 s.activated,

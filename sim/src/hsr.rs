@@ -32,6 +32,9 @@ pub struct Level {
     pub tris: usize,
     /// Triangles crossing one row at most (the span z-buffer's `ACTIVE`), as measured.
     pub active: usize,
+    /// Screen pieces a splitting method (Newell) keeps: `tris` plus the pieces its splits
+    /// add, as measured (its `FrameStats::activated`).
+    pub pieces: usize,
 }
 
 /// The three sizes of the lecture's table. The capacities are what the span z-buffer's frame
@@ -42,16 +45,19 @@ pub const LEVELS: [Level; 3] = [
         polygons: 100,
         tris: 60,
         active: 23,
+        pieces: 80,
     },
     Level {
         polygons: 2500,
         tris: 1309,
         active: 106,
+        pieces: 1342,
     },
     Level {
         polygons: 60_000,
         tris: 29_476,
         active: 495,
+        pieces: 29_638,
     },
 ];
 
@@ -114,67 +120,53 @@ pub trait Method {
     /// Name in the table.
     const NAME: &'static str;
     /// The workspace.
-    type Ws<P: RowPixel, const TRIS: usize, const ACTIVE: usize>: Resolve<P>;
+    type Ws<P: RowPixel, const TRIS: usize, const ACTIVE: usize, const PIECES: usize>: Resolve<P>;
 }
 
-/// Declares a method: `method!(Marker, "name", <P, TRIS, ACTIVE> WorkspaceType)`, where the
-/// workspace type may use `P`, `TRIS` and `ACTIVE` and has the library's workspace API
-/// (`new(background)`, `render(&scene, &options, &mut sink)`, `BYTES`).
+/// Declares a method: `method!(Marker, "name", [consts it uses] WorkspaceType)`, where the
+/// workspace type may use `P` and the level's capacities `TRIS`, `ACTIVE` and `PIECES`
+/// (listing those it uses) and has the library's workspace API (`new(background)`,
+/// `render(&scene, &options, &mut sink)`, `BYTES`).
 macro_rules! method {
-    ($marker:ident, $name:literal, <$p:ident, $t:ident, $a:ident> $ws:ty) => {
-        method!(@ $marker, $name, <$p, $t, $a> [$p, $t, $a] $ws);
-    };
-    // A workspace without an active list (the full-frame z-buffer) ignores `ACTIVE`.
-    ($marker:ident, $name:literal, <$p:ident, $t:ident, _> $ws:ty) => {
-        method!(@ $marker, $name, <$p, $t, ACTIVE> [$p, $t] $ws);
-    };
-    (@ $marker:ident, $name:literal, <$p:ident, $t:ident, $a:ident> [$($g:ident),*] $ws:ty) => {
+    ($marker:ident, $name:literal, [$($c:ident),*] $ws:ty) => {
         #[doc = concat!("The `", $name, "` method.")]
         pub struct $marker;
         impl Method for $marker {
             const NAME: &'static str = $name;
-            type Ws<$p: RowPixel, const $t: usize, const $a: usize> = $ws;
+            type Ws<P: RowPixel, const TRIS: usize, const ACTIVE: usize, const PIECES: usize> = $ws;
         }
-        method!(@impl [$($g),*] $ws);
-    };
-    (@impl [$p:ident, $t:ident, $a:ident] $ws:ty) => {
-        impl<$p: RowPixel, const $t: usize, const $a: usize> Resolve<$p> for $ws {
-            method!(@body $p, $ws);
-        }
-    };
-    (@impl [$p:ident, $t:ident] $ws:ty) => {
-        impl<$p: RowPixel, const $t: usize> Resolve<$p> for $ws {
-            method!(@body $p, $ws);
-        }
-    };
-    (@body $p:ident, $ws:ty) => {
-        const BYTES: usize = <$ws>::BYTES;
-        fn new(background: $p) -> Self {
-            <$ws>::new(background)
-        }
-        fn frame<K: RowSink<$p>>(
-            &mut self,
-            scene: &Scene<'_>,
-            sink: &mut K,
-        ) -> Result<FrameStats, RenderError<K::Error>> {
-            self.render(scene, &RenderOptions::default(), sink)
+        impl<P: RowPixel, $(const $c: usize),*> Resolve<P> for $ws {
+            const BYTES: usize = <$ws>::BYTES;
+            fn new(background: P) -> Self {
+                <$ws>::new(background)
+            }
+            fn frame<K: RowSink<P>>(
+                &mut self,
+                scene: &Scene<'_>,
+                sink: &mut K,
+            ) -> Result<FrameStats, RenderError<K::Error>> {
+                self.render(scene, &RenderOptions::default(), sink)
+            }
         }
     };
 }
 
-method!(SpanZBuffer, "span-zbuffer", <P, TRIS, ACTIVE>
+method!(SpanZBuffer, "span-zbuffer", [TRIS, ACTIVE]
     scanline3d::Workspace<P, Flat, WIDTH, HEIGHT, TRIS, ACTIVE, INSTANCES>);
-method!(ZBuffer, "zbuffer", <P, TRIS, _>
+method!(ZBuffer, "zbuffer", [TRIS]
     scanline3d::resolve::ZBufferWorkspace<P, Flat, WIDTH, HEIGHT, TRIS, INSTANCES>);
-method!(Band16, "band:16", <P, TRIS, ACTIVE>
+method!(Band16, "band:16", [TRIS, ACTIVE]
     scanline3d::resolve::BandWorkspace<P, Flat, WIDTH, HEIGHT, 16, TRIS, ACTIVE, INSTANCES>);
-method!(SpanSort, "span-sort", <P, TRIS, ACTIVE>
+method!(SpanSort, "span-sort", [TRIS, ACTIVE]
     scanline3d::resolve::SpanSortWorkspace<P, Flat, WIDTH, HEIGHT, TRIS, ACTIVE, INSTANCES>);
-method!(DepthSort, "depth-sort", <P, TRIS, ACTIVE>
+method!(DepthSort, "depth-sort", [TRIS, ACTIVE]
     scanline3d::resolve::DepthSortWorkspace<P, Flat, WIDTH, HEIGHT, TRIS, ACTIVE, INSTANCES>);
+// Newell keeps every piece and the pieces it splits (`PIECES`).
+method!(Newell, "newell", [PIECES, ACTIVE]
+    scanline3d::resolve::NewellWorkspace<P, Flat, WIDTH, HEIGHT, PIECES, ACTIVE, INSTANCES>);
 // Warnock keeps every piece (`TRIS`, as no triangle of these scenes is clipped into several),
 // a window list of up to one entry per piece, and the window stack the target size needs.
-method!(Warnock, "warnock", <P, TRIS, _>
+method!(Warnock, "warnock", [TRIS]
     scanline3d::resolve::WarnockWorkspace<P, Flat, WIDTH, HEIGHT, TRIS, TRIS, WARNOCK_STACK, INSTANCES>);
 
 /// Work done for each (method, level): `visit` gets the method and the level's capacities.
@@ -182,7 +174,7 @@ pub trait Visit {
     /// Why a visit failed.
     type Error;
     /// Measures method `M` at level `level` (an index into [`LEVELS`]).
-    fn visit<M: Method, const TRIS: usize, const ACTIVE: usize>(
+    fn visit<M: Method, const TRIS: usize, const ACTIVE: usize, const PIECES: usize>(
         &mut self,
         level: usize,
     ) -> Result<(), Self::Error>;
@@ -195,12 +187,13 @@ pub fn for_each<V: Visit>(v: &mut V) -> Result<(), V::Error> {
     levels::<Band16, V>(v)?;
     levels::<SpanSort, V>(v)?;
     levels::<DepthSort, V>(v)?;
+    levels::<Newell, V>(v)?;
     levels::<Warnock, V>(v)?;
     Ok(())
 }
 
 fn levels<M: Method, V: Visit>(v: &mut V) -> Result<(), V::Error> {
-    v.visit::<M, { LEVELS[0].tris }, { LEVELS[0].active }>(0)?;
-    v.visit::<M, { LEVELS[1].tris }, { LEVELS[1].active }>(1)?;
-    v.visit::<M, { LEVELS[2].tris }, { LEVELS[2].active }>(2)
+    v.visit::<M, { LEVELS[0].tris }, { LEVELS[0].active }, { LEVELS[0].pieces }>(0)?;
+    v.visit::<M, { LEVELS[1].tris }, { LEVELS[1].active }, { LEVELS[1].pieces }>(1)?;
+    v.visit::<M, { LEVELS[2].tris }, { LEVELS[2].active }, { LEVELS[2].pieces }>(2)
 }

@@ -6,8 +6,8 @@ use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::I16F16;
 use scanline3d::resolve::bsp::{BspTree, BspWorkspace};
 use scanline3d::resolve::{
-    warnock, BandWorkspace, DepthSortWorkspace, SpanSortWorkspace, WarnockWorkspace,
-    ZBufferWorkspace,
+    warnock, BandWorkspace, DepthSortWorkspace, NewellWorkspace, SpanSortWorkspace,
+    WarnockWorkspace, ZBufferWorkspace,
 };
 use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
 use scanline3d::sink::{FnSink, Row, RowPixel, RowSink, TriangleId};
@@ -649,6 +649,8 @@ pub enum Algorithm {
     Bsp,
     /// Warnock's area subdivision ([`WarnockWorkspace`]).
     Warnock,
+    /// Newell–Newell–Sancha depth sort, splitting where needed ([`NewellWorkspace`]).
+    Newell,
 }
 
 /// Band heights `band:N` accepts (the band is a compile-time capacity).
@@ -658,7 +660,7 @@ pub const ZBUFFER_MAX_SIZE: usize = 1024;
 
 impl Algorithm {
     /// Every method `sim` offers (bands at 16 rows), for tables and tests.
-    pub const ALL: [Algorithm; 7] = [
+    pub const ALL: [Algorithm; 8] = [
         Algorithm::SpanZBuffer,
         Algorithm::ZBuffer,
         Algorithm::Band(16),
@@ -666,6 +668,7 @@ impl Algorithm {
         Algorithm::SpanSort,
         Algorithm::Bsp,
         Algorithm::Warnock,
+        Algorithm::Newell,
     ];
 
     /// Whether the method is exact by design (all but the simple depth sort).
@@ -691,6 +694,7 @@ impl std::fmt::Display for Algorithm {
             Algorithm::SpanSort => write!(f, "span-sort"),
             Algorithm::Bsp => write!(f, "bsp"),
             Algorithm::Warnock => write!(f, "warnock"),
+            Algorithm::Newell => write!(f, "newell"),
         }
     }
 }
@@ -698,7 +702,7 @@ impl std::fmt::Display for Algorithm {
 impl std::str::FromStr for Algorithm {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        let choices = "span-zbuffer, zbuffer, band:N (N in 1,2,4,...,128), depth-sort, bsp, span-sort, warnock, raycast (the f64 reference)";
+        let choices = "span-zbuffer, zbuffer, band:N (N in 1,2,4,...,128), depth-sort, newell, bsp, span-sort, warnock, raycast (the f64 reference)";
         match s {
             "span-zbuffer" => Ok(Algorithm::SpanZBuffer),
             "zbuffer" => Ok(Algorithm::ZBuffer),
@@ -706,9 +710,7 @@ impl std::str::FromStr for Algorithm {
             "span-sort" => Ok(Algorithm::SpanSort),
             "bsp" => Ok(Algorithm::Bsp),
             "warnock" => Ok(Algorithm::Warnock),
-            "newell" => Err(format!(
-                "'{s}' is not implemented yet; choose one of {choices}"
-            )),
+            "newell" => Ok(Algorithm::Newell),
             _ => match s.strip_prefix("band:").map(str::parse::<usize>) {
                 Some(Ok(n)) if BAND_CHOICES.contains(&n) => Ok(Algorithm::Band(n)),
                 Some(_) => Err(format!("band height must be one of {BAND_CHOICES:?}")),
@@ -775,6 +777,7 @@ where
             const STACK: usize = warnock::stack_needed(Z, Z);
             with!(WarnockWorkspace<P, Flat, Z, Z, TRIS, ACTIVE, STACK>)
         }
+        Algorithm::Newell => with!(NewellWorkspace<P, Flat, M, M, TRIS, ACTIVE>),
     }
     .map_err(|e| e.to_string())
 }

@@ -203,7 +203,7 @@ fn every_algorithm_renders_the_same_ids_where_it_is_exact() {
         std::fs::read(dir.join(file)).unwrap()
     };
     let span = ids("span-zbuffer");
-    for exact in ["zbuffer", "band:4", "span-sort", "bsp"] {
+    for exact in ["zbuffer", "band:4", "span-sort", "bsp", "newell", "warnock"] {
         assert_eq!(ids(exact), span, "{exact}");
     }
     // Depth sort draws the two crossing triangles in one order: wrong on one side.
@@ -217,7 +217,6 @@ fn unknown_or_unfinished_algorithms_are_one_line_errors() {
     for (bad, says) in [
         ("painter", "unknown algorithm"),
         ("band:3", "band height must be one of"),
-        ("newell", "not implemented yet"),
     ] {
         let (code, _, stderr) = sim(
             &[

@@ -340,7 +340,7 @@ struct HsrHostRun {
 
 impl scanline3d_sim::hsr::Visit for HsrHostRun {
     type Error = String;
-    fn visit<M: scanline3d_sim::hsr::Method, const T: usize, const A: usize>(
+    fn visit<M: scanline3d_sim::hsr::Method, const T: usize, const A: usize, const K: usize>(
         &mut self,
         level: usize,
     ) -> Result<(), String> {
@@ -349,7 +349,7 @@ impl scanline3d_sim::hsr::Visit for HsrHostRun {
         use scanline3d_sim::hsr::{Resolve, HEIGHT, WIDTH};
         use scanline3d_sim::{metrics, reference::Image};
         let spec = &self.specs[level];
-        let mut ws = Box::new(M::Ws::<Rgb565, T, A>::new(Rgb565::BLACK));
+        let mut ws = Box::new(M::Ws::<Rgb565, T, A, K>::new(Rgb565::BLACK));
         let (hash, stats) = spec.with_scene(|scene| {
             let mut sink = HashSink::new();
             let stats = ws.frame(scene, &mut sink).map_err(|e| e.to_string())?;
@@ -362,7 +362,7 @@ impl scanline3d_sim::hsr::Visit for HsrHostRun {
             ));
         }
         // The same frame as triangle ids and eye depth, for the comparison with the reference.
-        let mut ids = Box::new(M::Ws::<TriangleId, T, A>::new(TriangleId::NONE));
+        let mut ids = Box::new(M::Ws::<TriangleId, T, A, K>::new(TriangleId::NONE));
         let mut image = Image {
             width: WIDTH,
             height: HEIGHT,
