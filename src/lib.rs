@@ -7,7 +7,9 @@
 //! bucketed by their first row, and walked row by row with exact edge stepping. Visibility is
 //! resolved with one row of depth (the span z-buffer), and every finished row goes to a
 //! [`RowSink`](sink::RowSink): an embedded-graphics `DrawTarget`, a frame buffer or a closure
-//! that feeds a panel, with no frame buffer needed.
+//! that feeds a panel, with no frame buffer needed. The other classic hidden-surface methods
+//! (band and full-frame z-buffer, span sorting, depth sort, Newell–Newell–Sancha, BSP order,
+//! Warnock) run on the same pipeline: see [`resolve`].
 //!
 //! ```
 //! use embedded_graphics::pixelcolor::{Rgb565, Rgb888};

@@ -330,7 +330,9 @@ impl PlaneSolver {
             num_x = -num_x;
             num_y = -num_y;
         }
-        let area = self.area as i128;
+        // `area` is positive by construction; `max(1)` lets the compiler see that wherever this
+        // is not inlined, so no division-by-zero panic path exists (the panic-never check).
+        let area = self.area.max(1) as i128;
         let div = |n: i128| (2 * n + area).div_euclid(2 * area);
         let px = 1i128 << (self.sub_bits + 1 + extra); // doubled units per pixel, scaled
         let value = ((f[0] as i128) << extra)

@@ -12,17 +12,20 @@
 //! | [`SpanSortWorkspace`] | span sorting (Watkins): visible segments from depths at span ends | one row of pixels, a span list; no depth | each pixel once |
 //! | [`DepthSortWorkspace`] | depth sort / painter's: far to near by mean depth, overwriting | one row of pixels, a key per triangle; no depth | every covered pixel (overdraw) |
 //! | [`NewellWorkspace`] | depth sort (Newell, Newell and Sancha): far to near, overlaps resolved by plane and projection tests, splitting cycles and interpenetration | every kept piece and its order, one row of pixels; no depth | every covered pixel (overdraw) |
+//! | [`bsp::BspWorkspace`] | BSP tree order (Fuchs, Kedem, Naylor): far to near for any eye position, the tree built ahead of time | one row of pixels, a key per triangle, a traversal stack; no depth | every covered pixel (overdraw) |
 //! | [`WarnockWorkspace`] | area subdivision (Warnock): windows split until simple | every kept piece, a frame of pixels, a window stack and index buffer; no depth | each pixel once |
 //!
 //! The z-buffers, span sorting and area subdivision render bit-identical frames to the span z-buffer: they
 //! apply the same rule (strictly nearer wins; on an exact tie, the triangle activated first,
-//! that is the one with the higher first row, then the lower id). The depth sort is the
+//! that is the one whose first row is nearer the top, then the lower id). The depth sort is the
 //! fast baseline that is wrong where one mean depth per triangle cannot order two surfaces
 //! (interpenetration, cyclic overlap, long surfaces beside short ones).
 //!
-//! Newell's depth sort paints far to near like the depth sort, but orders overlapping pieces
-//! by exact plane and projection tests and splits cycles and interpenetration, so it differs
-//! from the span z-buffer only on a few pixels where two surfaces meet (see [`newell`]).
+//! BSP order and Newell's depth sort paint far to near like the depth sort, but are correct:
+//! the BSP tree's build split whatever no order could draw, and Newell's sort orders
+//! overlapping pieces
+//! by exact plane and projection tests and splits cycles and interpenetration. They differ
+//! from the span z-buffer only on a few pixels along split seams (see [`bsp`], [`newell`]).
 //!
 //! Methods without depth memory hand rows to the sink with an empty [`Row::depth`].
 //!
