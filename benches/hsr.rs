@@ -21,6 +21,13 @@ impl Visit for Bench<'_, '_> {
         let mut ws = Box::new(M::Ws::<Rgb565, T, A, K>::new(Rgb565::BLACK));
         let id = BenchmarkId::new(M::NAME, hsr::LEVELS[level].polygons);
         SceneSpec::hsr(level)?.with_scene(|scene| {
+            // Time only frames that render completely (a capacity error returns early).
+            let first = ws
+                .frame(scene, &mut HashSink::new())
+                .map_err(|e| format!("{} at level {level}: {e}", M::NAME))?;
+            if !first.is_complete() {
+                return Err(format!("{} at level {level}: incomplete frame", M::NAME));
+            }
             self.0.bench_function(id, |b| {
                 b.iter(|| {
                     let mut sink = HashSink::new();
@@ -28,7 +35,8 @@ impl Visit for Bench<'_, '_> {
                     sink.hash()
                 })
             });
-        })
+            Ok(())
+        })?
     }
 }
 

@@ -37,8 +37,7 @@
 //!
 //! A [`WarnockWorkspace`] holds, in bytes:
 //!
-//! * `PIECES · size_of::<StoredTriangle>()` (52): the kept pieces, and per piece its depth
-//!   plane and shading payload, solved once per frame (48 more for flat RGB565);
+//! * `PIECES · size_of::<StoredTriangle>()` (52): the kept pieces;
 //! * `W · H · size_of::<P>()`: the frame buffer (windows finish in no particular row order, so
 //!   rows reach the sink only once the whole frame is resolved);
 //! * `LIST · 2`: the window index buffer (candidate lists, see below);
@@ -191,7 +190,6 @@ pub struct WarnockWorkspace<
     const INSTANCES: usize = MAX_INSTANCES,
 > {
     store: [StoredTriangle; PIECES],
-    surfaces: [Option<Surface<S::Payload<P>>>; PIECES],
     frame: [[P; W]; H],
     background: P,
     list: [u16; LIST],
@@ -227,7 +225,6 @@ impl<
         let () = Self::VALID;
         WarnockWorkspace {
             store: [StoredTriangle::EMPTY; PIECES],
-            surfaces: [None; PIECES],
             frame: [[background; W]; H],
             background,
             list: [0; LIST],
@@ -288,14 +285,6 @@ impl<
             &mut self.store,
         )?;
         stats.activated = n as u32;
-        // Plane set-up (128-bit solves) once per piece, not once per window.
-        for (t, s) in self.store.iter().zip(self.surfaces.iter_mut()).take(n) {
-            let v: [ScreenVertex<SUB_BITS>; 3] = t.screen();
-            *s = PlaneSolver::new(&v).map(|solver| Surface {
-                plane: DepthPlane::new(&solver, &v),
-                payload: S::payload::<P, SUB_BITS>(t.face(), t.id, &solver, &v),
-            });
-        }
         let frame = self.frame.as_flattened_mut();
         for row in frame.chunks_mut(W).take(height) {
             if let Some(row) = row.get_mut(..width) {
@@ -304,7 +293,6 @@ impl<
         }
         let mut sub = Subdivision::<P, S, SUB_BITS> {
             store: self.store.get(..n).unwrap_or(&[]),
-            surfaces: self.surfaces.get(..n).unwrap_or(&[]),
             frame,
             stride: W,
             vp: &vp,
@@ -343,8 +331,7 @@ enum Class {
     Surrounds,
 }
 
-/// A piece set up for depth and paint: its plane and shading payload (solved once per frame).
-#[derive(Clone, Copy, Debug)]
+/// A piece set up for depth and paint: its plane and shading payload.
 struct Surface<T> {
     plane: DepthPlane,
     payload: T,
@@ -374,9 +361,8 @@ fn centre_at_or_after<const SUB: u32>(p: i32) -> i64 {
 }
 
 /// The subdivision of one frame.
-struct Subdivision<'a, P: Copy, S: Shading, const SUB: u32> {
+struct Subdivision<'a, P, S, const SUB: u32> {
     store: &'a [StoredTriangle],
-    surfaces: &'a [Option<Surface<S::Payload<P>>>],
     /// The frame, rows of `stride` pixels.
     frame: &'a mut [P],
     stride: usize,
@@ -540,7 +526,13 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Subdivision<'_, P, S, SUB> {
 
     /// Depth plane and paint payload of piece `i`.
     fn surface(&self, i: usize) -> Option<Surface<S::Payload<P>>> {
-        self.surfaces.get(i).copied().flatten()
+        let t = self.store.get(i)?;
+        let v: [ScreenVertex<SUB>; 3] = t.screen();
+        let solver = PlaneSolver::new(&v)?;
+        Some(Surface {
+            plane: DepthPlane::new(&solver, &v),
+            payload: S::payload::<P, SUB>(t.face(), t.id, &solver, &v),
+        })
     }
 
     /// The wrapped stepped depth of piece `i` at pixel `(x, y)`, if it covers that centre.
@@ -551,7 +543,8 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Subdivision<'_, P, S, SUB> {
         if walk.row() != y || x < l || x >= r {
             return None;
         }
-        let plane = self.surface(i)?.plane;
+        let v: [ScreenVertex<SUB>; 3] = t.screen();
+        let plane = DepthPlane::new(&PlaneSolver::new(&v)?, &v);
         Some(stepped(&plane, l, y, x) as i32)
     }
 
