@@ -373,9 +373,14 @@ impl scanline3d_sim::hsr::Visit for HsrHostRun {
         spec.with_scene(|scene| {
             let mut sink = FnSink(|row: Row<'_, TriangleId>| {
                 let start = row.y as usize * WIDTH;
-                for (x, (id, q)) in row.pixels.iter().zip(row.depth).enumerate() {
+                // Methods without depth memory send no depth: NaN over surfaces (not compared).
+                for (x, id) in row.pixels.iter().enumerate() {
                     image.ids[start + x] = id.0;
-                    image.depth[start + x] = scene.camera.eye_distance(*q).unwrap_or(f32::INFINITY);
+                    image.depth[start + x] = match row.depth.get(x) {
+                        Some(q) => scene.camera.eye_distance(*q).unwrap_or(f32::INFINITY),
+                        None if id.0 >= 0 => f32::NAN,
+                        None => f32::INFINITY,
+                    };
                 }
                 Ok::<(), std::convert::Infallible>(())
             });
@@ -414,9 +419,9 @@ fn criterion_mean_ns(method: &str, polygons: usize) -> Option<f64> {
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map(std::path::PathBuf::from)
         .unwrap_or_else(|| root().join("target"));
-    let path = target.join(format!(
-        "criterion/hsr/{method}/{polygons}/new/estimates.json"
-    ));
+    // Criterion replaces characters it does not allow in directory names ("band:16").
+    let dir = method.replace(':', "_");
+    let path = target.join(format!("criterion/hsr/{dir}/{polygons}/new/estimates.json"));
     let json = std::fs::read_to_string(path).ok()?;
     let mean = &json[json.find("\"mean\"")?..];
     let value = &mean[mean.find("\"point_estimate\":")? + "\"point_estimate\":".len()..];
