@@ -212,7 +212,7 @@ fn every_algorithm_renders_the_same_ids_where_it_is_exact() {
 }
 
 #[test]
-fn unknown_or_unfinished_algorithms_are_one_line_errors() {
+fn unknown_algorithms_are_one_line_errors() {
     let dir = scratch("bad-algorithm");
     for (bad, says) in [
         ("painter", "unknown algorithm"),
