@@ -1,4 +1,4 @@
-//! The lean firmware, shared by `lean_minimal`, `lean_full` and `lean_baseline`: renders every
+//! The lean firmware, shared by `lean_minimal`, `lean_full`, `lean_baseline` and `lean_bsp`: renders every
 //! view of the exported scene (`examples/lean/scene.rs`, written by `sim export`) into a hashing
 //! panel model, with the workspace sized by the exported budget. The shading model and the
 //! clipping stage are type parameters, so each example carries only the code its choice needs.
@@ -10,7 +10,7 @@ use embedded_graphics::pixelcolor::Rgb565;
 use scanline3d::clip::Clipping;
 use scanline3d::scene::{Camera, Instance, Light, Scene, Transform};
 use scanline3d::sink::HashSink;
-use scanline3d::{RenderOptions, Shading};
+use scanline3d::{FrameStats, RenderOptions, Shading};
 use semihosting::println;
 
 struct Line {
@@ -33,12 +33,36 @@ fn scene_for<'a>(view: usize, instances: &'a [Instance<'a>]) -> Result<Scene<'a>
     })
 }
 
-/// Renders (or, with `RENDER` false, only builds) every view. Without rendering the program is
-/// the same minus the renderer, so the difference in size between a rendering build and a
-/// non-rendering one is the renderer's.
+/// Renders (or, with `RENDER` false, only builds) every view with the exported budget's
+/// span z-buffer workspace. Without rendering the program is the same minus the renderer, so
+/// the difference in size between a rendering build and a non-rendering one is the renderer's.
 pub fn run<S: Shading, C: Clipping, const RENDER: bool>(
     name: &str,
     clipping: C,
+) -> Result<(), &'static str> {
+    type Ws<S> = scene::SceneWorkspace<Rgb565, S>;
+    run_with::<C, _, RENDER>(
+        name,
+        clipping,
+        Ws::<S>::BYTES,
+        || Ws::<S>::new(Rgb565::new(0, 0, 0)),
+        |ws, scene, options, sink| ws.render(scene, options, sink).map_err(|_| "render"),
+    )
+}
+
+/// Renders every view with the workspace `new` makes (`workspace` bytes) and `render`, and
+/// prints each view's hash and instruction count, then the variant's memory.
+pub fn run_with<C: Clipping, W, const RENDER: bool>(
+    name: &str,
+    clipping: C,
+    workspace: usize,
+    new: impl FnOnce() -> W,
+    mut render: impl FnMut(
+        &mut W,
+        &Scene<'_>,
+        &RenderOptions<4, C>,
+        &mut HashSink,
+    ) -> Result<FrameStats, &'static str>,
 ) -> Result<(), &'static str> {
     arch::start_counter()?;
     measure::calibrate()?;
@@ -53,14 +77,13 @@ pub fn run<S: Shading, C: Clipping, const RENDER: bool>(
     measure::paint_stack();
     let mut lines: [Option<Line>; scene::VIEWS.len()] = core::array::from_fn(|_| None);
     {
-        let mut ws = scene::SceneWorkspace::<Rgb565, S>::new(Rgb565::new(0, 0, 0));
+        let mut ws = new();
         for (view, line) in lines.iter_mut().enumerate() {
             let scene = scene_for(view, &instances)?;
             let mut sink = HashSink::new();
             let mark = arch::start();
             let stats = if RENDER {
-                ws.render(&scene, &options, &mut sink)
-                    .map_err(|_| "render")?
+                render(&mut ws, &scene, &options, &mut sink)?
             } else {
                 core::hint::black_box((&scene, &options, &mut ws, &mut sink));
                 Default::default()
@@ -90,7 +113,7 @@ pub fn run<S: Shading, C: Clipping, const RENDER: bool>(
         name,
         peak_stack,
         measure::static_ram(),
-        scene::SceneWorkspace::<Rgb565, S>::BYTES
+        workspace
     );
     Ok(())
 }

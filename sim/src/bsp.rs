@@ -10,7 +10,7 @@
 //! chain as deep as its triangle count.
 
 use crate::scene::MeshData;
-use scanline3d::resolve::bsp::{BspNode, NO_CHILD};
+use scanline3d::resolve::bsp::{BspNode, BspTree, NO_CHILD};
 use std::collections::HashMap;
 
 type V3 = [f64; 3];
@@ -35,6 +35,11 @@ impl Bsp {
     /// plus one.
     pub fn stack_needed(&self) -> usize {
         2 * self.depth + 1
+    }
+
+    /// The tree as the library takes it, validated.
+    pub fn tree(&self) -> Result<BspTree<'_>, String> {
+        BspTree::new(&self.nodes, self.mesh.triangles.len()).map_err(|e| format!("BSP tree: {e:?}"))
     }
 }
 

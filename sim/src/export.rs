@@ -24,6 +24,9 @@ pub struct Export<'a> {
     pub normals: bool,
     /// The command that produced the file (recorded in its header).
     pub command: String,
+    /// A BSP tree built for `mesh` (then `mesh` is the tree's split mesh): exported as
+    /// `static` nodes validated at compile time, with the traversal stack it needs.
+    pub bsp: Option<&'a crate::bsp::Bsp>,
 }
 
 /// Area-weighted vertex normals, unit length, rounded to I16F16 bits.
@@ -101,6 +104,58 @@ pub fn rustfmt(source: &str) -> Option<String> {
         .flatten()
 }
 
+/// The tree as `static` nodes (pre-order), the map back to the input triangles and the
+/// traversal stack.
+fn bsp_source(b: &crate::bsp::Bsp) -> String {
+    let mut s = String::new();
+    let child = |c: u16| {
+        if c == scanline3d::resolve::bsp::NO_CHILD {
+            "NO_CHILD".to_string()
+        } else {
+            c.to_string()
+        }
+    };
+    let _ = writeln!(
+        s,
+        "/// BSP nodes in pre-order: {} nodes, depth {}; input triangles cut by planes: {}.",
+        b.nodes.len(),
+        b.depth,
+        b.splits
+    );
+    let _ = writeln!(s, "pub static BSP_NODES: [BspNode; {}] = [", b.nodes.len());
+    for n in &b.nodes {
+        let plane = n.plane.map(|v| f32_literal(v as f64));
+        let _ = writeln!(
+            s,
+            "    BspNode {{ plane: [{}], front: {}, back: {}, first: {}, count: {} }},",
+            plane.join(", "),
+            child(n.front),
+            child(n.back),
+            n.first,
+            n.count
+        );
+    }
+    s += "];\n\n";
+    let _ = writeln!(
+        s,
+        "/// For each triangle, the input (OBJ) triangle it is, or is a piece of."
+    );
+    let _ = writeln!(s, "pub static ORIGIN: [u32; {}] = [", b.origin.len());
+    for chunk in b.origin.chunks(16) {
+        let items: Vec<String> = chunk.iter().map(|o| o.to_string()).collect();
+        let _ = writeln!(s, "    {},", items.join(", "));
+    }
+    s += "];\n\n";
+    s += "/// The tree, validated at compile time.\n";
+    s += "pub static BSP_TREE: BspTree<'static> = valid_tree(BspTree::new(&BSP_NODES, TRIANGLES.len()));\n\n";
+    let _ = writeln!(
+        s,
+        "/// Traversal stack the tree needs: two entries per level plus one."
+    );
+    let _ = writeln!(s, "pub const BSP_STACK: usize = {};\n", b.stack_needed());
+    s
+}
+
 impl Export<'_> {
     /// The generated source, laid out close to rustfmt's style (pass it through [`rustfmt`]).
     pub fn source(&self) -> String {
@@ -122,11 +177,21 @@ impl Export<'_> {
             "//! measured over {} view(s) at {}x{} with a {} % margin.",
             a.views, a.width, a.height, self.margin_percent
         );
+        if let Some(b) = self.bsp {
+            let _ = writeln!(
+                s,
+                "//! The mesh is the split mesh of a BSP tree built for the OBJ's {} triangles (`BSP_TREE`).",
+                b.origin.iter().max().map_or(0, |&o| o as usize + 1)
+            );
+        }
         s += "\n";
         let mut uses = vec!["embedded_graphics::pixelcolor::Rgb888"];
         uses.push("fixed::types::I16F16");
         uses.push("scanline3d::scene::{Mesh, MeshColors, SceneError, Vertex}");
         uses.push("scanline3d::Workspace");
+        if self.bsp.is_some() {
+            uses.push("scanline3d::resolve::bsp::{BspNode, BspTree, BspWorkspace, NO_CHILD}");
+        }
         for u in uses {
             let _ = writeln!(s, "use {u};");
         }
@@ -135,6 +200,12 @@ impl Export<'_> {
         s += "    match mesh {\n        Ok(mesh) => mesh,\n";
         s += "        // Evaluated at compile time: invalid data fails the build.\n";
         s += "        Err(_) => panic!(\"invalid mesh\"),\n    }\n}\n\n";
+        if self.bsp.is_some() {
+            s += "const fn valid_tree(tree: Result<BspTree<'static>, scanline3d::resolve::bsp::BspError>) -> BspTree<'static> {\n";
+            s += "    match tree {\n        Ok(tree) => tree,\n";
+            s += "        // Evaluated at compile time: an invalid tree fails the build.\n";
+            s += "        Err(_) => panic!(\"invalid BSP tree\"),\n    }\n}\n\n";
+        }
         let _ = writeln!(s, "/// Model-space positions (I16F16 bits).");
         let _ = writeln!(s, "pub static VERTICES: [Vertex; {nv}] = [");
         for v in &m.vertices {
@@ -185,6 +256,9 @@ impl Export<'_> {
         let _ = writeln!(s, "const NORMALS: Option<&[Vertex]> = {normals};\n");
         s += "/// The mesh, validated at compile time.\n";
         s += "pub static MESH: Mesh<'static> = valid(Mesh::new(&VERTICES, &TRIANGLES, COLORS, NORMALS));\n\n";
+        if let Some(b) = self.bsp {
+            s += &bsp_source(b);
+        }
         let _ = writeln!(s, "/// Target width the budget was measured for.");
         let _ = writeln!(s, "pub const WIDTH: usize = {};", a.width);
         let _ = writeln!(s, "/// Target height the budget was measured for.");
@@ -220,6 +294,13 @@ impl Export<'_> {
         let _ = writeln!(s, "pub const INSTANCES: usize = 1;");
         let _ = writeln!(s, "/// The workspace this budget asks for.");
         s += "pub type SceneWorkspace<P, S> =\n    Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE, INSTANCES>;\n\n";
+        if self.bsp.is_some() {
+            let _ = writeln!(
+                s,
+                "/// The BSP workspace this budget and tree ask for (painter's order from `BSP_TREE`)."
+            );
+            s += "pub type SceneBspWorkspace<P, S> =\n    BspWorkspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE, BSP_STACK>;\n\n";
+        }
         let first = self
             .views
             .first()

@@ -302,6 +302,10 @@ struct ExportArgs {
     /// Also export vertex normals (only Gouraud shading uses them).
     #[arg(long)]
     normals: bool,
+    /// Also build a BSP tree and export it (`BSP_TREE`, `SceneBspWorkspace`): the mesh becomes
+    /// the tree's split mesh, and the budget is measured for it.
+    #[arg(long)]
+    bsp: bool,
 }
 
 fn run_analysis(v: &Views) -> Result<(SceneSpec, Vec<CameraSpec>, analyze::Analysis), String> {
@@ -341,7 +345,16 @@ fn export_command(a: ExportArgs) -> Result<(), String> {
     if a.views.demo {
         return Err("export takes an OBJ scene (the demo is already built in)".into());
     }
-    let (spec, cams, analysis) = run_analysis(&a.views)?;
+    let (mut spec, cams) = a.views.resolve()?;
+    let bsp = if a.bsp {
+        let b = scanline3d_sim::bsp::build(&spec.instances[0].mesh)?;
+        spec.instances[0].mesh = b.mesh.clone();
+        Some(b)
+    } else {
+        None
+    };
+    let (w, h) = a.views.size;
+    let analysis = analyze::analyze(&spec, &cams, w, h)?;
     // The command in the header leaves out the output path, so the same scene and options
     // always produce the same file.
     let mut args = std::env::args().skip(1);
@@ -363,6 +376,7 @@ fn export_command(a: ExportArgs) -> Result<(), String> {
         margin_percent: a.views.margin,
         normals: a.normals,
         command,
+        bsp: bsp.as_ref(),
     };
     let source = export.source();
     let source = scanline3d_sim::export::rustfmt(&source).unwrap_or_else(|| {

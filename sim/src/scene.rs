@@ -1,6 +1,7 @@
 //! Scene specifications shared by the fixed-point renderer and the float reference: owned mesh
 //! data, camera and light parameters, OBJ loading, and rendering to id/depth/colour images.
 
+use crate::bsp::Bsp;
 use crate::reference::{self, Image};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::I16F16;
@@ -481,32 +482,65 @@ impl SceneSpec {
     /// black background, flat shading, 4 sub-pixel bits ([`scanline3d::sink::HashSink`]).
     /// Firmware that renders the same scene must print the same hash.
     pub fn panel_hash(&self, w: usize, h: usize) -> Result<u32, String> {
+        self.panel_hash_with(w, h, Algorithm::SpanZBuffer)
+    }
+
+    /// [`panel_hash`](Self::panel_hash) of the frame `algorithm` renders (for BSP, in the order
+    /// of the tree [`crate::bsp::build`] makes, which `sim export --bsp` exports).
+    pub fn panel_hash_with(&self, w: usize, h: usize, algorithm: Algorithm) -> Result<u32, String> {
         std::thread::scope(|scope| {
             std::thread::Builder::new()
                 .stack_size(64 << 20)
-                .spawn_scoped(scope, || self.panel_hash_on_this_thread(w, h))
+                .spawn_scoped(scope, || self.panel_hash_on_this_thread(w, h, algorithm))
                 .map_err(|e| format!("cannot start render thread: {e}"))?
                 .join()
                 .map_err(|_| "render thread panicked".to_string())?
         })
     }
 
-    fn panel_hash_on_this_thread(&self, w: usize, h: usize) -> Result<u32, String> {
+    fn panel_hash_on_this_thread(
+        &self,
+        w: usize,
+        h: usize,
+        algorithm: Algorithm,
+    ) -> Result<u32, String> {
         use embedded_graphics::pixelcolor::Rgb565;
-        let meshes = self.meshes()?;
+        let bsp = self.bsp_for(algorithm)?;
+        let tree = bsp.as_ref().map(Bsp::tree).transpose()?;
+        let meshes = match &bsp {
+            Some(b) => vec![b.mesh.mesh()?],
+            None => self.meshes()?,
+        };
         let instances = self.library_instances(&meshes);
         let scene = Scene {
             instances: &instances,
             camera: self.camera.fixed()?,
             light: self.light.fixed()?,
         };
-        type PanelWs = Workspace<Rgb565, Flat, MAX_SIZE, MAX_SIZE, 65534, 4096>;
-        let mut ws: Box<PanelWs> = Box::new(Workspace::new(Rgb565::new(0, 0, 0)));
         let mut sink = scanline3d::sink::HashSink::new();
         let options = RenderOptions::default().with_back_face_culling(self.cull_back_faces);
-        ws.render_sized(w, h, &scene, &options, &mut sink)
-            .map_err(|e| e.to_string())?;
+        render_with(
+            algorithm,
+            tree.as_ref(),
+            Rgb565::new(0, 0, 0),
+            w,
+            h,
+            &scene,
+            &options,
+            &mut sink,
+        )?;
         Ok(sink.hash())
+    }
+
+    /// The BSP tree `algorithm` renders with (built here), if it is [`Algorithm::Bsp`].
+    fn bsp_for(&self, algorithm: Algorithm) -> Result<Option<Bsp>, String> {
+        if algorithm != Algorithm::Bsp {
+            return Ok(None);
+        }
+        let [instance] = self.instances.as_slice() else {
+            return Err("bsp renders scenes of one mesh".into());
+        };
+        crate::bsp::build(&instance.mesh).map(Some)
     }
 
     fn render_fixed_on_this_thread(
@@ -540,22 +574,8 @@ impl SceneSpec {
             ));
         }
         // BSP order renders the split mesh of a tree built here, then maps ids back.
-        let bsp = match algorithm {
-            Algorithm::Bsp => {
-                let [instance] = self.instances.as_slice() else {
-                    return Err("bsp renders scenes of one mesh".into());
-                };
-                Some(crate::bsp::build(&instance.mesh)?)
-            }
-            _ => None,
-        };
-        let tree = match &bsp {
-            Some(b) => Some(
-                BspTree::new(&b.nodes, b.mesh.triangles.len())
-                    .map_err(|e| format!("BSP tree: {e:?}"))?,
-            ),
-            None => None,
-        };
+        let bsp = self.bsp_for(algorithm)?;
+        let tree = bsp.as_ref().map(Bsp::tree).transpose()?;
         let meshes = match &bsp {
             Some(b) => vec![b.mesh.mesh()?],
             None => self.meshes()?,

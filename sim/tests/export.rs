@@ -15,7 +15,17 @@ fn root() -> PathBuf {
 const LEAN_OBJ: &str = "examples/lean/icosphere80.obj";
 const LEAN_RS: &str = "examples/lean/scene.rs";
 /// The export command for it (run from the repository root).
-const LEAN_EXPORT: [&str; 4] = ["export", LEAN_OBJ, "--views", "8"];
+const LEAN_EXPORT: &[&str] = &["export", LEAN_OBJ, "--views", "8"];
+/// The lean BSP firmware's scene: the cyclic-overlap corpus scene with its BSP tree.
+const BSP_RS: &str = "examples/lean/cyclic_bsp.rs";
+const BSP_EXPORT: &[&str] = &[
+    "export",
+    "sim/corpus/cyclic.obj",
+    "--views",
+    "8",
+    "--no-cull",
+    "--bsp",
+];
 
 #[test]
 fn demo_workspace_has_exactly_the_capacities_analyze_measures() {
@@ -48,40 +58,46 @@ fn lean_obj_is_the_generated_icosphere() {
 }
 
 #[test]
-fn export_regenerates_the_committed_lean_scene_and_it_is_rustfmt_clean() {
-    let dir = std::env::temp_dir().join(format!("scanline3d-export-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let out = dir.join("scene.rs");
-    let status = Command::new(env!("CARGO_BIN_EXE_sim"))
-        .args(LEAN_EXPORT)
-        .arg("--out")
-        .arg(&out)
-        .current_dir(root())
-        .output()
-        .unwrap();
-    assert!(status.status.success(), "{status:?}");
-    let generated = std::fs::read_to_string(&out).unwrap();
-    let committed = root().join(LEAN_RS);
-    if std::env::var_os("SCANLINE3D_BLESS").is_some() {
-        std::fs::write(&committed, &generated).unwrap();
+fn export_regenerates_the_committed_lean_scenes_and_they_are_rustfmt_clean() {
+    for (i, (args, committed)) in [(LEAN_EXPORT, LEAN_RS), (BSP_EXPORT, BSP_RS)]
+        .into_iter()
+        .enumerate()
+    {
+        let dir =
+            std::env::temp_dir().join(format!("scanline3d-export-{}-{i}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let out = dir.join("scene.rs");
+        let status = Command::new(env!("CARGO_BIN_EXE_sim"))
+            .args(args)
+            .arg("--out")
+            .arg(&out)
+            .current_dir(root())
+            .output()
+            .unwrap();
+        assert!(status.status.success(), "{status:?}");
+        let generated = std::fs::read_to_string(&out).unwrap();
+        let path = root().join(committed);
+        if std::env::var_os("SCANLINE3D_BLESS").is_some() {
+            std::fs::write(&path, &generated).unwrap();
+        }
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            generated,
+            "regenerate with: cargo run -p scanline3d-sim --bin sim -- {} --out {committed}",
+            args.join(" ")
+        );
+        let fmt = Command::new("rustfmt")
+            .args(["--edition", "2021", "--check"])
+            .arg(&out)
+            .output()
+            .expect("rustfmt (installed by `cargo xtask test`)");
+        assert!(
+            fmt.status.success(),
+            "{}",
+            String::from_utf8_lossy(&fmt.stdout)
+        );
+        let _ = std::fs::remove_dir_all(dir);
     }
-    assert_eq!(
-        std::fs::read_to_string(&committed).unwrap(),
-        generated,
-        "regenerate with: cargo run -p scanline3d-sim --bin sim -- {} --out {LEAN_RS}",
-        LEAN_EXPORT.join(" ")
-    );
-    let fmt = Command::new("rustfmt")
-        .args(["--edition", "2021", "--check"])
-        .arg(&out)
-        .output()
-        .expect("rustfmt (installed by `cargo xtask test`)");
-    assert!(
-        fmt.status.success(),
-        "{}",
-        String::from_utf8_lossy(&fmt.stdout)
-    );
-    let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]

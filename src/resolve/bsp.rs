@@ -68,6 +68,11 @@ pub enum BspError {
     },
 }
 
+/// Whether node `node`'s child `c` of a tree of `len` nodes is absent or comes after it.
+const fn child_ok(c: u16, node: usize, len: usize) -> bool {
+    c == NO_CHILD || (c as usize > node && (c as usize) < len)
+}
+
 /// A BSP tree over one mesh, validated: node 0 is the root and every child comes after its
 /// parent.
 #[derive(Clone, Copy, Debug)]
@@ -86,23 +91,28 @@ impl<'a> BspTree<'a> {
     /// let cycle = BspNode { front: 0, ..leaf };
     /// assert_eq!(BspTree::new(&[cycle], 2).unwrap_err(), BspError::BadChild { node: 0 });
     /// ```
-    pub fn new(nodes: &'a [BspNode], triangles: usize) -> Result<Self, BspError> {
+    pub const fn new(nodes: &'a [BspNode], triangles: usize) -> Result<Self, BspError> {
         if nodes.is_empty() {
             return Err(BspError::Empty);
         }
+        // `while` rather than iterators: a `const fn`, so a tree exported as `static` data is
+        // validated when the firmware is built.
         let mut next_first = 0usize;
-        for (i, n) in nodes.iter().enumerate() {
-            let child_ok = |c: u16| c == NO_CHILD || (c as usize > i && (c as usize) < nodes.len());
-            if !child_ok(n.front) || !child_ok(n.back) {
+        let mut i = 0;
+        while i < nodes.len() {
+            let n = &nodes[i];
+            if !child_ok(n.front, i, nodes.len()) || !child_ok(n.back, i, nodes.len()) {
                 return Err(BspError::BadChild { node: i });
             }
             if n.first as usize != next_first || next_first + n.count as usize > triangles {
                 return Err(BspError::BadRange { node: i });
             }
             next_first += n.count as usize;
-            if !n.plane.iter().all(|v| v.is_finite()) {
+            let [a, b, c, d] = n.plane;
+            if !(a.is_finite() && b.is_finite() && c.is_finite() && d.is_finite()) {
                 return Err(BspError::BadPlane { node: i });
             }
+            i += 1;
         }
         if next_first != triangles {
             return Err(BspError::BadRange {

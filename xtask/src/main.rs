@@ -217,6 +217,9 @@ const LEAN_VARIANTS: [&str; 3] = ["minimal", "full", "baseline"];
 /// The scene the lean firmware was exported from, and how many views it was analysed from.
 const LEAN_OBJ: &str = "examples/lean/icosphere80.obj";
 const LEAN_VIEWS: usize = 8;
+/// The scene of the lean BSP build (`examples/lean_bsp.rs`), exported with
+/// `sim export sim/corpus/cyclic.obj --views 8 --no-cull --bsp`.
+const LEAN_BSP_OBJ: &str = "sim/corpus/cyclic.obj";
 
 /// Flash (vector table, code, read-only data, initialised data) of an ELF.
 fn flash_bytes(path: &std::path::Path) -> Result<u64, String> {
@@ -264,8 +267,45 @@ fn lean() -> Result<(), String> {
             .panel_hash(240, 240)
         })
         .collect::<Result<Vec<u32>, String>>()?;
+    let bsp_base = SceneSpec::single(
+        MeshData::load_obj(&root().join(LEAN_BSP_OBJ))?,
+        scanline3d_sim::scene::CameraSpec::looking_at([0.0, 0.0, 1.0], [0.0; 3], 50.0, 0.1, 10.0),
+        Default::default(),
+        false,
+    );
+    let bsp_expected = scanline3d_sim::analyze::default_views(&bsp_base, LEAN_VIEWS)?
+        .into_iter()
+        .map(|camera| {
+            SceneSpec {
+                camera,
+                ..bsp_base.clone()
+            }
+            .panel_hash_with(240, 240, scanline3d_sim::scene::Algorithm::Bsp)
+        })
+        .collect::<Result<Vec<u32>, String>>()?;
     let mut table = Vec::new();
+    let mut bsp_table = Vec::new();
     for (target, machine) in FIRMWARE {
+        step(&format!("lean firmware (bsp) on QEMU {machine}, {target}"));
+        let out = run_example(target, "lean", "lean_bsp")?;
+        print!("{out}");
+        if view_hashes(&out) != bsp_expected {
+            return Err(format!(
+                "lean_bsp on {target}: hashes {:08x?} differ from the host's BSP render of {LEAN_BSP_OBJ}: {bsp_expected:08x?}",
+                view_hashes(&out)
+            ));
+        }
+        println!("view hashes equal the host's BSP render of {LEAN_BSP_OBJ}");
+        let elf_path = root()
+            .join("target")
+            .join(target)
+            .join("lean/examples/lean_bsp");
+        bsp_table.push(format!(
+            "| {target} | {} | {} | {} |",
+            flash_bytes(&elf_path)?,
+            summary_field(&out, "workspace"),
+            summary_field(&out, "peak_stack")
+        ));
         let mut flash = std::collections::HashMap::new();
         for variant in LEAN_VARIANTS {
             step(&format!(
@@ -273,15 +313,7 @@ fn lean() -> Result<(), String> {
             ));
             let out = run_example(target, "lean", &format!("lean_{variant}"))?;
             print!("{out}");
-            let hashes: Vec<u32> = out
-                .lines()
-                .filter_map(|l| l.strip_prefix("view "))
-                .filter_map(|l| {
-                    l.split_whitespace()
-                        .nth(2)
-                        .and_then(|h| u32::from_str_radix(h, 16).ok())
-                })
-                .collect();
+            let hashes = view_hashes(&out);
             if variant != "baseline" {
                 if hashes != expected {
                     return Err(format!("lean_{variant} on {target}: hashes {hashes:08x?} differ from the host render of {LEAN_OBJ}: {expected:08x?}"));
@@ -313,7 +345,26 @@ fn lean() -> Result<(), String> {
     for row in table {
         println!("{row}");
     }
+    println!("\nlean BSP firmware, {LEAN_BSP_OBJ} (3 triangles, 7 after splitting), 240x240, `lean` profile:");
+    println!("| target | firmware flash B | workspace B | peak stack B (workspace included) |");
+    println!("|---|---|---|---|");
+    for row in bsp_table {
+        println!("{row}");
+    }
     Ok(())
+}
+
+/// The hashes of the `view N hash H ...` lines of a lean firmware's output.
+fn view_hashes(output: &str) -> Vec<u32> {
+    output
+        .lines()
+        .filter_map(|l| l.strip_prefix("view "))
+        .filter_map(|l| {
+            l.split_whitespace()
+                .nth(2)
+                .and_then(|h| u32::from_str_radix(h, 16).ok())
+        })
+        .collect()
 }
 
 /// One (method, scene size) of the hidden-surface table, as the host computes it.
