@@ -322,18 +322,18 @@ impl PlaneSolver {
     /// Solves the plane through values `f` at the three vertices (raw bits of any format below
     /// 2^32 in magnitude), returning it with `extra` more fractional bits.
     pub fn plane(&self, f: [i64; 3], extra: u32) -> Plane {
-        let (d1, d2) = ((f[1] - f[0]) as i128, (f[2] - f[0]) as i128);
+        let (d1, d2) = (f[1] - f[0], f[2] - f[0]);
         // Gradient per doubled unit = num / area.
-        let mut num_x = d1 * self.e2.1 as i128 - d2 * self.e1.1 as i128;
-        let mut num_y = d2 * self.e1.0 as i128 - d1 * self.e2.0 as i128;
+        let mut num_x = cross_diff(d1, self.e2.1, d2, self.e1.1);
+        let mut num_y = cross_diff(d2, self.e1.0, d1, self.e2.0);
         if self.flip {
             num_x = -num_x;
             num_y = -num_y;
         }
         // `area` is positive by construction; `max(1)` lets the compiler see that wherever this
         // is not inlined, so no division-by-zero panic path exists (the panic-never check).
-        let area = self.area.max(1) as i128;
-        let div = |n: i128| (2 * n + area).div_euclid(2 * area);
+        let area = self.area.max(1);
+        let div = |n: i128| round_div(n, area);
         let px = 1i128 << (self.sub_bits + 1 + extra); // doubled units per pixel, scaled
         let value = ((f[0] as i128) << extra)
             + div((num_x * self.to_ref.0 as i128 + num_y * self.to_ref.1 as i128) << extra);
@@ -344,6 +344,39 @@ impl PlaneSolver {
             dy: sat(div(num_y * px)),
         }
     }
+}
+
+/// `a·b − c·d`, exactly. When every factor fits 31 bits the products and their difference fit
+/// 63, and 64-bit multiplies give the same result as 128-bit ones, much cheaper on 32-bit cores.
+#[inline]
+fn cross_diff(a: i64, b: i64, c: i64, d: i64) -> i128 {
+    const LIMIT: u64 = 1 << 30;
+    if a.unsigned_abs() < LIMIT
+        && b.unsigned_abs() < LIMIT
+        && c.unsigned_abs() < LIMIT
+        && d.unsigned_abs() < LIMIT
+    {
+        (a * b - c * d) as i128
+    } else {
+        a as i128 * b as i128 - c as i128 * d as i128
+    }
+}
+
+/// `n / d` rounded to nearest (halves up), for `d >= 1`.
+///
+/// The numerators of small and medium triangles fit 63 bits, and then a 64-bit division gives
+/// the same quotient as a 128-bit one at a fraction of the cost on cores without a 64-bit
+/// divider (Cortex-M0: `__aeabi_ldivmod` instead of `__divti3`).
+#[inline]
+fn round_div(n: i128, d: i64) -> i128 {
+    let d = d.max(1);
+    let (num, den) = (2 * n + d as i128, 2 * d as i128);
+    if let (Ok(num), Ok(den)) = (i64::try_from(num), i64::try_from(den)) {
+        if let Some(q) = num.checked_div_euclid(den) {
+            return q as i128;
+        }
+    }
+    num.div_euclid(den.max(1))
 }
 
 /// The depth plane: `q` in I24F40 (40 fractional bits, 10 more than [`Depth`]).
@@ -486,6 +519,59 @@ pub fn first_row<const S: u32>(v: &[ScreenVertex<S>; 3], width: i32, height: i32
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The 64-bit fast paths give exactly the 128-bit results, on both sides of their limits.
+    #[test]
+    fn fast_paths_equal_wide_arithmetic() {
+        let wide_div = |n: i128, d: i64| (2 * n + d as i128).div_euclid(2 * d as i128);
+        let edges = [
+            0i128,
+            1,
+            -1,
+            i64::MAX as i128 / 2 - 1,
+            i64::MAX as i128 / 2,
+            i64::MAX as i128 / 2 + 1,
+            i64::MIN as i128 / 2,
+            i64::MIN as i128 / 2 - 1,
+            i64::MAX as i128,
+            (i64::MAX as i128) << 3,
+            -(1i128 << 100),
+        ];
+        let dens = [1i64, 2, 3, 7, 1 << 20, (1 << 40) + 1, i64::MAX / 2, i64::MAX / 2 + 1];
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for &d in &dens {
+            for &n in &edges {
+                for n in [n, -n, n + 1, n - 1] {
+                    assert_eq!(round_div(n, d), wide_div(n, d), "{n} / {d}");
+                }
+            }
+            for _ in 0..2000 {
+                let n = (next() as i64 >> (next() % 64)) as i128;
+                assert_eq!(round_div(n, d), wide_div(n, d), "{n} / {d}");
+            }
+        }
+        let limit = 1i64 << 30;
+        let factors = [0, 1, -1, limit - 1, -(limit - 1), limit, -limit, i64::MAX >> 20];
+        let wide = |a: i64, b: i64, c: i64, d: i64| a as i128 * b as i128 - c as i128 * d as i128;
+        for a in factors {
+            for b in factors {
+                for (c, d) in [(b, a), (limit - 1, -(limit - 1)), (-limit, limit), (3, 5)] {
+                    assert_eq!(cross_diff(a, b, c, d), wide(a, b, c, d));
+                }
+            }
+        }
+        for _ in 0..20000 {
+            let f = |v: u64| (v as i64) >> (v % 40 + 24);
+            let (a, b, c, d) = (f(next()), f(next()), f(next()), f(next()));
+            assert_eq!(cross_diff(a, b, c, d), wide(a, b, c, d), "{a} {b} {c} {d}");
+        }
+    }
     use std::vec::Vec;
 
     /// Independent reference: exact edge functions with the top-left tie rule.
