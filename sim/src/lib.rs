@@ -22,6 +22,8 @@ pub mod meshgen;
 #[cfg(not(target_os = "none"))]
 pub mod metrics;
 #[cfg(not(target_os = "none"))]
+pub mod peers;
+#[cfg(not(target_os = "none"))]
 pub mod reference;
 #[cfg(not(target_os = "none"))]
 pub mod scene;
