@@ -537,7 +537,16 @@ mod tests {
             (i64::MAX as i128) << 3,
             -(1i128 << 100),
         ];
-        let dens = [1i64, 2, 3, 7, 1 << 20, (1 << 40) + 1, i64::MAX / 2, i64::MAX / 2 + 1];
+        let dens = [
+            1i64,
+            2,
+            3,
+            7,
+            1 << 20,
+            (1 << 40) + 1,
+            i64::MAX / 2,
+            i64::MAX / 2 + 1,
+        ];
         let mut x = 0x9E37_79B9_7F4A_7C15u64;
         let mut next = || {
             x ^= x << 13;
@@ -557,7 +566,16 @@ mod tests {
             }
         }
         let limit = 1i64 << 30;
-        let factors = [0, 1, -1, limit - 1, -(limit - 1), limit, -limit, i64::MAX >> 20];
+        let factors = [
+            0,
+            1,
+            -1,
+            limit - 1,
+            -(limit - 1),
+            limit,
+            -limit,
+            i64::MAX >> 20,
+        ];
         let wide = |a: i64, b: i64, c: i64, d: i64| a as i128 * b as i128 - c as i128 * d as i128;
         for a in factors {
             for b in factors {

@@ -467,17 +467,191 @@ fn fields(line: &str) -> std::collections::HashMap<&str, &str> {
 
 /// Mean time per frame (ns) from a criterion run of `cargo bench --bench hsr`, if there is one.
 fn criterion_mean_ns(method: &str, polygons: usize) -> Option<f64> {
+    criterion_mean_ns_of("hsr", method, &polygons.to_string())
+}
+
+/// Mean time (ns) of criterion benchmark `group/function/parameter` from the last run.
+fn criterion_mean_ns_of(group: &str, function: &str, parameter: &str) -> Option<f64> {
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map(std::path::PathBuf::from)
         .unwrap_or_else(|| root().join("target"));
     // Criterion replaces characters it does not allow in directory names ("band:16").
-    let dir = method.replace(':', "_");
-    let path = target.join(format!("criterion/hsr/{dir}/{polygons}/new/estimates.json"));
+    let dir = function.replace(':', "_");
+    let path = target.join(format!(
+        "criterion/{group}/{dir}/{parameter}/new/estimates.json"
+    ));
     let json = std::fs::read_to_string(path).ok()?;
     let mean = &json[json.find("\"mean\"")?..];
     let value = &mean[mean.find("\"point_estimate\":")? + "\"point_estimate\":".len()..];
     let end = value.find([',', '}'])?;
     value[..end].trim().parse().ok()
+}
+
+/// The host's CPU model (for the tables' headers).
+fn host_cpu() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines().find_map(|l| {
+                l.strip_prefix("model name")
+                    .map(|v| v.trim_start_matches([' ', '\t', ':']).to_owned())
+            })
+        })
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// `cargo xtask peers`: ours against the peer renderers (`euc`, `embedded-3dgfx`) on the
+/// corpus, time per frame from one criterion run (`cargo bench --bench peers`) and mismatch
+/// against the f64 reference, into `docs/peers.md`.
+fn peers() -> Result<(), String> {
+    use scanline3d_sim::peers::{self, Peer};
+    const SIZE: usize = 240;
+    step("criterion: ours and the peers, every corpus scene (cargo bench --bench peers)");
+    run(cargo().args(["bench", "--bench", "peers"]))?;
+    step("ours and the peers against the f64 reference (every corpus scene and camera)");
+    let rows = peers::corpus_table(SIZE, SIZE)?;
+    let scenes: Vec<&str> = scanline3d_sim::corpus::all()
+        .iter()
+        .map(|s| s.name)
+        .collect();
+    let renderers = ["ours", "euc", "embedded-3dgfx", "embedded-3dgfx-1mesh"];
+    let mut md = String::new();
+    let mut line = |s: String| {
+        md.push_str(&s);
+        md.push('\n');
+    };
+    line("# Ours against the peer renderers".into());
+    line(String::new());
+    line("Written by `cargo xtask peers`; do not edit by hand. Every corpus scene at 240×240, rendered by".into());
+    line(format!(
+        "scanline3d's default (`Workspace`: span z-buffer, flat shading, 4 sub-pixel bits) and by the peers a user would otherwise pick: [`euc`](https://crates.io/crates/euc) {} and [`embedded-3dgfx`](https://crates.io/crates/embedded-3dgfx) {}. How the peers are driven (id images through per-triangle colours, cameras, what is set up once) is in `sim/src/peers.rs`.",
+        peers::EUC_VERSION,
+        peers::EMBEDDED_3DGFX_VERSION
+    ));
+    line(String::new());
+    line(format!(
+        "Host: {} ({}). Times: criterion means from `cargo bench --bench peers`, one run, camera 0 of each scene, each renderer writing a whole Rgb565 frame; ours also lights every face (Lambert), the peers draw flat colours.",
+        host_cpu(),
+        first_line(Command::new("rustc").arg("--version"))
+    ));
+    line(String::new());
+    line("## Time per frame".into());
+    line(String::new());
+    line("Ratio = the peer's time / ours (above 1: ours is faster). `embedded-3dgfx` draws one mesh per triangle, the only way it has to give each face its own colour as ours does; `embedded-3dgfx-1mesh` draws the whole scene as one mesh in one colour, its cheapest frame, for scale (not the same picture).".into());
+    line(String::new());
+    line("| scene | ours | euc | embedded-3dgfx | embedded-3dgfx-1mesh |".into());
+    line("|---|---|---|---|---|".into());
+    let mut slower = Vec::new();
+    for scene in &scenes {
+        let times: Vec<Option<f64>> = renderers
+            .iter()
+            .map(|r| criterion_mean_ns_of("peers", r, scene))
+            .collect();
+        let ours = times[0].ok_or_else(|| format!("no criterion result for ours/{scene}"))?;
+        let mut cells = vec![format!("{:.1} µs", ours / 1000.0)];
+        for (r, t) in renderers.iter().zip(&times).skip(1) {
+            let t = t.ok_or_else(|| format!("no criterion result for {r}/{scene}"))?;
+            let ratio = t / ours;
+            if ratio < 2.0 {
+                slower.push(format!("{r} on {scene}: {ratio:.2}×"));
+            }
+            cells.push(format!("{:.1} µs ({ratio:.2}×)", t / 1000.0));
+        }
+        line(format!("| {scene} | {} |", cells.join(" | ")));
+    }
+    line(String::new());
+    if slower.is_empty() {
+        line("Ours is at least 2× faster than every peer on every scene.".into());
+    } else {
+        line(format!(
+            "Where ours is not at least 2× faster (peer time / ours): {}.",
+            slower.join("; ")
+        ));
+    }
+    line(String::new());
+    line("## Accuracy against the f64 reference".into());
+    line(String::new());
+    line("Every camera of each scene, judged by `metrics::compare` with our default error bound (4 sub-pixel bits) for every renderer. Id mismatches: pixels showing another triangle than the reference (worst camera, percent of the frame); real: mismatches not explained by the bound, summed over cameras; max px: the largest distance from a mismatching pixel centre to an edge of the triangles involved. A peer that cannot render a scene correctly is marked, not dropped.".into());
+    line(String::new());
+    line("| scene | cameras | renderer | id mismatches (worst) | real | max px |".into());
+    line("|---|---|---|---|---|---|".into());
+    for scene in &scenes {
+        let of_scene: Vec<_> = rows.iter().filter(|r| r.scene == *scene).collect();
+        let outcomes = |name: &str| -> Vec<&peers::Outcome> {
+            of_scene
+                .iter()
+                .map(|r| {
+                    if name == "ours" {
+                        &r.ours
+                    } else {
+                        &r.peers
+                            .iter()
+                            .find(|(p, _)| p.name() == name)
+                            .expect("every peer has a row")
+                            .1
+                    }
+                })
+                .collect()
+        };
+        for name in ["ours", "euc", "embedded-3dgfx"] {
+            let o = outcomes(name);
+            let failed: Vec<&str> = o
+                .iter()
+                .filter_map(|o| o.metrics.as_ref().err().map(String::as_str))
+                .collect();
+            if let Some(e) = failed.first() {
+                line(format!(
+                    "| {scene} | {} | {name} | failed: {e} | | |",
+                    o.len()
+                ));
+                continue;
+            }
+            let m: Vec<_> = o.iter().filter_map(|o| o.metrics.as_ref().ok()).collect();
+            let worst = m
+                .iter()
+                .map(|m| m.id_mismatch_percent())
+                .fold(0.0, f64::max);
+            let real: usize = m.iter().map(|m| m.real).sum();
+            let max_px = o.iter().map(|o| o.max_edge_distance).fold(0.0, f64::max);
+            let mark = if real > 0 { " **wrong**" } else { "" };
+            line(format!(
+                "| {scene} | {} | {name} | {worst:.3} % | {real}{mark} | {max_px:.2} |",
+                o.len()
+            ));
+        }
+    }
+    line(String::new());
+    line("## What each peer does".into());
+    line(String::new());
+    let caps: Vec<_> = Peer::ALL.iter().map(|p| p.capabilities()).collect();
+    line(format!(
+        "| | {} |",
+        caps.iter()
+            .map(|c| format!("{} {}", c.name, c.version))
+            .collect::<Vec<_>>()
+            .join(" | ")
+    ));
+    line(format!("|---|{}", "---|".repeat(caps.len())));
+    type Field = fn(&peers::Capabilities) -> &'static str;
+    let fields: [(&str, Field); 7] = [
+        ("near plane", |c| c.near),
+        ("far plane", |c| c.far),
+        ("depth", |c| c.depth),
+        ("sub-pixel precision", |c| c.sub_pixel),
+        ("fill rule", |c| c.fill_rule),
+        ("back faces", |c| c.back_faces),
+        ("colours", |c| c.colours),
+    ];
+    for (name, get) in fields {
+        line(format!(
+            "| {name} | {} |",
+            caps.iter().map(get).collect::<Vec<_>>().join(" | ")
+        ));
+    }
+    let path = root().join("docs/peers.md");
+    std::fs::write(&path, md).map_err(|e| format!("{}: {e}", path.display()))?;
+    println!("wrote {}", path.display());
+    Ok(())
 }
 
 /// `n` with thousands separators, as the README writes figures.
@@ -636,15 +810,7 @@ fn hsr_table() -> Result<(), String> {
         .collect();
     let qemu = first_line(Command::new("qemu-system-arm").arg("--version"));
     let rustc = first_line(Command::new("rustc").arg("--version"));
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|s| {
-            s.lines().find_map(|l| {
-                l.strip_prefix("model name")
-                    .map(|v| v.trim_start_matches([' ', '\t', ':']).to_owned())
-            })
-        })
-        .unwrap_or_else(|| "unknown".into());
+    let cpu = host_cpu();
 
     let mut md = String::new();
     let mut line = |s: String| {
@@ -1002,6 +1168,7 @@ fn main() -> ExitCode {
         "test" => test(),
         "firmware" => install().and_then(|_| firmware()),
         "lean" => install().and_then(|_| lean()),
+        "peers" => peers(),
         // The host renders build whole-frame workspaces (megabytes at 60,000 polygons) by value:
         // give them a thread with room for that.
         "hsr-table" => install().and_then(|_| {
@@ -1020,7 +1187,9 @@ fn main() -> ExitCode {
             fuzz(seconds)
         }
         _ => {
-            eprintln!("usage: cargo xtask test | firmware | lean | hsr-table | fuzz [SECONDS]");
+            eprintln!(
+                "usage: cargo xtask test | firmware | lean | hsr-table | peers | fuzz [SECONDS]"
+            );
             return ExitCode::from(2);
         }
     };
