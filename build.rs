@@ -128,6 +128,12 @@ REGION_ALIAS(\"REGION_HEAP\", RAM);\nREGION_ALIAS(\"REGION_STACK\", RAM);\n";
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=sim/src/meshgen.rs");
+    // `examples/tradeoff.rs` renders every precision variant, or with
+    // `--cfg scanline3d_variant="fast"` (passed by `cargo xtask tradeoff` through `cargo rustc`)
+    // only that preset, so each preset's flash can be measured alone.
+    println!(
+        "cargo::rustc-check-cfg=cfg(scanline3d_variant, values(\"fast\", \"balanced\", \"exact\", \"bits0\", \"micromath\"))"
+    );
     // The firmware example links with the runtime's link.x. On Arm, cortex-m-rt's link.x
     // includes memory.x from the linker search path (the top-level one). On RISC-V,
     // `.cargo/config.toml` passes memory-riscv-virt.x (QEMU virt's RAM, with the region

@@ -86,6 +86,7 @@ extern crate std;
 pub mod clip;
 pub mod demo;
 pub mod math;
+pub mod preset;
 pub mod project;
 pub mod raster;
 pub mod render;

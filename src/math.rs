@@ -15,6 +15,8 @@
 /// assert!((Micromath::sqrt(2.0) - 1.414_213_5).abs() < 1e-2);
 /// ```
 pub trait MathBackend {
+    /// The backend's name ("libm", "micromath").
+    const NAME: &'static str;
     /// Sine of an angle in radians.
     fn sin(x: f32) -> f32;
     /// Cosine of an angle in radians.
@@ -30,6 +32,7 @@ pub trait MathBackend {
 pub struct Libm;
 
 impl MathBackend for Libm {
+    const NAME: &'static str = "libm";
     fn sin(x: f32) -> f32 {
         libm::sinf(x)
     }
@@ -52,6 +55,7 @@ impl MathBackend for Libm {
 pub struct Micromath;
 
 impl MathBackend for Micromath {
+    const NAME: &'static str = "micromath";
     fn sin(x: f32) -> f32 {
         micromath::F32Ext::sin(x)
     }

@@ -27,6 +27,8 @@ pub mod peers;
 pub mod reference;
 #[cfg(not(target_os = "none"))]
 pub mod scene;
+#[cfg(not(target_os = "none"))]
+pub mod tradeoff;
 
 #[cfg(not(target_os = "none"))]
 use metrics::{ErrorBound, Metrics};
@@ -55,6 +57,31 @@ pub fn accuracy_with(
     algorithm: scene::Algorithm,
 ) -> Result<(Metrics, scene::FixedRender, reference::Image), String> {
     let fixed = spec.render_fixed_with(w, h, sub_bits, algorithm)?;
+    judge(spec, w, h, sub_bits, fixed)
+}
+
+#[cfg(not(target_os = "none"))]
+/// [`accuracy_with`] at the sub-pixel bits and set-up math of a precision preset.
+pub fn accuracy_preset(
+    spec: &SceneSpec,
+    w: usize,
+    h: usize,
+    preset: scene::PresetChoice,
+    algorithm: scene::Algorithm,
+) -> Result<(Metrics, scene::FixedRender, reference::Image), String> {
+    let fixed = spec.render_fixed_preset(w, h, preset, algorithm)?;
+    judge(spec, w, h, preset.sub_bits(), fixed)
+}
+
+#[cfg(not(target_os = "none"))]
+/// Compares a fixed-point render with the reference under the error bound of `sub_bits`.
+fn judge(
+    spec: &SceneSpec,
+    w: usize,
+    h: usize,
+    sub_bits: u32,
+    fixed: scene::FixedRender,
+) -> Result<(Metrics, scene::FixedRender, reference::Image), String> {
     let reference = spec.reference()?;
     let ref_image = reference.render(w, h);
     let bound = ErrorBound {

@@ -7,8 +7,10 @@
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use scanline3d_sim::metrics::{self, ErrorBound};
 use scanline3d_sim::reference::Image;
-use scanline3d_sim::scene::{self, Algorithm, CameraSpec, LightSpec, MeshData, SceneSpec};
-use scanline3d_sim::{accuracy, accuracy_with, analyze, corpus};
+use scanline3d_sim::scene::{
+    self, Algorithm, CameraSpec, LightSpec, MeshData, PresetChoice, SceneSpec,
+};
+use scanline3d_sim::{accuracy, accuracy_preset, accuracy_with, analyze, corpus};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -135,6 +137,10 @@ struct View {
     /// Sub-pixel bits of the fixed-point renderer: 0, 2, 4 (default) or 8.
     #[arg(long, default_value_t = 4)]
     sub_pixel_bits: u32,
+    /// Precision preset (scanline3d::preset): fast, balanced (the default settings) or exact.
+    /// Sets the sub-pixel bits and the set-up math together.
+    #[arg(long, conflicts_with = "sub_pixel_bits")]
+    preset: Option<PresetChoice>,
     /// Draw back faces too (open surfaces).
     #[arg(long)]
     no_cull: bool,
@@ -142,6 +148,13 @@ struct View {
     /// depth-sort, span-sort, or raycast (the f64 reference ray caster).
     #[arg(long, value_parser = method, default_value = "span-zbuffer")]
     algorithm: Method,
+}
+
+impl View {
+    /// The sub-pixel bits in effect (the preset's, if one was chosen).
+    fn sub_bits(&self) -> u32 {
+        self.preset.map_or(self.sub_pixel_bits, |p| p.sub_bits())
+    }
 }
 
 /// What `--algorithm` selects: a fixed-point method, or the f64 ray caster.
@@ -433,11 +446,18 @@ fn render(a: RenderArgs) -> Result<(), String> {
     };
     let (image, stats_json) = match renderer {
         Some(algorithm) => {
-            let r = spec.render_fixed_with(w, h, a.view.sub_pixel_bits, algorithm)?;
+            let r = match a.view.preset {
+                Some(p) => spec.render_fixed_preset(w, h, p, algorithm)?,
+                None => spec.render_fixed_with(w, h, a.view.sub_pixel_bits, algorithm)?,
+            };
             let s = r.stats;
+            let preset = a
+                .view
+                .preset
+                .map_or("null".to_string(), |p| format!("\"{p}\""));
             let json = format!(
-                "{{\"renderer\": \"fixed\", \"algorithm\": \"{algorithm}\", \"sub_pixel_bits\": {}, \"width\": {w}, \"height\": {h}, \"triangles_in\": {}, \"culled\": {}, \"clipped\": {}, \"rejected\": {}, \"drawn\": {}, \"spans\": {}, \"fragments\": {}, \"pixels_written\": {}, \"peak_active\": {}, \"dropped\": {}}}\n",
-                a.view.sub_pixel_bits, s.triangles_in, s.culled, s.clipped, s.rejected, s.activated, s.spans, s.fragments, s.pixels_written, s.peak_active, s.dropped
+                "{{\"renderer\": \"fixed\", \"algorithm\": \"{algorithm}\", \"preset\": {preset}, \"sub_pixel_bits\": {}, \"width\": {w}, \"height\": {h}, \"triangles_in\": {}, \"culled\": {}, \"clipped\": {}, \"rejected\": {}, \"drawn\": {}, \"spans\": {}, \"fragments\": {}, \"pixels_written\": {}, \"peak_active\": {}, \"dropped\": {}}}\n",
+                a.view.sub_bits(), s.triangles_in, s.culled, s.clipped, s.rejected, s.activated, s.spans, s.fragments, s.pixels_written, s.peak_active, s.dropped
             );
             (r.image, json)
         }
@@ -499,11 +519,18 @@ fn compare(a: CompareArgs) -> Result<(), String> {
         let Method::Fixed(algorithm) = a.view.algorithm else {
             return Err("raycast is the reference itself: choose a fixed-point --algorithm".into());
         };
-        let (m, fixed, reference) = accuracy_with(&spec, w, h, a.view.sub_pixel_bits, algorithm)?;
+        let (m, fixed, reference) = match a.view.preset {
+            Some(p) => accuracy_preset(&spec, w, h, p, algorithm)?,
+            None => accuracy_with(&spec, w, h, a.view.sub_pixel_bits, algorithm)?,
+        };
+        let preset = a
+            .view
+            .preset
+            .map_or(String::new(), |p| format!(" (preset {p})"));
         say!(
-            "{} at {w}x{h}, {} sub-pixel bits, {algorithm}, fixed-point vs f64 reference:",
+            "{} at {w}x{h}, {} sub-pixel bits{preset}, {algorithm}, fixed-point vs f64 reference:",
             path.display(),
-            a.view.sub_pixel_bits
+            a.view.sub_bits()
         );
         say!("{m}");
         if let Some(p) = &a.side_by_side {

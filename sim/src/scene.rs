@@ -5,6 +5,8 @@ use crate::bsp::Bsp;
 use crate::reference::{self, Image};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::I16F16;
+use scanline3d::math::{Libm, MathBackend, Micromath};
+use scanline3d::preset::{self, Preset};
 use scanline3d::resolve::bsp::{BspTree, BspWorkspace};
 use scanline3d::resolve::{
     warnock, BandWorkspace, DepthSortWorkspace, NewellWorkspace, SpanSortWorkspace,
@@ -225,9 +227,20 @@ impl CameraSpec {
 
     /// The library camera.
     pub fn fixed(&self) -> Result<Camera, String> {
-        Camera::look_at(f32s(self.eye), f32s(self.target), f32s(self.up))
-            .and_then(|v| v.perspective(self.fovy as f32, self.near as f32, self.far as f32))
-            .map_err(|e| e.to_string())
+        self.fixed_with(SetupMath::Libm)
+    }
+
+    /// [`Self::fixed`] with set-up computed by `math`.
+    pub fn fixed_with(&self, math: SetupMath) -> Result<Camera, String> {
+        fn with<M: MathBackend>(c: &CameraSpec) -> Result<Camera, scanline3d::scene::SceneError> {
+            Camera::look_at_with::<M>(f32s(c.eye), f32s(c.target), f32s(c.up))
+                .and_then(|v| v.perspective_with::<M>(c.fovy as f32, c.near as f32, c.far as f32))
+        }
+        match math {
+            SetupMath::Libm => with::<Libm>(self),
+            SetupMath::Micromath => with::<Micromath>(self),
+        }
+        .map_err(|e| e.to_string())
     }
     /// The reference camera.
     pub fn reference(&self) -> Result<reference::Camera, String> {
@@ -385,11 +398,20 @@ impl SceneSpec {
     /// workspace). The camera and light are built from the specs as [`Self::render_fixed`]
     /// builds them.
     pub fn with_scene<R>(&self, f: impl FnOnce(&Scene<'_>) -> R) -> Result<R, String> {
+        self.with_scene_math(SetupMath::Libm, f)
+    }
+
+    /// [`Self::with_scene`] with the camera set up by `math`.
+    pub fn with_scene_math<R>(
+        &self,
+        math: SetupMath,
+        f: impl FnOnce(&Scene<'_>) -> R,
+    ) -> Result<R, String> {
         let meshes = self.meshes()?;
         let instances = self.library_instances(&meshes);
         let scene = Scene {
             instances: &instances,
-            camera: self.camera.fixed()?,
+            camera: self.camera.fixed_with(math)?,
             light: self.light.fixed()?,
         };
         Ok(f(&scene))
@@ -446,6 +468,30 @@ impl SceneSpec {
         sub_bits: u32,
         algorithm: Algorithm,
     ) -> Result<FixedRender, String> {
+        self.render_fixed_settings(w, h, sub_bits, SetupMath::Libm, algorithm)
+    }
+
+    /// [`Self::render_fixed_with`] with the sub-pixel bits and set-up math of a precision preset
+    /// (`scanline3d::preset`).
+    pub fn render_fixed_preset(
+        &self,
+        w: usize,
+        h: usize,
+        preset: PresetChoice,
+        algorithm: Algorithm,
+    ) -> Result<FixedRender, String> {
+        self.render_fixed_settings(w, h, preset.sub_bits(), preset.math(), algorithm)
+    }
+
+    /// [`Self::render_fixed_with`] at `sub_bits` with set-up computed by `math`.
+    pub fn render_fixed_settings(
+        &self,
+        w: usize,
+        h: usize,
+        sub_bits: u32,
+        math: SetupMath,
+        algorithm: Algorithm,
+    ) -> Result<FixedRender, String> {
         // The host workspaces are large (capacity for 2048×2048 and 65534 triangles) and the
         // library builds them by value, which in debug builds goes through the stack: render on
         // a thread with room for that.
@@ -453,7 +499,7 @@ impl SceneSpec {
             std::thread::Builder::new()
                 .stack_size(256 << 20)
                 .spawn_scoped(scope, || {
-                    self.render_fixed_on_this_thread(w, h, sub_bits, algorithm)
+                    self.render_fixed_on_this_thread(w, h, sub_bits, math, algorithm)
                 })
                 .map_err(|e| format!("cannot start render thread: {e}"))?
                 .join()
@@ -548,13 +594,14 @@ impl SceneSpec {
         w: usize,
         h: usize,
         sub_bits: u32,
+        math: SetupMath,
         algorithm: Algorithm,
     ) -> Result<FixedRender, String> {
         match sub_bits {
-            0 => self.render_fixed_s::<0>(w, h, algorithm),
-            2 => self.render_fixed_s::<2>(w, h, algorithm),
-            4 => self.render_fixed_s::<4>(w, h, algorithm),
-            8 => self.render_fixed_s::<8>(w, h, algorithm),
+            0 => self.render_fixed_s::<0>(w, h, math, algorithm),
+            2 => self.render_fixed_s::<2>(w, h, math, algorithm),
+            4 => self.render_fixed_s::<4>(w, h, math, algorithm),
+            8 => self.render_fixed_s::<8>(w, h, math, algorithm),
             _ => Err(format!(
                 "sub-pixel bits must be one of {SUB_PIXEL_CHOICES:?}"
             )),
@@ -565,6 +612,7 @@ impl SceneSpec {
         &self,
         w: usize,
         h: usize,
+        math: SetupMath,
         algorithm: Algorithm,
     ) -> Result<FixedRender, String> {
         let max = algorithm.max_size();
@@ -581,7 +629,7 @@ impl SceneSpec {
             None => self.meshes()?,
         };
         let instances = self.library_instances(&meshes);
-        let camera = self.camera.fixed()?;
+        let camera = self.camera.fixed_with(math)?;
         let scene = Scene {
             instances: &instances,
             camera,
@@ -648,6 +696,90 @@ impl SceneSpec {
             }
         }
         Ok(FixedRender { image, stats })
+    }
+}
+
+/// Math backend of the per-frame set-up (`scanline3d::math`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SetupMath {
+    /// [`Libm`]: accurate (the default).
+    Libm,
+    /// [`Micromath`]: approximate, smaller.
+    Micromath,
+}
+
+/// A precision preset of `scanline3d::preset`, chosen at run time (`sim render --preset`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PresetChoice {
+    /// [`preset::Fast`].
+    Fast,
+    /// [`preset::Balanced`] (the default).
+    Balanced,
+    /// [`preset::Exact`].
+    Exact,
+}
+
+impl PresetChoice {
+    /// Every preset, fastest first.
+    pub const ALL: [PresetChoice; 3] = [
+        PresetChoice::Fast,
+        PresetChoice::Balanced,
+        PresetChoice::Exact,
+    ];
+
+    /// Its name in `scanline3d::preset`.
+    pub fn name(self) -> &'static str {
+        match self {
+            PresetChoice::Fast => preset::Fast::NAME,
+            PresetChoice::Balanced => preset::Balanced::NAME,
+            PresetChoice::Exact => preset::Exact::NAME,
+        }
+    }
+
+    /// Its sub-pixel bits.
+    pub fn sub_bits(self) -> u32 {
+        match self {
+            PresetChoice::Fast => preset::Fast::SUB_BITS,
+            PresetChoice::Balanced => preset::Balanced::SUB_BITS,
+            PresetChoice::Exact => preset::Exact::SUB_BITS,
+        }
+    }
+
+    /// Its set-up math.
+    pub fn math(self) -> SetupMath {
+        fn of<P: Preset>() -> SetupMath {
+            if P::Math::NAME == Micromath::NAME {
+                SetupMath::Micromath
+            } else {
+                SetupMath::Libm
+            }
+        }
+        match self {
+            PresetChoice::Fast => of::<preset::Fast>(),
+            PresetChoice::Balanced => of::<preset::Balanced>(),
+            PresetChoice::Exact => of::<preset::Exact>(),
+        }
+    }
+}
+
+impl std::fmt::Display for PresetChoice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for PresetChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        PresetChoice::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| {
+                format!(
+                    "unknown preset '{s}'; choose one of {}",
+                    preset::NAMES.join(", ")
+                )
+            })
     }
 }
 

@@ -233,3 +233,65 @@ fn unknown_algorithms_are_one_line_errors() {
         assert!(stderr.contains(says), "{bad}: {stderr}");
     }
 }
+
+#[test]
+fn presets_set_sub_pixel_bits_and_set_up_math_together() {
+    let dir = scratch("preset");
+    let ids = |preset: &[&str], name: &str| {
+        let (code, _, stderr) = sim(
+            &[
+                &[
+                    "render",
+                    &corpus("pawn"),
+                    "--eye",
+                    "-2.2,1.6,3.2",
+                    "--size",
+                    "96x96",
+                ][..],
+                preset,
+                &["--ids", name, "--stats", &format!("{name}.json")],
+            ]
+            .concat(),
+            &dir,
+        );
+        assert_eq!(code, 0, "{stderr}");
+        let stats = std::fs::read_to_string(dir.join(format!("{name}.json"))).unwrap();
+        (std::fs::read(dir.join(name)).unwrap(), stats)
+    };
+    // Balanced is the default settings exactly; exact is 8 sub-pixel bits with libm set-up.
+    let (default, _) = ids(&[], "default.ids");
+    let (balanced, stats) = ids(&["--preset", "balanced"], "balanced.ids");
+    assert_eq!(default, balanced);
+    assert!(
+        stats.contains("\"preset\": \"balanced\", \"sub_pixel_bits\": 4"),
+        "{stats}"
+    );
+    let (bits8, _) = ids(&["--sub-pixel-bits", "8"], "bits8.ids");
+    let (exact, stats) = ids(&["--preset", "exact"], "exact.ids");
+    assert_eq!(bits8, exact);
+    assert!(stats.contains("\"sub_pixel_bits\": 8"), "{stats}");
+    // Fast is 2 bits with libm set-up, a coarser frame than the default.
+    let (bits2, _) = ids(&["--sub-pixel-bits", "2"], "bits2.ids");
+    let (fast, stats) = ids(&["--preset", "fast"], "fast.ids");
+    assert_eq!(bits2, fast);
+    assert_ne!(fast, balanced);
+    assert!(
+        stats.contains("\"preset\": \"fast\", \"sub_pixel_bits\": 2"),
+        "{stats}"
+    );
+    // A preset and explicit sub-pixel bits conflict; unknown presets are named.
+    for (args, says) in [
+        (
+            &["--preset", "fast", "--sub-pixel-bits", "2"][..],
+            "cannot be used with",
+        ),
+        (
+            &["--preset", "nope"][..],
+            "choose one of fast, balanced, exact",
+        ),
+    ] {
+        let (code, _, stderr) = sim(&[&["render", &corpus("cube")][..], args].concat(), &dir);
+        assert_eq!(code, 2, "{stderr}");
+        assert!(stderr.contains(says), "{stderr}");
+    }
+}

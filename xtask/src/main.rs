@@ -5,6 +5,8 @@
 use std::io::{BufRead, BufReader};
 use std::process::{Command, ExitCode, Stdio};
 
+mod tradeoff;
+
 const TARGETS: [&str; 3] = [
     "thumbv6m-none-eabi",
     "thumbv7em-none-eabihf",
@@ -1169,6 +1171,7 @@ fn main() -> ExitCode {
         "firmware" => install().and_then(|_| firmware()),
         "lean" => install().and_then(|_| lean()),
         "peers" => peers(),
+        "tradeoff" => install().and_then(|_| tradeoff::tradeoff()),
         // The host renders build whole-frame workspaces (megabytes at 60,000 polygons) by value:
         // give them a thread with room for that.
         "hsr-table" => install().and_then(|_| {
@@ -1188,7 +1191,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | lean | hsr-table | peers | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | lean | hsr-table | peers | tradeoff | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }

@@ -1,0 +1,77 @@
+//! Host speed of the precision variants (`docs/tradeoff.md`): every variant of
+//! `scanline3d_sim::tradeoff::VARIANTS` on every corpus scene from its first camera, at 240×240,
+//! into the hashing panel model. `cargo bench --bench tradeoff`; `cargo xtask tradeoff` reads
+//! `target/criterion/tradeoff/<variant>/<scene>/new/estimates.json`.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
+use scanline3d::scene::Scene;
+use scanline3d::sink::HashSink;
+use scanline3d::{Flat, RenderOptions, Workspace};
+use scanline3d_sim::corpus;
+use scanline3d_sim::scene::{LightSpec, SceneSpec};
+use scanline3d_sim::tradeoff::VARIANTS;
+use std::hint::black_box;
+use std::time::Duration;
+
+/// Room for the largest corpus scene (10,082 triangles) and 240 slivers crossing one row.
+type Ws = Workspace<Rgb565, Flat, 240, 240, 16384, 1024>;
+
+type Group<'c> = criterion::BenchmarkGroup<'c, criterion::measurement::WallTime>;
+
+fn time<const S: u32>(
+    group: &mut Group<'_>,
+    (variant, scene_name): (&str, &str),
+    ws: &mut Ws,
+    scene: &Scene<'_>,
+    cull: bool,
+) {
+    let options = RenderOptions::default()
+        .with_back_face_culling(cull)
+        .with_sub_pixel_bits::<S>();
+    let first = ws.render(scene, &options, &mut HashSink::new());
+    assert!(
+        first.is_ok_and(|s| s.is_complete()),
+        "{variant} on {scene_name}: incomplete frame"
+    );
+    group.bench_function(BenchmarkId::new(variant, scene_name), |b| {
+        b.iter(|| {
+            let mut sink = HashSink::new();
+            black_box(ws.render(scene, &options, &mut sink).ok());
+            sink.hash()
+        })
+    });
+}
+
+fn bench(c: &mut Criterion) {
+    let mut group = c.benchmark_group("tradeoff");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_millis(1000));
+    let mut ws: Box<Ws> = Box::new(Workspace::new(Rgb565::BLACK));
+    for scene in corpus::all() {
+        let spec = SceneSpec::single(
+            scene.mesh.clone(),
+            scene.cameras[0],
+            LightSpec::default(),
+            scene.cull_back_faces,
+        );
+        for v in VARIANTS {
+            let id = (v.name, scene.name);
+            let cull = spec.cull_back_faces;
+            spec.with_scene_math(v.math, |s| match v.sub_bits {
+                0 => time::<0>(&mut group, id, &mut ws, s, cull),
+                2 => time::<2>(&mut group, id, &mut ws, s, cull),
+                4 => time::<4>(&mut group, id, &mut ws, s, cull),
+                8 => time::<8>(&mut group, id, &mut ws, s, cull),
+                n => panic!("no variant has {n} sub-pixel bits"),
+            })
+            .expect("corpus scene");
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

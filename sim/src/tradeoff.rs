@@ -1,0 +1,129 @@
+//! The precision variants `cargo xtask tradeoff` measures (`docs/tradeoff.md`): the presets of
+//! `scanline3d::preset`, and the default with one knob changed, so each knob's own effect shows.
+
+use crate::corpus;
+use crate::metrics::{self, ErrorBound, Metrics};
+use crate::scene::{LightSpec, PresetChoice, SceneSpec, SetupMath};
+
+/// One set of precision choices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Variant {
+    /// Name in the table (a preset's name, or the knob changed).
+    pub name: &'static str,
+    /// The preset, if this is one.
+    pub preset: Option<PresetChoice>,
+    /// Sub-pixel bits.
+    pub sub_bits: u32,
+    /// Per-frame set-up math.
+    pub math: SetupMath,
+}
+
+const fn preset(p: PresetChoice, name: &'static str, sub_bits: u32, math: SetupMath) -> Variant {
+    Variant {
+        name,
+        preset: Some(p),
+        sub_bits,
+        math,
+    }
+}
+
+const fn knob(name: &'static str, sub_bits: u32, math: SetupMath) -> Variant {
+    Variant {
+        name,
+        preset: None,
+        sub_bits,
+        math,
+    }
+}
+
+/// Every variant, in the order of `examples/tradeoff.rs` (a test keeps the presets' entries
+/// equal to `scanline3d::preset`).
+pub const VARIANTS: [Variant; 5] = [
+    preset(PresetChoice::Fast, "fast", 2, SetupMath::Libm),
+    preset(PresetChoice::Balanced, "balanced", 4, SetupMath::Libm),
+    preset(PresetChoice::Exact, "exact", 8, SetupMath::Libm),
+    knob("bits:0", 0, SetupMath::Libm),
+    knob("micromath", 4, SetupMath::Micromath),
+];
+
+/// One variant on one corpus scene and camera, against the f64 reference.
+#[derive(Clone, Debug)]
+pub struct Accuracy {
+    /// Variant name.
+    pub variant: &'static str,
+    /// Corpus scene.
+    pub scene: &'static str,
+    /// Camera index.
+    pub camera: usize,
+    /// Comparison with the reference under the variant's error bound.
+    pub metrics: Metrics,
+}
+
+/// Every variant on every corpus scene and camera at `w × h` (the reference rendered once per
+/// camera); `progress(done, total)` after each camera.
+pub fn corpus_accuracy(
+    w: usize,
+    h: usize,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<Vec<Accuracy>, String> {
+    let scenes = corpus::all();
+    let total: usize = scenes.iter().map(|s| s.cameras.len()).sum();
+    let mut done = 0;
+    let mut out = Vec::new();
+    for scene in &scenes {
+        for (k, camera) in scene.cameras.iter().enumerate() {
+            let spec = SceneSpec::single(
+                scene.mesh.clone(),
+                *camera,
+                LightSpec::default(),
+                scene.cull_back_faces,
+            );
+            let reference = spec.reference()?;
+            let ref_image = reference.render(w, h);
+            for v in VARIANTS {
+                let fixed = spec.render_fixed_settings(
+                    w,
+                    h,
+                    v.sub_bits,
+                    v.math,
+                    crate::scene::Algorithm::SpanZBuffer,
+                )?;
+                let bound = ErrorBound {
+                    sub_bits: v.sub_bits,
+                    max_model_coord: spec.max_model_coord(),
+                    focal_px: reference.camera.focal_px(h),
+                };
+                out.push(Accuracy {
+                    variant: v.name,
+                    scene: scene.name,
+                    camera: k,
+                    metrics: metrics::compare(&fixed.image, &ref_image, &reference, &bound),
+                });
+            }
+            done += 1;
+            progress(done, total);
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn preset_variants_are_the_library_presets() {
+        for v in VARIANTS {
+            if let Some(p) = v.preset {
+                assert_eq!(
+                    (v.name, v.sub_bits, v.math),
+                    (p.name(), p.sub_bits(), p.math())
+                );
+            }
+        }
+        assert_eq!(
+            VARIANTS.iter().filter(|v| v.preset.is_some()).count(),
+            PresetChoice::ALL.len()
+        );
+    }
+}

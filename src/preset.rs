@@ -1,0 +1,159 @@
+//! Named precision presets: each choice that trades accuracy for speed or size, bundled and
+//! fixed at compile time so a build pays only for the one it uses.
+//!
+//! | preset | sub-pixel bits | set-up math |
+//! |---|---|---|
+//! | [`Fast`] | 2 | [`Libm`] |
+//! | [`Balanced`] (the default) | 4 | [`Libm`] |
+//! | [`Exact`] | 8 | [`Libm`] |
+//!
+//! Sub-pixel bits set how finely vertices snap (`2^-S` pixel), the math backend how per-frame
+//! camera and model matrices are computed; everything after the transform is integer
+//! arithmetic in every preset. What each preset costs and how accurate it is are measured, not
+//! assumed: `cargo xtask tradeoff` writes `docs/tradeoff.md` (accuracy against the f64
+//! reference on every corpus scene, instructions on thumbv7em and thumbv6m, host time, flash).
+//! [`Micromath`] set-up is measured there as a single-knob variation and is in no preset: its
+//! camera error moves vertices beyond the sub-pixel error bound (real mismatches) and saves
+//! under 1 KiB of flash.
+//!
+//! So far the knobs trade accuracy for little speed (`Fast` takes about 7 % fewer instructions
+//! than `Exact` on thumbv6m): per-triangle set-up, which dominates the frame, costs nearly the
+//! same at every setting.
+//!
+//! A preset gives the [`RenderOptions`] and the [`Camera`] of a frame:
+//!
+//! ```
+//! use scanline3d::preset::{Exact, Preset};
+//! let options = Exact::options(); // RenderOptions<8>
+//! let camera = Exact::camera([0.0, 1.0, 4.0], [0.0; 3], [0.0, 1.0, 0.0], 50.0, 0.5, 20.0)?;
+//! # let _ = (options, camera);
+//! # Ok::<(), scanline3d::scene::SceneError>(())
+//! ```
+
+use crate::clip::FrustumClip;
+#[cfg(doc)]
+use crate::math::Micromath;
+use crate::math::{Libm, MathBackend};
+use crate::render::RenderOptions;
+use crate::scene::{Camera, SceneError};
+
+/// A named bundle of precision choices.
+pub trait Preset {
+    /// The name `sim render --preset` takes.
+    const NAME: &'static str;
+    /// Sub-pixel bits of [`Preset::Options`].
+    const SUB_BITS: u32;
+    /// Render options: sub-pixel bits and the clipping stage.
+    type Options;
+    /// Math backend for per-frame set-up (camera, model rotations).
+    type Math: MathBackend;
+
+    /// The preset's render options (back-face culling on, as [`RenderOptions::default`]).
+    fn options() -> Self::Options;
+
+    /// A `gluLookAt` · `gluPerspective` camera computed with the preset's math backend.
+    fn camera(
+        eye: [f32; 3],
+        target: [f32; 3],
+        up: [f32; 3],
+        fovy_degrees: f32,
+        near: f32,
+        far: f32,
+    ) -> Result<Camera, SceneError> {
+        Camera::look_at_with::<Self::Math>(eye, target, up)?.perspective_with::<Self::Math>(
+            fovy_degrees,
+            near,
+            far,
+        )
+    }
+}
+
+/// Coarse: 2 sub-pixel bits, [`Libm`] set-up.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Fast;
+
+/// The default: 4 sub-pixel bits, [`Libm`] set-up (what [`RenderOptions::default`] and
+/// [`Camera::look_at`] give).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Balanced;
+
+/// Finest: 8 sub-pixel bits, [`Libm`] set-up.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Exact;
+
+impl Preset for Fast {
+    const NAME: &'static str = "fast";
+    const SUB_BITS: u32 = 2;
+    type Options = RenderOptions<2, FrustumClip>;
+    type Math = Libm;
+    fn options() -> Self::Options {
+        RenderOptions::default().with_sub_pixel_bits::<2>()
+    }
+}
+
+impl Preset for Balanced {
+    const NAME: &'static str = "balanced";
+    const SUB_BITS: u32 = 4;
+    type Options = RenderOptions<4, FrustumClip>;
+    type Math = Libm;
+    fn options() -> Self::Options {
+        RenderOptions::default()
+    }
+}
+
+impl Preset for Exact {
+    const NAME: &'static str = "exact";
+    const SUB_BITS: u32 = 8;
+    type Options = RenderOptions<8, FrustumClip>;
+    type Math = Libm;
+    fn options() -> Self::Options {
+        RenderOptions::default().with_sub_pixel_bits::<8>()
+    }
+}
+
+/// The presets' names, fastest first.
+pub const NAMES: [&str; 3] = [Fast::NAME, Balanced::NAME, Exact::NAME];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera<P: Preset>() -> Camera {
+        match P::camera([1.0, 2.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0], 50.0, 0.5, 9.0) {
+            Ok(c) => c,
+            Err(e) => panic!("{e:?}"),
+        }
+    }
+
+    #[test]
+    fn balanced_is_the_default() {
+        let d = RenderOptions::default();
+        assert_eq!(d.cull_back_faces, Balanced::options().cull_back_faces);
+        let c = Camera::look_at([1.0, 2.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0])
+            .and_then(|v| v.perspective(50.0, 0.5, 9.0));
+        assert_eq!(c.map(|c| c.focal()), Ok(camera::<Balanced>().focal()));
+    }
+
+    #[test]
+    fn presets_differ_in_sub_pixel_bits_and_compute_set_up_with_libm() {
+        let exact = 1.0 / libm::tanf(25f32.to_radians());
+        assert_eq!(camera::<Fast>().focal(), exact);
+        assert_eq!(camera::<Exact>().focal(), exact);
+        const { assert!(Fast::SUB_BITS < Balanced::SUB_BITS && Balanced::SUB_BITS < Exact::SUB_BITS) };
+        // The options carry the same bits as the constants.
+        let bits = |o: &dyn core::any::Any| {
+            if o.is::<RenderOptions<2>>() {
+                2
+            } else if o.is::<RenderOptions<4>>() {
+                4
+            } else if o.is::<RenderOptions<8>>() {
+                8
+            } else {
+                u32::MAX
+            }
+        };
+        assert_eq!(bits(&Fast::options()), Fast::SUB_BITS);
+        assert_eq!(bits(&Balanced::options()), Balanced::SUB_BITS);
+        assert_eq!(bits(&Exact::options()), Exact::SUB_BITS);
+    }
+}

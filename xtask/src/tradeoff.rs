@@ -1,0 +1,437 @@
+//! `cargo xtask tradeoff`: the speed–accuracy trade of the precision presets and single-knob
+//! variations (`scanline3d_sim::tradeoff::VARIANTS`), measured: accuracy against the f64
+//! reference on every corpus scene and camera, instructions per frame of the demo orbit on
+//! thumbv7em and thumbv6m under QEMU (`examples/tradeoff.rs`), host time per frame (criterion,
+//! `cargo bench --bench tradeoff`) and each preset's flash. Writes `docs/tradeoff.md` and the
+//! plot `docs/tradeoff.png` (cost against error, Pareto front marked).
+
+use crate::{
+    cargo, criterion_mean_ns_of, first_line, flash_bytes, host_cpu, root, run, step, thousands,
+};
+use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
+use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
+use embedded_graphics::prelude::*;
+use embedded_graphics::primitives::{Circle, Line, PrimitiveStyle, Rectangle};
+use embedded_graphics::text::Text;
+use scanline3d_sim::tradeoff::{self, Accuracy, VARIANTS};
+use std::collections::HashMap;
+use std::process::Command;
+
+/// Targets whose instruction counts the table shows.
+const TARGETS: [&str; 2] = ["thumbv7em-none-eabihf", "thumbv6m-none-eabi"];
+const SIZE: usize = 240;
+
+/// `variant frame hash [instructions]` lines of the trade-off example's output.
+fn frames(output: &str) -> Vec<(String, u32, u32, Option<u64>)> {
+    output
+        .lines()
+        .filter_map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            if w.first() != Some(&"variant") || w.len() < 8 {
+                return None;
+            }
+            let hash = u32::from_str_radix(w[5], 16).ok()?;
+            let instructions = w.get(9).and_then(|v| v.parse().ok());
+            Some((w[1].to_string(), w[3].parse().ok()?, hash, instructions))
+        })
+        .collect()
+}
+
+/// Runs a firmware ELF with the runner `.cargo/config.toml` gives for `target` (QEMU with a
+/// deterministic instruction clock); its standard output.
+fn run_on_qemu(target: &str, elf: &std::path::Path) -> Result<String, String> {
+    let config = std::fs::read_to_string(root().join(".cargo/config.toml"))
+        .map_err(|e| format!(".cargo/config.toml: {e}"))?;
+    let section = format!("[target.{target}]");
+    let runner = config
+        .split_once(&section)
+        .and_then(|(_, rest)| {
+            rest.lines()
+                .take_while(|l| !l.starts_with("[target"))
+                .find_map(|l| l.trim().strip_prefix("runner = "))
+        })
+        .map(|r| r.trim_matches('"').to_string())
+        .ok_or_else(|| format!("no runner for {target} in .cargo/config.toml"))?;
+    let mut words = runner.split_whitespace();
+    let program = words.next().ok_or("empty runner")?;
+    let out = Command::new(program)
+        .args(words)
+        .arg(elf)
+        .output()
+        .map_err(|e| format!("{program}: {e}"))?;
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    if !out.status.success() {
+        return Err(format!("{} on {target} failed:\n{text}", elf.display()));
+    }
+    Ok(text)
+}
+
+/// One variant's figures.
+struct Row {
+    name: &'static str,
+    sub_bits: u32,
+    math: &'static str,
+    preset: bool,
+    mean_id: f64,
+    worst_id: f64,
+    worst_scene: &'static str,
+    real: usize,
+    depth_beyond: usize,
+    min_psnr: f64,
+    instructions: Vec<f64>,
+    host_ns: Option<f64>,
+    flash: Vec<Option<u64>>,
+}
+
+pub fn tradeoff() -> Result<(), String> {
+    step("the variants against the f64 reference (every corpus scene and camera)");
+    let bar = indicatif::ProgressBar::new(0);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} cameras, {elapsed}")
+            .map_err(|e| e.to_string())?,
+    );
+    let accuracy = tradeoff::corpus_accuracy(SIZE, SIZE, |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })?;
+    bar.finish();
+
+    step("host time per frame (cargo bench --bench tradeoff)");
+    run(cargo().args(["bench", "--bench", "tradeoff"]))?;
+
+    step("host hashes of the trade-off example");
+    let host = cargo()
+        .args(["run", "--quiet", "--release", "--example", "tradeoff"])
+        .current_dir(root())
+        .output()
+        .map_err(|e| e.to_string())?;
+    if !host.status.success() {
+        return Err("the trade-off example failed on the host".into());
+    }
+    let host_frames = frames(&String::from_utf8_lossy(&host.stdout));
+    let host_hashes: Vec<_> = host_frames
+        .iter()
+        .map(|f| (f.0.clone(), f.1, f.2))
+        .collect();
+
+    let mut instructions: HashMap<(&str, &str), f64> = HashMap::new();
+    let mut flash: HashMap<(&str, &str), u64> = HashMap::new();
+    let mut workspace = 0u64;
+    for target in TARGETS {
+        for v in VARIANTS {
+            step(&format!(
+                "trade-off firmware, {} alone, on QEMU: {target}",
+                v.name
+            ));
+            // The cfg goes to the example alone (the final compilation unit).
+            run(cargo()
+                .args(["rustc", "--quiet", "--release", "--example", "tradeoff"])
+                .args(["--target", target, "--", "--cfg"])
+                .arg(format!(
+                    "scanline3d_variant=\"{}\"",
+                    v.name.replace(':', "")
+                )))?;
+            let elf = root()
+                .join("target")
+                .join(target)
+                .join("release/examples/tradeoff");
+            flash.insert((v.name, target), flash_bytes(&elf)?);
+            let out = run_on_qemu(target, &elf)?;
+            let f = frames(&out);
+            let hashes: Vec<_> = f.iter().map(|f| (f.0.clone(), f.1, f.2)).collect();
+            let host: Vec<_> = host_hashes
+                .iter()
+                .filter(|h| h.0 == v.name)
+                .cloned()
+                .collect();
+            if hashes != host {
+                return Err(format!(
+                    "{target}, {}: frame hashes differ from the host's",
+                    v.name
+                ));
+            }
+            let counts: Vec<u64> = f.iter().filter_map(|x| x.3).collect();
+            if counts.len() != host.len() || counts.is_empty() {
+                return Err(format!("{target}: no counts for {}", v.name));
+            }
+            let mean = counts.iter().sum::<u64>() as f64 / counts.len() as f64;
+            println!(
+                "{} frames, hashes equal the host's, {mean:.0} instructions per frame",
+                f.len()
+            );
+            instructions.insert((v.name, target), mean);
+            workspace = out
+                .lines()
+                .find_map(|l| l.strip_prefix("summary workspace "))
+                .and_then(|v| v.trim().parse().ok())
+                .unwrap_or(0);
+        }
+    }
+
+    let scenes: Vec<&'static str> = scanline3d_sim::corpus::all()
+        .iter()
+        .map(|s| s.name)
+        .collect();
+    let rows: Vec<Row> = VARIANTS
+        .iter()
+        .map(|v| {
+            let mine: Vec<&Accuracy> = accuracy.iter().filter(|a| a.variant == v.name).collect();
+            let (worst_id, worst_scene) = mine
+                .iter()
+                .map(|a| (a.metrics.id_mismatch_percent(), a.scene))
+                .fold((0.0, ""), |w, x| if x.0 > w.0 { x } else { w });
+            let host: Vec<f64> = scenes
+                .iter()
+                .filter_map(|s| criterion_mean_ns_of("tradeoff", v.name, s))
+                .collect();
+            Row {
+                name: v.name,
+                sub_bits: v.sub_bits,
+                math: match v.math {
+                    scanline3d_sim::scene::SetupMath::Libm => "libm",
+                    scanline3d_sim::scene::SetupMath::Micromath => "micromath",
+                },
+                preset: v.preset.is_some(),
+                mean_id: mine
+                    .iter()
+                    .map(|a| a.metrics.id_mismatch_percent())
+                    .sum::<f64>()
+                    / mine.len().max(1) as f64,
+                worst_id,
+                worst_scene,
+                real: mine.iter().map(|a| a.metrics.real).sum(),
+                depth_beyond: mine.iter().map(|a| a.metrics.depth_beyond_bound).sum(),
+                min_psnr: mine
+                    .iter()
+                    .map(|a| a.metrics.psnr)
+                    .fold(f64::INFINITY, f64::min),
+                instructions: TARGETS
+                    .iter()
+                    .map(|t| instructions.get(&(v.name, *t)).copied().unwrap_or(0.0))
+                    .collect(),
+                host_ns: (host.len() == scenes.len()).then(|| host.iter().sum()),
+                flash: TARGETS
+                    .iter()
+                    .map(|t| flash.get(&(v.name, *t)).copied())
+                    .collect(),
+            }
+        })
+        .collect();
+
+    // Pareto front over (thumbv6m instructions, mean id mismatches), among variants without
+    // real mismatches.
+    let v6m = |r: &Row| r.instructions[1];
+    let dominated = |r: &Row| {
+        rows.iter().any(|o| {
+            o.real == 0
+                && v6m(o) <= v6m(r)
+                && o.mean_id <= r.mean_id
+                && (v6m(o) < v6m(r) || o.mean_id < r.mean_id)
+        })
+    };
+    let front: Vec<bool> = rows.iter().map(|r| r.real == 0 && !dominated(r)).collect();
+
+    let exact_v6m = rows
+        .iter()
+        .find(|r| r.name == "exact")
+        .map(v6m)
+        .unwrap_or(1.0);
+    let mut md = String::new();
+    let mut line = |s: String| {
+        md.push_str(&s);
+        md.push('\n');
+    };
+    line("# Speed against accuracy: the precision presets".into());
+    line(String::new());
+    line("Written by `cargo xtask tradeoff`; do not edit by hand. The presets of `scanline3d::preset` (fast, balanced = the default, exact) and the default with one knob changed, so that each knob's own effect shows.".into());
+    line(String::new());
+    line(format!("* **Accuracy:** every corpus scene from every camera ({} views) at {SIZE}×{SIZE} against the f64 reference, each variant judged under its own sub-pixel error bound (`metrics::compare`). Id mismatches: pixels showing another triangle than the reference (mean and worst view); real: mismatches the bound does not explain, summed over all views; depth: pixels beyond their depth bound, summed.", accuracy.len() / VARIANTS.len()));
+    line(format!("* **Instructions:** the demo orbit (1420 triangles, 8 frames, mean per frame) on QEMU ({}, `-icount shift=0`): mps2-an386 for thumbv7em (Cortex-M4F), mps2-an385 for thumbv6m. `examples/tradeoff.rs` is built once per variant, so each image carries only its own code (in one image holding every variant, LLVM inlined each variant differently, and the counts no longer compared like with like); every frame hash equals the host's.", first_line(Command::new("qemu-system-arm").arg("--version"))));
+    line(format!("* **Host time:** criterion (`cargo bench --bench tradeoff`), the sum over the corpus scenes (first camera each) of the mean time per frame, on {} ({}).", host_cpu(), first_line(Command::new("rustc").arg("--version"))));
+    line(format!("* **Flash:** that variant's trade-off firmware (release profile, demo mesh data included). **RAM:** the workspace is the same for every variant, {} B; no knob changes memory yet.", thousands(workspace)));
+    line("* **Pareto front:** variants without real mismatches that no other such variant beats on both thumbv6m instructions and mean id mismatches.".into());
+    line(String::new());
+    line("| variant | sub-pixel bits | set-up math | id mismatches, mean / worst (scene) | real | depth beyond bound | worst colour PSNR | thumbv7em instr./frame | thumbv6m instr./frame | thumbv6m vs exact | host time, corpus | flash thumbv7em / thumbv6m | Pareto |".into());
+    line("|---|---|---|---|---|---|---|---|---|---|---|---|---|".into());
+    for (r, on_front) in rows.iter().zip(&front) {
+        let flash = match (r.flash[0], r.flash[1]) {
+            (Some(a), Some(b)) => format!("{} / {} B", thousands(a), thousands(b)),
+            _ => "n/a".into(),
+        };
+        line(format!(
+            "| {}{} | {} | {} | {:.3} % / {:.3} % ({}) | {} | {} | {:.1} dB | {} | {} | {:.2}× | {} | {} | {} |",
+            if r.preset { "**" } else { "" },
+            if r.preset { format!("{}**", r.name) } else { r.name.to_string() },
+            r.sub_bits,
+            r.math,
+            r.mean_id,
+            r.worst_id,
+            r.worst_scene,
+            r.real,
+            r.depth_beyond,
+            r.min_psnr,
+            thousands(r.instructions[0] as u64),
+            thousands(r.instructions[1] as u64),
+            exact_v6m / v6m(r),
+            r.host_ns.map_or("n/a".into(), |ns| format!("{:.1} µs", ns / 1000.0)),
+            flash,
+            if *on_front { "on the front" } else if r.real > 0 { "has real mismatches" } else { "dominated" },
+        ));
+    }
+    line(String::new());
+    line("![instructions against id mismatches](tradeoff.png)".into());
+    line(String::new());
+    line("## Presets per scene".into());
+    line(String::new());
+    line("Worst view's id mismatches and the real mismatches summed over views.".into());
+    line(String::new());
+    let presets: Vec<&str> = VARIANTS
+        .iter()
+        .filter(|v| v.preset.is_some())
+        .map(|v| v.name)
+        .collect();
+    line(format!("| scene | {} |", presets.join(" | ")));
+    line(format!("|---|{}", "---|".repeat(presets.len())));
+    for scene in &scenes {
+        let cells: Vec<String> = presets
+            .iter()
+            .map(|p| {
+                let of: Vec<&Accuracy> = accuracy
+                    .iter()
+                    .filter(|a| a.variant == *p && a.scene == *scene)
+                    .collect();
+                let worst = of
+                    .iter()
+                    .map(|a| a.metrics.id_mismatch_percent())
+                    .fold(0.0, f64::max);
+                let real: usize = of.iter().map(|a| a.metrics.real).sum();
+                format!("{worst:.3} % / {real} real")
+            })
+            .collect();
+        line(format!("| {scene} | {} |", cells.join(" | ")));
+    }
+    let path = root().join("docs/tradeoff.md");
+    std::fs::write(&path, md).map_err(|e| format!("{}: {e}", path.display()))?;
+    println!("wrote {}", path.display());
+    plot(&rows, &front)?;
+    Ok(())
+}
+
+/// `docs/tradeoff.png`: thumbv6m instructions per frame (x) against mean id mismatches (y, log
+/// scale), one point per variant, the Pareto front joined.
+fn plot(rows: &[Row], front: &[bool]) -> Result<(), String> {
+    let (w, h) = (640usize, 400usize);
+    let mut img = scanline3d_sim::scene::RgbImage {
+        width: w,
+        height: h,
+        pixels: vec![[255; 3]; w * h],
+    };
+    let (left, right, top, bottom) = (70i32, 610i32, 30i32, 350i32);
+    let xs: Vec<f64> = rows.iter().map(|r| r.instructions[1]).collect();
+    let ys: Vec<f64> = rows.iter().map(|r| r.mean_id.max(1e-4).log10()).collect();
+    let (x0, x1) = (
+        xs.iter().copied().fold(f64::INFINITY, f64::min) * 0.98,
+        xs.iter().copied().fold(0.0, f64::max) * 1.02,
+    );
+    let (y0, y1) = (
+        ys.iter().copied().fold(f64::INFINITY, f64::min).floor(),
+        ys.iter().copied().fold(f64::NEG_INFINITY, f64::max).ceil(),
+    );
+    let px = |x: f64| left + ((x - x0) / (x1 - x0) * (right - left) as f64) as i32;
+    let py = |y: f64| bottom - ((y - y0) / (y1 - y0).max(1e-9) * (bottom - top) as f64) as i32;
+    let black = PrimitiveStyle::with_stroke(Rgb888::BLACK, 1);
+    let text = MonoTextStyle::new(&FONT_6X10, Rgb888::BLACK);
+    let e = |_| "drawing failed".to_string();
+    Rectangle::with_corners(Point::new(left, top), Point::new(right, bottom))
+        .into_styled(black)
+        .draw(&mut img)
+        .map_err(e)?;
+    Text::new(
+        "thumbv6m instructions per frame (demo orbit, QEMU)",
+        Point::new(left + 120, 385),
+        text,
+    )
+    .draw(&mut img)
+    .map_err(e)?;
+    Text::new(
+        "mean id mismatches vs f64 reference (%, log)",
+        Point::new(left, 20),
+        text,
+    )
+    .draw(&mut img)
+    .map_err(e)?;
+    for k in 0..=4 {
+        let x = x0 + (x1 - x0) * k as f64 / 4.0;
+        Text::new(
+            &format!("{:.2}M", x / 1e6),
+            Point::new(px(x) - 15, bottom + 14),
+            text,
+        )
+        .draw(&mut img)
+        .map_err(e)?;
+    }
+    let mut d = y0;
+    while d <= y1 {
+        Text::new(
+            &format!("{}", 10f64.powf(d)),
+            Point::new(8, py(d) + 3),
+            text,
+        )
+        .draw(&mut img)
+        .map_err(e)?;
+        Line::new(Point::new(left, py(d)), Point::new(left + 4, py(d)))
+            .into_styled(black)
+            .draw(&mut img)
+            .map_err(e)?;
+        d += 1.0;
+    }
+    let mut on: Vec<(i32, i32)> = rows
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| front[*i])
+        .map(|(i, _)| (px(xs[i]), py(ys[i])))
+        .collect();
+    on.sort();
+    let green = PrimitiveStyle::with_stroke(Rgb888::new(30, 150, 60), 2);
+    for pair in on.windows(2) {
+        Line::new(
+            Point::new(pair[0].0, pair[0].1),
+            Point::new(pair[1].0, pair[1].1),
+        )
+        .into_styled(green)
+        .draw(&mut img)
+        .map_err(e)?;
+    }
+    for (i, r) in rows.iter().enumerate() {
+        let colour = if front[i] {
+            Rgb888::new(30, 150, 60)
+        } else if r.real > 0 {
+            Rgb888::new(200, 40, 40)
+        } else {
+            Rgb888::new(120, 120, 120)
+        };
+        let c = Point::new(px(xs[i]), py(ys[i]));
+        Circle::with_center(c, if r.preset { 9 } else { 6 })
+            .into_styled(PrimitiveStyle::with_fill(colour))
+            .draw(&mut img)
+            .map_err(e)?;
+        Text::new(
+            r.name,
+            c + Point::new(7, -4),
+            MonoTextStyle::new(&FONT_6X10, colour),
+        )
+        .draw(&mut img)
+        .map_err(e)?;
+    }
+    Text::new(
+        "green: Pareto front; red: real mismatches; grey: dominated; large: preset",
+        Point::new(left + 10, bottom - 8),
+        text,
+    )
+    .draw(&mut img)
+    .map_err(e)?;
+    let path = root().join("docs/tradeoff.png");
+    scanline3d_sim::scene::write_png(&path, w, h, &img.pixels)?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
