@@ -691,13 +691,15 @@ impl InstanceSetup<'_> {
         })
     }
 
-    /// Clips and projects triangle `tri`, calling `f` with each visible screen triangle.
+    /// Clips and projects triangle `tri`, calling `f` with each visible screen triangle (whose
+    /// depths are 0 unless `depth`).
     fn screen_triangles<const S: u32, C: Clipping>(
         &self,
         tri: usize,
         vp: &Viewport<S>,
         cull: bool,
         lit: bool,
+        depth: bool,
         mut f: impl FnMut([ScreenVertex<S>; 3]),
     ) -> Fate {
         let Some(&idx) = self.instance.mesh.triangles().get(tri) else {
@@ -722,7 +724,7 @@ impl InstanceSetup<'_> {
                 f(s);
             }
         };
-        let project = |c: &ClipVertex| vp.project(&c.p, c.color);
+        let project = |c: &ClipVertex| vp.project_with(&c.p, c.color, depth);
         let mut polygon = ClipPolygon::new();
         let clipped = match C::clip(vp, &cv, &mut polygon) {
             Clipped::Outside => return Fate::Rejected,
@@ -831,12 +833,15 @@ pub(crate) fn drive<
     }
     order.visit(&setups, |setup, tri, rank| {
         let (mut q_sum, mut q_count) = (0u64, 0u64);
-        let fate = setup.screen_triangles::<SUB, C>(tri, vp, options.cull_back_faces, false, |s| {
-            if sorted && rank.is_none() {
-                q_sum += s.iter().map(|v| v.q.to_bits().max(0) as u64).sum::<u64>();
-                q_count += 3;
-            }
-        });
+        // Only a depth sort needs depths in pass 1; the others skip their division.
+        let depth = sorted && rank.is_none();
+        let fate =
+            setup.screen_triangles::<SUB, C>(tri, vp, options.cull_back_faces, false, depth, |s| {
+                if depth {
+                    q_sum += s.iter().map(|v| v.q.to_bits().max(0) as u64).sum::<u64>();
+                    q_count += 3;
+                }
+            });
         match fate {
             Fate::Culled => stats.culled += 1,
             Fate::Rejected => stats.rejected += 1,
@@ -927,7 +932,7 @@ impl<const SUB: u32, C: Clipping> ActivePieces<SUB> for MeshPieces<'_, '_, SUB, 
         } else {
             setup.face_color(tri, idx)
         };
-        setup.screen_triangles::<SUB, C>(tri, self.vp, self.cull, S::PER_VERTEX, |s| {
+        setup.screen_triangles::<SUB, C>(tri, self.vp, self.cull, S::PER_VERTEX, true, |s| {
             f(s, face, id as u32, key)
         });
     }
@@ -1133,6 +1138,7 @@ pub(crate) fn for_each_screen_piece<
                 vp,
                 options.cull_back_faces,
                 S::PER_VERTEX,
+                true,
                 |s| f(s, face, id),
             );
             match fate {
