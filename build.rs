@@ -132,7 +132,7 @@ fn main() {
     // `--cfg scanline3d_variant="fast"` (passed by `cargo xtask tradeoff` through `cargo rustc`)
     // only that preset, so each preset's flash can be measured alone.
     println!(
-        "cargo::rustc-check-cfg=cfg(scanline3d_variant, values(\"fast\", \"balanced\", \"exact\", \"bits0\", \"micromath\"))"
+        "cargo::rustc-check-cfg=cfg(scanline3d_variant, values(\"fast\", \"balanced\", \"exact\", \"bits0\", \"micromath\", \"narrowtransform\", \"reciprocal\", \"narrownormals\"))"
     );
     // The firmware example links with the runtime's link.x. On Arm, cortex-m-rt's link.x
     // includes memory.x from the linker search path (the top-level one). On RISC-V,

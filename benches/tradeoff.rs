@@ -5,11 +5,15 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
+use scanline3d::math::{NarrowNormals, WideNormals};
+use scanline3d::preset::{Arithmetic, Precise, Quick, Setup};
+use scanline3d::project::{ExactDivision, Reciprocal};
 use scanline3d::scene::Scene;
 use scanline3d::sink::HashSink;
+use scanline3d::vertex::{NarrowTransform, WideTransform};
 use scanline3d::{Flat, RenderOptions, Workspace};
 use scanline3d_sim::corpus;
-use scanline3d_sim::scene::{LightSpec, SceneSpec};
+use scanline3d_sim::scene::{LightSpec, SceneSpec, SetupArith};
 use scanline3d_sim::tradeoff::VARIANTS;
 use std::hint::black_box;
 use std::time::Duration;
@@ -19,7 +23,7 @@ type Ws = Workspace<Rgb565, Flat, 240, 240, 16384, 1024>;
 
 type Group<'c> = criterion::BenchmarkGroup<'c, criterion::measurement::WallTime>;
 
-fn time<const S: u32>(
+fn time<const S: u32, A: Arithmetic>(
     group: &mut Group<'_>,
     (variant, scene_name): (&str, &str),
     ws: &mut Ws,
@@ -28,7 +32,8 @@ fn time<const S: u32>(
 ) {
     let options = RenderOptions::default()
         .with_back_face_culling(cull)
-        .with_sub_pixel_bits::<S>();
+        .with_sub_pixel_bits::<S>()
+        .with_arithmetic(A::default());
     let first = ws.render(scene, &options, &mut HashSink::new());
     assert!(
         first.is_ok_and(|s| s.is_complete()),
@@ -60,12 +65,25 @@ fn bench(c: &mut Criterion) {
         for v in VARIANTS {
             let id = (v.name, scene.name);
             let cull = spec.cull_back_faces;
-            spec.with_scene_math(v.math, |s| match v.sub_bits {
-                0 => time::<0>(&mut group, id, &mut ws, s, cull),
-                2 => time::<2>(&mut group, id, &mut ws, s, cull),
-                4 => time::<4>(&mut group, id, &mut ws, s, cull),
-                8 => time::<8>(&mut group, id, &mut ws, s, cull),
-                n => panic!("no variant has {n} sub-pixel bits"),
+            let p = v.precision;
+            spec.with_scene_math(p.math, |s| match (p.sub_bits, p.arith) {
+                (0, SetupArith::Precise) => time::<0, Precise>(&mut group, id, &mut ws, s, cull),
+                (2, SetupArith::Quick) => time::<2, Quick>(&mut group, id, &mut ws, s, cull),
+                (4, SetupArith::Precise) => time::<4, Precise>(&mut group, id, &mut ws, s, cull),
+                (8, SetupArith::Precise) => time::<8, Precise>(&mut group, id, &mut ws, s, cull),
+                (4, SetupArith::NarrowTransform) => {
+                    type A = Setup<NarrowTransform, ExactDivision, WideNormals>;
+                    time::<4, A>(&mut group, id, &mut ws, s, cull)
+                }
+                (4, SetupArith::Reciprocal) => {
+                    type A = Setup<WideTransform, Reciprocal, WideNormals>;
+                    time::<4, A>(&mut group, id, &mut ws, s, cull)
+                }
+                (4, SetupArith::NarrowNormals) => {
+                    type A = Setup<WideTransform, ExactDivision, NarrowNormals>;
+                    time::<4, A>(&mut group, id, &mut ws, s, cull)
+                }
+                other => panic!("no benchmark for {other:?}"),
             })
             .expect("corpus scene");
         }

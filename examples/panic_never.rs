@@ -10,7 +10,7 @@
 //!
 //! `cargo xtask test` builds it for all three targets. It covers what a firmware frame runs:
 //! scene and camera set-up, the vertex stage, clipping, projection, bucketing, the edge walk, the
-//! span z-buffer and the row sink.
+//! span z-buffer and the row sink, with the default arithmetic and the fast preset's narrow one.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -23,6 +23,7 @@ fn main() {
 #[cfg(target_os = "none")]
 mod firmware {
     use scanline3d::demo::{self, PanelWorkspace};
+    use scanline3d::preset::{Fast, Preset};
 
     #[cfg_attr(target_arch = "arm", cortex_m_rt::entry)]
     #[cfg_attr(target_arch = "riscv32", riscv_rt::entry)]
@@ -34,6 +35,10 @@ mod firmware {
             if let Ok(scene) = demo::scene(&instances, frame, demo::ORBIT_FRAMES) {
                 let out = demo::render_panel_frame(&mut ws, &scene);
                 core::hint::black_box(&out);
+                // The narrow set-up arithmetic of the fast preset, too.
+                let mut sink = scanline3d::sink::HashSink::new();
+                let quick = ws.render(&scene, &Fast::options(), &mut sink);
+                core::hint::black_box((&quick, sink.hash()));
             }
             frame = frame.wrapping_add(1);
         }

@@ -14,7 +14,8 @@
 #![cfg_attr(target_os = "none", no_main)]
 
 use embedded_graphics::pixelcolor::Rgb565;
-use scanline3d::preset::{self, Preset};
+use scanline3d::clip::FrustumClip;
+use scanline3d::preset::{self, Arithmetic, Preset};
 use scanline3d::scene::{Camera, Scene, SceneError};
 use scanline3d::sink::HashSink;
 use scanline3d::{demo, Flat, RenderOptions, Workspace};
@@ -33,9 +34,9 @@ struct Frame {
 }
 
 /// Renders the orbit with `options` and cameras computed by `camera`, calling `report` per frame.
-fn orbit<const S: u32>(
+fn orbit<const S: u32, A: Arithmetic>(
     ws: &mut Ws,
-    options: RenderOptions<S>,
+    options: RenderOptions<S, FrustumClip, A>,
     camera: impl Fn(u32) -> Result<Camera, SceneError>,
     count: &impl Fn() -> Counter,
     mut report: impl FnMut(u32, Frame),
@@ -86,6 +87,12 @@ const BUILD_VARIANT: &str = if cfg!(scanline3d_variant = "fast") {
     "bits:0"
 } else if cfg!(scanline3d_variant = "micromath") {
     "micromath"
+} else if cfg!(scanline3d_variant = "narrowtransform") {
+    "narrow-transform"
+} else if cfg!(scanline3d_variant = "reciprocal") {
+    "reciprocal"
+} else if cfg!(scanline3d_variant = "narrownormals") {
+    "narrow-normals"
 } else {
     "balanced"
 };
@@ -115,13 +122,19 @@ fn variants(
     count: &impl Fn() -> Counter,
     mut report: impl FnMut(&str, u32, Frame),
 ) -> Result<(), &'static str> {
+    use preset::Setup;
     use preset::{Balanced, Exact, Fast};
-    use scanline3d::math::{Libm, Micromath};
+    use scanline3d::math::{Libm, Micromath, NarrowNormals, WideNormals};
+    use scanline3d::project::{ExactDivision, Reciprocal};
+    use scanline3d::vertex::{NarrowTransform, WideTransform};
     const FAST: bool = renders(Fast::NAME);
     const BALANCED: bool = renders(Balanced::NAME);
     const EXACT: bool = renders(Exact::NAME);
     const BITS0: bool = renders("bits:0");
     const MICROMATH: bool = renders("micromath");
+    const NARROW_TRANSFORM: bool = renders("narrow-transform");
+    const RECIPROCAL: bool = renders("reciprocal");
+    const NARROW_NORMALS: bool = renders("narrow-normals");
     let default = RenderOptions::default();
     if FAST {
         let camera = preset_camera::<Fast>;
@@ -150,6 +163,25 @@ fn variants(
     if MICROMATH {
         orbit(ws, default, math_camera::<Micromath>, count, |f, l| {
             report("micromath", f, l)
+        })?;
+    }
+    let libm = math_camera::<Libm>;
+    if NARROW_TRANSFORM {
+        let a = Setup::<NarrowTransform, ExactDivision, WideNormals>::default();
+        orbit(ws, default.with_arithmetic(a), libm, count, |f, l| {
+            report("narrow-transform", f, l)
+        })?;
+    }
+    if RECIPROCAL {
+        let a = Setup::<WideTransform, Reciprocal, WideNormals>::default();
+        orbit(ws, default.with_arithmetic(a), libm, count, |f, l| {
+            report("reciprocal", f, l)
+        })?;
+    }
+    if NARROW_NORMALS {
+        let a = Setup::<WideTransform, ExactDivision, NarrowNormals>::default();
+        orbit(ws, default.with_arithmetic(a), libm, count, |f, l| {
+            report("narrow-normals", f, l)
         })?;
     }
     Ok(())

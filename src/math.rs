@@ -98,6 +98,70 @@ pub(crate) fn normalize_i64(v: [i64; 3]) -> Option<[i32; 3]> {
     Some(s.map(|c| ((c << 30) / len) as i32))
 }
 
+/// How precisely lighting normalizes normals, chosen at compile time (see
+/// [`crate::preset::Arithmetic`]).
+pub trait NormalPrecision:
+    Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed + 'static
+{
+    /// Name in the trade-off table.
+    const NAME: &'static str;
+    /// Unit vector in I2F30 bits along `v`; `None` for the zero vector.
+    fn normalize(v: [i64; 3]) -> Option<[i32; 3]>;
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for super::WideNormals {}
+    impl Sealed for super::NarrowNormals {}
+}
+
+/// Normals normalized in 64-bit integers to 30 bits ([`normalize_i64`]): the default.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WideNormals;
+
+/// Normals normalized in 32-bit integers to 15 bits ([`normalize_i32`]): a direction error
+/// below 2^-13 rad, far below one 8-bit colour step, for a fraction of the cost on cores
+/// without a 64-bit divider.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NarrowNormals;
+
+impl NormalPrecision for WideNormals {
+    const NAME: &'static str = "wide";
+    #[inline]
+    fn normalize(v: [i64; 3]) -> Option<[i32; 3]> {
+        normalize_i64(v)
+    }
+}
+
+impl NormalPrecision for NarrowNormals {
+    const NAME: &'static str = "narrow";
+    #[inline]
+    fn normalize(v: [i64; 3]) -> Option<[i32; 3]> {
+        normalize_i32(v)
+    }
+}
+
+/// [`normalize_i64`] to 15 bits in 32-bit arithmetic: the input is shifted until every
+/// component fits 15 bits (so the squared length is below `3 * 2^30`, a `u32`), and each
+/// component is divided in `i32` (`|c| << 15 <= 2^30`). The result is in I2F30 bits with its
+/// low 15 bits zero.
+pub(crate) fn normalize_i32(v: [i64; 3]) -> Option<[i32; 3]> {
+    let max = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
+    if max == 0 {
+        return None;
+    }
+    let bits = 64 - max.leading_zeros();
+    let shift = bits.saturating_sub(15);
+    // Each component is now within ±2^15.
+    let s = v.map(|c| (c >> shift) as i32);
+    let len_sq: u32 = s.iter().map(|&c| (c * c) as u32).sum();
+    let len = len_sq.isqrt() as i32;
+    if len == 0 {
+        return None;
+    }
+    Some(s.map(|c| (c << 15).wrapping_div(len) << 15))
+}
+
 /// Dot product of two I2F30 vectors, result in I2F30 bits (each product is below 2^61).
 #[inline]
 pub(crate) fn dot_q30(a: [i32; 3], b: [i32; 3]) -> i32 {
@@ -119,6 +183,35 @@ mod tests {
             assert!((n[0] as i64 - (3 << 30) / 5).abs() <= 2);
         }
         assert_eq!(normalize_i64([0, 0, 0]), None);
+    }
+
+    #[test]
+    fn narrow_normals_are_unit_to_15_bits_and_agree_with_wide() {
+        let mut x = 0x9e37_79b9u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x as i64) >> (x % 40) as u32
+        };
+        for _ in 0..2000 {
+            let v = [next(), next(), next()];
+            let (Some(wide), Some(narrow)) = (normalize_i64(v), normalize_i32(v)) else {
+                assert_eq!(normalize_i32(v), None, "{v:?}");
+                continue;
+            };
+            for k in 0..3 {
+                // 15-bit truncation of the input and of the quotient: a few 2^-15 at most.
+                let diff = (wide[k] as i64 - narrow[k] as i64).abs();
+                assert!(diff <= 4 << 15, "{v:?}: {wide:?} {narrow:?}");
+            }
+        }
+        assert_eq!(normalize_i32([0, 0, 0]), None);
+        assert_eq!(normalize_i32([0, -7, 0]), Some([0, -(1 << 30), 0]));
+        assert_eq!(
+            normalize_i32([i64::MIN + 1, 0, 0]),
+            Some([-(1 << 30), 0, 0])
+        );
     }
 
     #[test]

@@ -33,9 +33,52 @@
 use crate::clip::FrustumClip;
 #[cfg(doc)]
 use crate::math::Micromath;
-use crate::math::{Libm, MathBackend};
+use crate::math::{Libm, MathBackend, NarrowNormals, NormalPrecision, WideNormals};
+use crate::project::{ExactDivision, ProjectionPrecision, Reciprocal};
 use crate::render::RenderOptions;
 use crate::scene::{Camera, SceneError};
+use crate::vertex::{NarrowTransform, TransformPrecision, WideTransform};
+use core::marker::PhantomData;
+
+/// The integer arithmetic of the per-vertex and per-triangle set-up, one compile-time choice
+/// per stage: how vertices are transformed ([`TransformPrecision`]), divided by `w`
+/// ([`ProjectionPrecision`]) and lit ([`NormalPrecision`]). [`Setup`] combines one of each;
+/// [`Precise`] is the default of [`RenderOptions`], [`Quick`] the narrow choice at every
+/// stage.
+///
+/// Pixel-level work (edge walking, depth and colour interpolation) is exact in every
+/// arithmetic: the choices move vertices and shades by the bounds each knob documents, never
+/// break the fill rule or the watertightness of shared edges (a shared vertex gives the same
+/// result in every triangle).
+pub trait Arithmetic: Copy + Default + core::fmt::Debug + PartialEq + Eq + 'static {
+    /// Transform stage.
+    type Transform: TransformPrecision;
+    /// Projection stage.
+    type Projection: ProjectionPrecision;
+    /// Lighting stage.
+    type Normals: NormalPrecision;
+}
+
+/// The arithmetic made of transform `T`, projection `P` and normals `N`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Setup<T, P, N>(PhantomData<(T, P, N)>);
+
+impl<T: TransformPrecision, P: ProjectionPrecision, N: NormalPrecision> Arithmetic
+    for Setup<T, P, N>
+{
+    type Transform = T;
+    type Projection = P;
+    type Normals = N;
+}
+
+/// Wide arithmetic everywhere: 64-bit transform products, exact division per coordinate,
+/// 30-bit normals. The default.
+pub type Precise = Setup<WideTransform, ExactDivision, WideNormals>;
+
+/// Narrow arithmetic everywhere: 32-bit transform products, one reciprocal per vertex, 15-bit
+/// normals. Vertices move by about 10^-4 of their offsets, shades by far less than a colour
+/// step; on cores without 64-bit multiply and divide this removes most of the set-up's cost.
+pub type Quick = Setup<NarrowTransform, Reciprocal, NarrowNormals>;
 
 /// A named bundle of precision choices.
 pub trait Preset {
@@ -47,6 +90,8 @@ pub trait Preset {
     type Options;
     /// Math backend for per-frame set-up (camera, model rotations).
     type Math: MathBackend;
+    /// Integer arithmetic of the per-vertex and per-triangle set-up.
+    type Arithmetic: Arithmetic;
 
     /// The preset's render options (back-face culling on, as [`RenderOptions::default`]).
     fn options() -> Self::Options;
@@ -68,26 +113,29 @@ pub trait Preset {
     }
 }
 
-/// Coarse: 2 sub-pixel bits, [`Libm`] set-up.
+/// Coarse and cheap: 2 sub-pixel bits, [`Quick`] arithmetic, [`Libm`] set-up.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Fast;
 
-/// The default: 4 sub-pixel bits, [`Libm`] set-up (what [`RenderOptions::default`] and
-/// [`Camera::look_at`] give).
+/// The default: 4 sub-pixel bits, [`Precise`] arithmetic, [`Libm`] set-up (what
+/// [`RenderOptions::default`] and [`Camera::look_at`] give).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Balanced;
 
-/// Finest: 8 sub-pixel bits, [`Libm`] set-up.
+/// Finest: 8 sub-pixel bits, [`Precise`] arithmetic, [`Libm`] set-up.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Exact;
 
 impl Preset for Fast {
     const NAME: &'static str = "fast";
     const SUB_BITS: u32 = 2;
-    type Options = RenderOptions<2, FrustumClip>;
+    type Options = RenderOptions<2, FrustumClip, Quick>;
     type Math = Libm;
+    type Arithmetic = Quick;
     fn options() -> Self::Options {
-        RenderOptions::default().with_sub_pixel_bits::<2>()
+        RenderOptions::default()
+            .with_sub_pixel_bits::<2>()
+            .with_arithmetic(Quick::default())
     }
 }
 
@@ -96,6 +144,7 @@ impl Preset for Balanced {
     const SUB_BITS: u32 = 4;
     type Options = RenderOptions<4, FrustumClip>;
     type Math = Libm;
+    type Arithmetic = Precise;
     fn options() -> Self::Options {
         RenderOptions::default()
     }
@@ -106,6 +155,7 @@ impl Preset for Exact {
     const SUB_BITS: u32 = 8;
     type Options = RenderOptions<8, FrustumClip>;
     type Math = Libm;
+    type Arithmetic = Precise;
     fn options() -> Self::Options {
         RenderOptions::default().with_sub_pixel_bits::<8>()
     }
@@ -142,7 +192,7 @@ mod tests {
         const { assert!(Fast::SUB_BITS < Balanced::SUB_BITS && Balanced::SUB_BITS < Exact::SUB_BITS) };
         // The options carry the same bits as the constants.
         let bits = |o: &dyn core::any::Any| {
-            if o.is::<RenderOptions<2>>() {
+            if o.is::<RenderOptions<2, FrustumClip, Quick>>() {
                 2
             } else if o.is::<RenderOptions<4>>() {
                 4

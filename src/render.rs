@@ -18,14 +18,16 @@
 //! [`Workspace::BYTES`].
 
 use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping, FrustumClip};
-use crate::project::{Depth, ScreenVertex, Viewport};
+use crate::math::NormalPrecision;
+use crate::preset::{Arithmetic, Precise};
+use crate::project::{Depth, ProjectionPrecision, ScreenVertex, Viewport};
 use crate::raster::{
     color_channels, first_row, signed_area, xy, DepthPlane, PlaneSolver, TriangleWalk,
 };
 use crate::scene::{Instance, MeshColors, Scene};
 use crate::shading::{Shading, SpanDepth};
 use crate::sink::{Row, RowPixel, RowSink};
-use crate::vertex::{shade, Lighting, ModelView, TransformError};
+use crate::vertex::{shade, Lighting, ModelView, TransformError, TransformPrecision};
 use embedded_graphics::pixelcolor::Rgb888;
 use fixed::types::I16F16;
 use heapless::{Vec, VecView};
@@ -46,11 +48,17 @@ pub const MAX_INSTANCES: usize = 8;
 /// assert!(!both_sides.cull_back_faces);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RenderOptions<const SUB_BITS: u32 = 4, C: Clipping = FrustumClip> {
+pub struct RenderOptions<
+    const SUB_BITS: u32 = 4,
+    C: Clipping = FrustumClip,
+    A: Arithmetic = Precise,
+> {
     /// Skip triangles whose front (counter-clockwise) side faces away from the camera.
     pub cull_back_faces: bool,
     /// The clipping stage (a zero-sized type).
     pub clipping: C,
+    /// The set-up arithmetic (a zero-sized type): [`Precise`] by default.
+    pub arithmetic: A,
 }
 
 impl Default for RenderOptions<4> {
@@ -58,25 +66,28 @@ impl Default for RenderOptions<4> {
         RenderOptions {
             cull_back_faces: true,
             clipping: FrustumClip,
+            arithmetic: Precise::default(),
         }
     }
 }
 
-impl<const SUB_BITS: u32, C: Clipping> RenderOptions<SUB_BITS, C> {
+impl<const SUB_BITS: u32, C: Clipping, A: Arithmetic> RenderOptions<SUB_BITS, C, A> {
     /// The same options with back-face culling on or off. (Prefer this to a struct literal,
     /// which cannot infer the default `SUB_BITS`.)
     pub const fn with_back_face_culling(self, on: bool) -> Self {
         RenderOptions {
             cull_back_faces: on,
             clipping: self.clipping,
+            arithmetic: self.arithmetic,
         }
     }
 
     /// The same options with another number of sub-pixel bits.
-    pub const fn with_sub_pixel_bits<const N: u32>(self) -> RenderOptions<N, C> {
+    pub const fn with_sub_pixel_bits<const N: u32>(self) -> RenderOptions<N, C, A> {
         RenderOptions {
             cull_back_faces: self.cull_back_faces,
             clipping: self.clipping,
+            arithmetic: self.arithmetic,
         }
     }
 
@@ -89,10 +100,32 @@ impl<const SUB_BITS: u32, C: Clipping> RenderOptions<SUB_BITS, C> {
     /// let lean = RenderOptions::default().with_clipping(NoClip);
     /// assert_eq!(lean.clipping, NoClip);
     /// ```
-    pub const fn with_clipping<D: Clipping>(self, clipping: D) -> RenderOptions<SUB_BITS, D> {
+    pub const fn with_clipping<D: Clipping>(self, clipping: D) -> RenderOptions<SUB_BITS, D, A> {
         RenderOptions {
             cull_back_faces: self.cull_back_faces,
             clipping,
+            arithmetic: self.arithmetic,
+        }
+    }
+
+    /// The same options with another set-up arithmetic ([`crate::preset::Arithmetic`]).
+    ///
+    /// ```
+    /// use scanline3d::preset::{Quick, Setup};
+    /// use scanline3d::{project::Reciprocal, vertex::WideTransform, math::WideNormals};
+    /// let quick = scanline3d::RenderOptions::default().with_arithmetic(Quick::default());
+    /// // One knob alone: reciprocal projection, the rest precise.
+    /// let one = quick.with_arithmetic(Setup::<WideTransform, Reciprocal, WideNormals>::default());
+    /// # let _ = one;
+    /// ```
+    pub const fn with_arithmetic<B: Arithmetic>(
+        self,
+        arithmetic: B,
+    ) -> RenderOptions<SUB_BITS, C, B> {
+        RenderOptions {
+            cull_back_faces: self.cull_back_faces,
+            clipping: self.clipping,
+            arithmetic,
         }
     }
 }
@@ -535,10 +568,10 @@ impl<
     /// assert_eq!(stats.fragments, 28);
     /// # Ok::<(), scanline3d::scene::SceneError>(())
     /// ```
-    pub fn render<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         self.render_sized(W, H, scene, options, sink)
@@ -565,12 +598,12 @@ impl<
     /// assert_eq!((rows, stats.rows), (80, 80));
     /// # Ok::<(), scanline3d::scene::SceneError>(())
     /// ```
-    pub fn render_sized<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render_sized<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         width: usize,
         height: usize,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         let vp = viewport::<SUB_BITS, K::Error>(width, height, W, H, scene)?;
@@ -594,7 +627,7 @@ impl<
             background: self.background,
             spans: 0,
         };
-        drive::<P, S, SUB_BITS, C, K, INSTANCES, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _>(
             frame,
             &mut resolve,
             &mut IdOrder,
@@ -662,15 +695,20 @@ impl InstanceSetup<'_> {
     }
 
     /// The lit flat colour of triangle `tri`.
-    fn face_color(&self, tri: usize, idx: [u16; 3]) -> Rgb888 {
+    fn face_color<N: NormalPrecision>(&self, tri: usize, idx: [u16; 3]) -> Rgb888 {
         let verts = self.instance.mesh.vertices();
         let zero = [I16F16::ZERO; 3];
         let v = idx.map(|i| verts.get(i as usize).unwrap_or(&zero));
-        shade(self.vertex_colors(tri, idx)[0], self.lighting.face(v))
+        shade(self.vertex_colors(tri, idx)[0], self.lighting.face::<N>(v))
     }
 
     /// Transforms (and, for Gouraud, lights) the three vertices of triangle `tri`.
-    fn clip_vertices(&self, tri: usize, idx: [u16; 3], lit: bool) -> [ClipVertex; 3] {
+    fn clip_vertices<A: Arithmetic>(
+        &self,
+        tri: usize,
+        idx: [u16; 3],
+        lit: bool,
+    ) -> [ClipVertex; 3] {
         let mesh = self.instance.mesh;
         let verts = mesh.vertices();
         let zero = [I16F16::ZERO; 3];
@@ -678,22 +716,25 @@ impl InstanceSetup<'_> {
         let colors = if lit {
             let base = self.vertex_colors(tri, idx);
             let intensity = match mesh.normals() {
-                Some(n) => idx.map(|i| self.lighting.vertex(n.get(i as usize).unwrap_or(&zero))),
-                None => [self.lighting.face(v); 3],
+                Some(n) => idx.map(|i| {
+                    self.lighting
+                        .vertex::<A::Normals>(n.get(i as usize).unwrap_or(&zero))
+                }),
+                None => [self.lighting.face::<A::Normals>(v); 3],
             };
             [0, 1, 2].map(|k| color_channels(shade(base[k], intensity[k])))
         } else {
             [[I16F16::ZERO; 3]; 3]
         };
         [0, 1, 2].map(|k| ClipVertex {
-            p: self.mv.apply(v[k]),
+            p: A::Transform::apply(&self.mv, v[k]),
             color: colors[k],
         })
     }
 
     /// Clips and projects triangle `tri`, calling `f` with each visible screen triangle (whose
     /// depths are 0 unless `depth`).
-    fn screen_triangles<const S: u32, C: Clipping>(
+    fn screen_triangles<const S: u32, C: Clipping, A: Arithmetic>(
         &self,
         tri: usize,
         vp: &Viewport<S>,
@@ -705,7 +746,7 @@ impl InstanceSetup<'_> {
         let Some(&idx) = self.instance.mesh.triangles().get(tri) else {
             return Fate::Rejected;
         };
-        let cv = self.clip_vertices(tri, idx, lit);
+        let cv = self.clip_vertices::<A>(tri, idx, lit);
         let (w, h) = (vp.width as i32, vp.height as i32);
         let mut first: Option<i32> = None;
         let mut culled = false;
@@ -724,7 +765,7 @@ impl InstanceSetup<'_> {
                 f(s);
             }
         };
-        let project = |c: &ClipVertex| vp.project_with(&c.p, c.color, depth);
+        let project = |c: &ClipVertex| A::Projection::project(vp, &c.p, c.color, depth);
         let mut polygon = ClipPolygon::new();
         let clipped = match C::clip(vp, &cv, &mut polygon) {
             Clipped::Outside => return Fate::Rejected,
@@ -804,6 +845,7 @@ pub(crate) fn drive<
     S: Shading,
     const SUB: u32,
     C: Clipping,
+    A: Arithmetic,
     K: RowSink<P>,
     const INSTANCES: usize,
     R: Resolve<P, S>,
@@ -812,7 +854,7 @@ pub(crate) fn drive<
     resolve: &mut R,
     order: &mut impl TriangleOrder,
     scene: &Scene<'_>,
-    options: &RenderOptions<SUB, C>,
+    options: &RenderOptions<SUB, C, A>,
     vp: &Viewport<SUB>,
     sink: &mut K,
 ) -> Result<FrameStats, RenderError<K::Error>> {
@@ -835,13 +877,19 @@ pub(crate) fn drive<
         let (mut q_sum, mut q_count) = (0u64, 0u64);
         // Only a depth sort needs depths in pass 1; the others skip their division.
         let depth = sorted && rank.is_none();
-        let fate =
-            setup.screen_triangles::<SUB, C>(tri, vp, options.cull_back_faces, false, depth, |s| {
+        let fate = setup.screen_triangles::<SUB, C, A>(
+            tri,
+            vp,
+            options.cull_back_faces,
+            false,
+            depth,
+            |s| {
                 if depth {
                     q_sum += s.iter().map(|v| v.q.to_bits().max(0) as u64).sum::<u64>();
                     q_count += 3;
                 }
-            });
+            },
+        );
         match fate {
             Fate::Culled => stats.culled += 1,
             Fate::Rejected => stats.rejected += 1,
@@ -884,7 +932,7 @@ pub(crate) fn drive<
         keys: ws.keys,
         vp,
         cull: options.cull_back_faces,
-        clipping: core::marker::PhantomData::<C>,
+        stages: core::marker::PhantomData::<(C, A)>,
     };
     walk_rows::<P, S, SUB, K, R>(
         ws.heads, ws.next, ws.active, &pieces, resolve, width, sink, stats,
@@ -903,16 +951,18 @@ pub(crate) trait ActivePieces<const SUB: u32> {
 }
 
 /// Pieces of mesh triangles, transformed, clipped and projected again on activation.
-struct MeshPieces<'a, 's, const SUB: u32, C> {
+struct MeshPieces<'a, 's, const SUB: u32, C, A> {
     setups: &'a [InstanceSetup<'s>],
     refs: &'a [u16],
     keys: &'a [u32],
     vp: &'a Viewport<SUB>,
     cull: bool,
-    clipping: core::marker::PhantomData<C>,
+    stages: core::marker::PhantomData<(C, A)>,
 }
 
-impl<const SUB: u32, C: Clipping> ActivePieces<SUB> for MeshPieces<'_, '_, SUB, C> {
+impl<const SUB: u32, C: Clipping, A: Arithmetic> ActivePieces<SUB>
+    for MeshPieces<'_, '_, SUB, C, A>
+{
     #[inline(always)]
     fn each_piece<S: Shading>(
         &self,
@@ -930,9 +980,9 @@ impl<const SUB: u32, C: Clipping> ActivePieces<SUB> for MeshPieces<'_, '_, SUB, 
         let face = if S::PER_VERTEX {
             Rgb888::new(0, 0, 0)
         } else {
-            setup.face_color(tri, idx)
+            setup.face_color::<A::Normals>(tri, idx)
         };
-        setup.screen_triangles::<SUB, C>(tri, self.vp, self.cull, S::PER_VERTEX, true, |s| {
+        setup.screen_triangles::<SUB, C, A>(tri, self.vp, self.cull, S::PER_VERTEX, true, |s| {
             f(s, face, id as u32, key)
         });
     }
@@ -1113,11 +1163,12 @@ pub(crate) fn for_each_screen_piece<
     S: Shading,
     const SUB: u32,
     C: Clipping,
+    A: Arithmetic,
     E,
     const INSTANCES: usize,
 >(
     scene: &Scene<'_>,
-    options: &RenderOptions<SUB, C>,
+    options: &RenderOptions<SUB, C, A>,
     vp: &Viewport<SUB>,
     mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32),
 ) -> Result<FrameStats, RenderError<E>> {
@@ -1131,9 +1182,9 @@ pub(crate) fn for_each_screen_piece<
             let face = if S::PER_VERTEX {
                 Rgb888::new(0, 0, 0)
             } else {
-                setup.face_color(tri, idx)
+                setup.face_color::<A::Normals>(tri, idx)
             };
-            let fate = setup.screen_triangles::<SUB, C>(
+            let fate = setup.screen_triangles::<SUB, C, A>(
                 tri,
                 vp,
                 options.cull_back_faces,

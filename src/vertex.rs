@@ -13,7 +13,7 @@
 //!
 //! [`MAX_MODEL_COORD`]: crate::scene::MAX_MODEL_COORD
 
-use crate::math::{dot_q30, normalize_i64};
+use crate::math::{dot_q30, NormalPrecision};
 use crate::scene::{Light, Transform, Vertex};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::{I16F16, I2F30};
@@ -41,12 +41,71 @@ pub enum TransformError {
     OutOfEnvelope,
 }
 
+/// How precisely vertices are transformed, chosen at compile time (see
+/// [`crate::preset::Arithmetic`]).
+pub trait TransformPrecision:
+    Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed + 'static
+{
+    /// Name in the trade-off table.
+    const NAME: &'static str;
+    /// Transforms a model vertex of the mesh `mv` was made for.
+    fn apply(mv: &ModelView, v: &Vertex) -> EyePoint;
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for super::WideTransform {}
+    impl Sealed for super::NarrowTransform {}
+}
+
+/// I16F16 × I16F16 products summed in `i64` and rounded once ([`ModelView::apply`]): eye
+/// coordinates within 2^-17 units of the exact product of the I16F16 matrix and vertex. The
+/// default.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WideTransform;
+
+/// 15-bit × 16-bit products summed in `i32` ([`ModelView::apply_narrow`]): one 32-bit multiply
+/// per product instead of a 64-bit one, for an eye-space error of about 2^-14 of the mesh's
+/// extent times the matrix's largest entry (see [`ModelView`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NarrowTransform;
+
+impl TransformPrecision for WideTransform {
+    const NAME: &'static str = "wide";
+    #[inline]
+    fn apply(mv: &ModelView, v: &Vertex) -> EyePoint {
+        mv.apply(v)
+    }
+}
+
+impl TransformPrecision for NarrowTransform {
+    const NAME: &'static str = "narrow";
+    #[inline]
+    fn apply(mv: &ModelView, v: &Vertex) -> EyePoint {
+        mv.apply_narrow(v)
+    }
+}
+
 /// The model→eye transform of one instance, in I16F16, with the third row negated so that it
 /// yields `w = −z` directly.
+///
+/// It also keeps a narrow copy for [`NarrowTransform`]: vertices are shifted right by
+/// `vertex_shift` so they fit 16 bits (`|v| <= 2^15` for the mesh's largest coordinate), the
+/// matrix entries are rounded to `|m| <= 2^14` by a common `matrix_shift`, so a row's three
+/// products sum below `3 · 2^29` in `i32`; the sum is scaled back by `2^(matrix_shift +
+/// vertex_shift − 16)` to I16F16. Rounding an entry errs by at most `2^(matrix_shift − 1) <=
+/// 2^-14 · max|m|` and truncating a vertex coordinate by less than `2^vertex_shift <= 2^-14 ·
+/// max|v|`, so an eye coordinate errs by at most `3 · 2^-13 · max|m| · max|v|` (the largest
+/// product) plus one unit of I16F16 rounding: below 4·10^-4 of the mesh's extent for a
+/// rotation, and typically far less.
 #[derive(Clone, Copy, Debug)]
 pub struct ModelView {
     m: [[I16F16; 3]; 3],
     t: [I16F16; 3],
+    narrow: [[i32; 3]; 3],
+    vertex_shift: u32,
+    /// `matrix_shift + vertex_shift − 16`: positive scales up, negative down.
+    narrow_scale: i32,
 }
 
 impl ModelView {
@@ -80,7 +139,25 @@ impl ModelView {
                 return Err(TransformError::OutOfEnvelope);
             }
         }
-        Ok(ModelView { m, t })
+        let bits = |v: u32| 32 - v.leading_zeros();
+        let vertex_shift = bits(max_abs_bits.unsigned_abs()).saturating_sub(15);
+        let largest = m.iter().flatten().map(|e| e.to_bits().unsigned_abs()).max();
+        let matrix_shift = bits(largest.unwrap_or(0)).saturating_sub(14);
+        let narrow = m.map(|row| {
+            row.map(|e| {
+                let e = e.to_bits() as i64;
+                // Round to nearest; |e| < 2^(matrix_shift + 14), so the result is within ±2^14.
+                let half = (1i64 << matrix_shift) >> 1;
+                ((e + half) >> matrix_shift) as i32
+            })
+        });
+        Ok(ModelView {
+            m,
+            t,
+            narrow,
+            vertex_shift,
+            narrow_scale: matrix_shift as i32 + vertex_shift as i32 - 16,
+        })
     }
 
     /// Transforms a model vertex (validated mesh, so inside the proven envelope).
@@ -93,6 +170,30 @@ impl ModelView {
                 + ((self.t[r].to_bits() as i64) << 16);
             // I32F32 -> I16F16, rounding to nearest; the envelope proof bounds the result.
             I16F16::from_bits(((sum + (1 << 15)) >> 16) as i32)
+        };
+        EyePoint {
+            x: row(0),
+            y: row(1),
+            w: row(2),
+        }
+    }
+
+    /// [`ModelView::apply`] with 32-bit products ([`NarrowTransform`]; error bound above).
+    #[inline]
+    pub fn apply_narrow(&self, v: &Vertex) -> EyePoint {
+        let v = v.map(|c| c.to_bits() >> self.vertex_shift);
+        let scale = self.narrow_scale;
+        let row = |r: usize| {
+            let [a, b, c] = self.narrow[r];
+            // |a·v0 + b·v1 + c·v2| <= 3 · 2^14 · 2^15 < 2^31.
+            let sum = a * v[0] + b * v[1] + c * v[2];
+            let scaled = if scale >= 0 {
+                sum.wrapping_shl(scale as u32)
+            } else {
+                let down = scale.unsigned_abs().min(31);
+                sum.wrapping_add((1 << down) >> 1) >> down
+            };
+            I16F16::from_bits(scaled.wrapping_add(self.t[r].to_bits()))
         };
         EyePoint {
             x: row(0),
@@ -156,8 +257,8 @@ impl Lighting {
         }
     }
 
-    fn intensity_of_world_normal(&self, n: [i64; 3]) -> I2F30 {
-        let lambert = match normalize_i64(n) {
+    fn intensity_of_world_normal<N: NormalPrecision>(&self, n: [i64; 3]) -> I2F30 {
+        let lambert = match N::normalize(n) {
             Some(unit) => dot_q30(unit, self.direction).max(0),
             None => 0,
         };
@@ -171,8 +272,9 @@ impl Lighting {
             .map(|row| (0..3).map(|k| row[k] as i64 * n[k] as i64).sum())
     }
 
-    /// Intensity of a face with model-space vertices `v` (counter-clockwise = front).
-    pub fn face(&self, v: [&Vertex; 3]) -> I2F30 {
+    /// Intensity of a face with model-space vertices `v` (counter-clockwise = front), with
+    /// normals normalized at precision `N`.
+    pub fn face<N: NormalPrecision>(&self, v: [&Vertex; 3]) -> I2F30 {
         let d = |a: &Vertex, b: &Vertex, k: usize| b[k].to_bits() as i64 - a[k].to_bits() as i64;
         let e1 = [0, 1, 2].map(|k| d(v[0], v[1], k));
         let e2 = [0, 1, 2].map(|k| d(v[0], v[2], k));
@@ -182,19 +284,20 @@ impl Lighting {
             e1[2] * e2[0] - e1[0] * e2[2],
             e1[0] * e2[1] - e1[1] * e2[0],
         ];
-        match normalize_i64(n) {
-            Some(unit) => self.intensity_of_world_normal(self.normal_to_world(unit)),
+        match N::normalize(n) {
+            Some(unit) => self.intensity_of_world_normal::<N>(self.normal_to_world(unit)),
             None => self.ambient,
         }
     }
 
-    /// Intensity at a vertex with model-space normal `n` (any non-zero length).
-    pub fn vertex(&self, n: &Vertex) -> I2F30 {
-        match normalize_i64(n.map(|c| c.to_bits() as i64)) {
+    /// Intensity at a vertex with model-space normal `n` (any non-zero length), normalized at
+    /// precision `N`.
+    pub fn vertex<N: NormalPrecision>(&self, n: &Vertex) -> I2F30 {
+        match N::normalize(n.map(|c| c.to_bits() as i64)) {
             Some(unit) => {
                 let w = self.normal_to_world(unit);
                 let w = if self.flip { w.map(|c| -c) } else { w };
-                self.intensity_of_world_normal(w)
+                self.intensity_of_world_normal::<N>(w)
             }
             None => self.ambient,
         }
@@ -277,24 +380,81 @@ mod tests {
     }
 
     #[test]
+    fn narrow_transform_stays_within_its_bound() {
+        let view = crate::scene::Camera::look_at([3.0, 2.0, 5.0], [0.0; 3], [0.0, 1.0, 0.0])
+            .unwrap()
+            .world_to_eye;
+        let mut x = 0x2545_f491u32;
+        let mut next = |range: f32| {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            (x as f32 / u32::MAX as f32 * 2.0 - 1.0) * range
+        };
+        for &(extent, scale) in &[(1.0f32, 1.0f32), (0.01, 3.0), (100.0, 0.5), (1000.0, 2.0)] {
+            for _ in 0..50 {
+                let model = Transform::rotation_y(next(3.0))
+                    .then_after(&Transform::rotation_x(next(3.0)))
+                    .then_after(&Transform::scale([scale; 3]));
+                let p = v(next(extent), next(extent), next(extent));
+                let max = (extent * 65536.0) as i32;
+                let mv = ModelView::new(&model, &view, max).unwrap();
+                let (wide, narrow) = (mv.apply(&p), mv.apply_narrow(&p));
+                // The documented bound, in I16F16 bits.
+                let m =
+                    mv.m.iter()
+                        .flatten()
+                        .map(|e| e.to_bits().abs())
+                        .max()
+                        .unwrap();
+                let bound = 3.0 * (m as f64 * max as f64 / 65536.0) / 8192.0 + 1.0;
+                for (a, b) in [(wide.x, narrow.x), (wide.y, narrow.y), (wide.w, narrow.w)] {
+                    let err = (a.to_bits() as f64 - b.to_bits() as f64).abs();
+                    assert!(
+                        err <= bound,
+                        "extent {extent} scale {scale}: {a} {b} > {bound}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn narrow_and_wide_normals_light_alike() {
+        use crate::math::{NarrowNormals, WideNormals};
+        let light = Light::new([0.3, 0.5, 1.0], 0.2, 0.8).unwrap();
+        let l = Lighting::new(&light, &Transform::rotation_x(0.4));
+        let (a, b) = (v(0.0, 0.0, 0.0), v(1.0, 0.1, 0.0));
+        for k in 0..64 {
+            let t = k as f32 * 0.1;
+            let c = v(libm::cosf(t), libm::sinf(t), 0.5);
+            let wide = l.face::<WideNormals>([&a, &b, &c]).to_bits();
+            let narrow = l.face::<NarrowNormals>([&a, &b, &c]).to_bits();
+            // Well below one 8-bit colour step (2^22 in I2F30 bits).
+            assert!((wide - narrow).abs() < 1 << 17, "{t}: {wide} {narrow}");
+        }
+    }
+
+    #[test]
     fn lambert_face_lighting() {
+        use crate::math::WideNormals as W;
         let light = Light::new([0.0, 0.0, 1.0], 0.25, 0.75).unwrap();
         let l = Lighting::new(&light, &Transform::IDENTITY);
         let (a, b, c) = (v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0));
         // Faces +z: full light.
-        assert_eq!(l.face([&a, &b, &c]), I2F30::from_bits(1 << 30));
+        assert_eq!(l.face::<W>([&a, &b, &c]), I2F30::from_bits(1 << 30));
         // Faces -z: ambient only.
-        assert_eq!(l.face([&a, &c, &b]), I2F30::from_num(0.25));
+        assert_eq!(l.face::<W>([&a, &c, &b]), I2F30::from_num(0.25));
         // Rotated 60° away: 0.25 + 0.75 * 0.5.
         let r = Lighting::new(&light, &Transform::rotation_x(core::f32::consts::FRAC_PI_3));
-        let i: f32 = r.face([&a, &b, &c]).to_num();
+        let i: f32 = r.face::<W>([&a, &b, &c]).to_num();
         assert!((i - 0.625).abs() < 1e-5, "{i}");
         // Mirroring z leaves this z = 0 triangle where it is (still facing +z, fully lit) but
         // turns a +z vertex normal into -z.
         let m = Lighting::new(&light, &Transform::scale([1.0, 1.0, -1.0]));
-        assert_eq!(m.face([&a, &b, &c]), I2F30::from_bits(1 << 30));
-        assert_eq!(m.vertex(&v(0.0, 0.0, 1.0)), I2F30::from_num(0.25));
-        assert_eq!(m.vertex(&v(0.0, 0.0, -3.0)), I2F30::from_bits(1 << 30));
+        assert_eq!(m.face::<W>([&a, &b, &c]), I2F30::from_bits(1 << 30));
+        assert_eq!(m.vertex::<W>(&v(0.0, 0.0, 1.0)), I2F30::from_num(0.25));
+        assert_eq!(m.vertex::<W>(&v(0.0, 0.0, -3.0)), I2F30::from_bits(1 << 30));
     }
 
     #[test]

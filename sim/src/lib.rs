@@ -57,11 +57,11 @@ pub fn accuracy_with(
     algorithm: scene::Algorithm,
 ) -> Result<(Metrics, scene::FixedRender, reference::Image), String> {
     let fixed = spec.render_fixed_with(w, h, sub_bits, algorithm)?;
-    judge(spec, w, h, sub_bits, fixed)
+    judge(spec, w, h, scene::Precision::bits(sub_bits), fixed)
 }
 
 #[cfg(not(target_os = "none"))]
-/// [`accuracy_with`] at the sub-pixel bits and set-up math of a precision preset.
+/// [`accuracy_with`] with the precision choices of a preset.
 pub fn accuracy_preset(
     spec: &SceneSpec,
     w: usize,
@@ -70,24 +70,27 @@ pub fn accuracy_preset(
     algorithm: scene::Algorithm,
 ) -> Result<(Metrics, scene::FixedRender, reference::Image), String> {
     let fixed = spec.render_fixed_preset(w, h, preset, algorithm)?;
-    judge(spec, w, h, preset.sub_bits(), fixed)
+    judge(spec, w, h, preset.precision(), fixed)
 }
 
 #[cfg(not(target_os = "none"))]
-/// Compares a fixed-point render with the reference under the error bound of `sub_bits`.
+/// Compares a fixed-point render with the reference under the error bound of `precision`.
 fn judge(
     spec: &SceneSpec,
     w: usize,
     h: usize,
-    sub_bits: u32,
+    precision: scene::Precision,
     fixed: scene::FixedRender,
 ) -> Result<(Metrics, scene::FixedRender, reference::Image), String> {
     let reference = spec.reference()?;
     let ref_image = reference.render(w, h);
     let bound = ErrorBound {
-        sub_bits,
+        sub_bits: precision.sub_bits,
         max_model_coord: spec.max_model_coord(),
         focal_px: reference.camera.focal_px(h),
+        arithmetic: precision
+            .arith
+            .documented_error(w, h, spec.max_model_coord()),
     };
     let m = metrics::compare(&fixed.image, &ref_image, &reference, &bound);
     Ok((m, fixed, ref_image))

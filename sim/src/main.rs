@@ -629,7 +629,8 @@ fn demo(out: &Path) -> Result<(), String> {
         ErrorBound {
             sub_bits: 4,
             max_model_coord: spec.max_model_coord(),
-            focal_px: spec.reference()?.camera.focal_px(h)
+            focal_px: spec.reference()?.camera.focal_px(h),
+            arithmetic: Default::default(),
         }
         .position_px(4.0)
     );

@@ -37,18 +37,32 @@ pub struct ErrorBound {
     pub max_model_coord: f64,
     /// Pixels per world unit at eye depth 1.
     pub focal_px: f64,
+    /// What a narrow set-up arithmetic adds (zero for the precise default).
+    pub arithmetic: ArithmeticError,
+}
+
+/// The documented error a set-up arithmetic (`scanline3d::preset::Arithmetic`) adds to the
+/// precise one's, for one scene and screen.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ArithmeticError {
+    /// Screen position error in pixels (`project::Reciprocal`: 2^-14 of a vertex's offset from
+    /// the screen centre, at most the guard band's corner).
+    pub px: f64,
+    /// Eye-space error in world units (`vertex::NarrowTransform`: 3 · 2^-13 · max|m| · max|v|,
+    /// with max|m| = 1 for the rigid model transforms the corpus and tools use).
+    pub eye_units: f64,
 }
 
 impl ErrorBound {
     /// `ε(w)` in pixels at eye depth `w`.
     pub fn position_px(&self, w: f64) -> f64 {
         let snap = std::f64::consts::SQRT_2 * 0.5f64.powi(self.sub_bits as i32 + 1);
-        snap + self.focal_px * self.eye_units() / w.max(1e-9) + 2f64.powi(-12)
+        snap + self.focal_px * self.eye_units() / w.max(1e-9) + 2f64.powi(-12) + self.arithmetic.px
     }
 
     /// Eye-space position error `E` of the transform, in world units (see the module docs).
     pub fn eye_units(&self) -> f64 {
-        2f64.powi(-16) * (1.0 + 3.0 * self.max_model_coord)
+        2f64.powi(-16) * (1.0 + 3.0 * self.max_model_coord) + self.arithmetic.eye_units
     }
 
     /// Relative depth error at eye depth `w` with near plane `near`, not counting the screen

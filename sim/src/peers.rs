@@ -590,6 +590,7 @@ pub fn bound(spec: &SceneSpec, reference: &reference::Scene, h: usize) -> ErrorB
         sub_bits: 4,
         max_model_coord: spec.max_model_coord(),
         focal_px: reference.camera.focal_px(h),
+        arithmetic: Default::default(),
     }
 }
 

@@ -2,11 +2,14 @@
 //! data, camera and light parameters, OBJ loading, and rendering to id/depth/colour images.
 
 use crate::bsp::Bsp;
+use crate::metrics::ArithmeticError;
 use crate::reference::{self, Image};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::I16F16;
-use scanline3d::math::{Libm, MathBackend, Micromath};
-use scanline3d::preset::{self, Preset};
+use scanline3d::clip::FrustumClip;
+use scanline3d::math::{Libm, MathBackend, Micromath, NarrowNormals, WideNormals};
+use scanline3d::preset::{self, Arithmetic, Precise, Preset, Setup};
+use scanline3d::project::{ExactDivision, Reciprocal};
 use scanline3d::resolve::bsp::{BspTree, BspWorkspace};
 use scanline3d::resolve::{
     warnock, BandWorkspace, DepthSortWorkspace, NewellWorkspace, SpanSortWorkspace,
@@ -14,6 +17,7 @@ use scanline3d::resolve::{
 };
 use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
 use scanline3d::sink::{FnSink, Row, RowPixel, RowSink, TriangleId};
+use scanline3d::vertex::{NarrowTransform, WideTransform};
 use scanline3d::{Flat, FrameStats, RenderOptions, Workspace};
 use std::convert::Infallible;
 use std::path::Path;
@@ -468,10 +472,10 @@ impl SceneSpec {
         sub_bits: u32,
         algorithm: Algorithm,
     ) -> Result<FixedRender, String> {
-        self.render_fixed_settings(w, h, sub_bits, SetupMath::Libm, algorithm)
+        self.render_fixed_settings(w, h, Precision::bits(sub_bits), algorithm)
     }
 
-    /// [`Self::render_fixed_with`] with the sub-pixel bits and set-up math of a precision preset
+    /// [`Self::render_fixed_with`] with the precision choices of a preset
     /// (`scanline3d::preset`).
     pub fn render_fixed_preset(
         &self,
@@ -480,16 +484,16 @@ impl SceneSpec {
         preset: PresetChoice,
         algorithm: Algorithm,
     ) -> Result<FixedRender, String> {
-        self.render_fixed_settings(w, h, preset.sub_bits(), preset.math(), algorithm)
+        self.render_fixed_settings(w, h, preset.precision(), algorithm)
     }
 
-    /// [`Self::render_fixed_with`] at `sub_bits` with set-up computed by `math`.
+    /// [`Self::render_fixed_with`] with any precision choices. Narrow arithmetic
+    /// ([`SetupArith`] other than `Precise`) is built for the span z-buffer only.
     pub fn render_fixed_settings(
         &self,
         w: usize,
         h: usize,
-        sub_bits: u32,
-        math: SetupMath,
+        precision: Precision,
         algorithm: Algorithm,
     ) -> Result<FixedRender, String> {
         // The host workspaces are large (capacity for 2048×2048 and 65534 triangles) and the
@@ -499,7 +503,7 @@ impl SceneSpec {
             std::thread::Builder::new()
                 .stack_size(256 << 20)
                 .spawn_scoped(scope, || {
-                    self.render_fixed_on_this_thread(w, h, sub_bits, math, algorithm)
+                    self.render_fixed_on_this_thread(w, h, precision, algorithm)
                 })
                 .map_err(|e| format!("cannot start render thread: {e}"))?
                 .join()
@@ -593,22 +597,36 @@ impl SceneSpec {
         &self,
         w: usize,
         h: usize,
-        sub_bits: u32,
-        math: SetupMath,
+        precision: Precision,
         algorithm: Algorithm,
     ) -> Result<FixedRender, String> {
-        match sub_bits {
-            0 => self.render_fixed_s::<0>(w, h, math, algorithm),
-            2 => self.render_fixed_s::<2>(w, h, math, algorithm),
-            4 => self.render_fixed_s::<4>(w, h, math, algorithm),
-            8 => self.render_fixed_s::<8>(w, h, math, algorithm),
-            _ => Err(format!(
-                "sub-pixel bits must be one of {SUB_PIXEL_CHOICES:?}"
-            )),
+        use preset::Quick;
+        let math = precision.math;
+        macro_rules! bits {
+            ($a:ty) => {
+                match precision.sub_bits {
+                    0 => self.render_fixed_s::<0, $a>(w, h, math, algorithm),
+                    2 => self.render_fixed_s::<2, $a>(w, h, math, algorithm),
+                    4 => self.render_fixed_s::<4, $a>(w, h, math, algorithm),
+                    8 => self.render_fixed_s::<8, $a>(w, h, math, algorithm),
+                    _ => Err(format!(
+                        "sub-pixel bits must be one of {SUB_PIXEL_CHOICES:?}"
+                    )),
+                }
+            };
+        }
+        match precision.arith {
+            SetupArith::Precise => bits!(Precise),
+            SetupArith::Quick => bits!(Quick),
+            SetupArith::NarrowTransform => {
+                bits!(Setup<NarrowTransform, ExactDivision, WideNormals>)
+            }
+            SetupArith::Reciprocal => bits!(Setup<WideTransform, Reciprocal, WideNormals>),
+            SetupArith::NarrowNormals => bits!(Setup<WideTransform, ExactDivision, NarrowNormals>),
         }
     }
 
-    fn render_fixed_s<const S: u32>(
+    fn render_fixed_s<const S: u32, A: Dispatch>(
         &self,
         w: usize,
         h: usize,
@@ -644,7 +662,8 @@ impl SceneSpec {
         };
         let options = RenderOptions::default()
             .with_back_face_culling(self.cull_back_faces)
-            .with_sub_pixel_bits::<S>();
+            .with_sub_pixel_bits::<S>()
+            .with_arithmetic(A::default());
         let mut target = RgbImage {
             width: w,
             height: h,
@@ -655,7 +674,7 @@ impl SceneSpec {
             let mut sink = FnSink(|row: Row<'_, Rgb888>| {
                 scanline3d::sink::RowSink::write_row(&mut display, row)
             });
-            render_with(
+            A::render(
                 algorithm,
                 tree.as_ref(),
                 Rgb888::BLACK,
@@ -680,7 +699,7 @@ impl SceneSpec {
             }
             Ok(())
         });
-        render_with(
+        A::render(
             algorithm,
             tree.as_ref(),
             TriangleId::NONE,
@@ -706,6 +725,77 @@ pub enum SetupMath {
     Libm,
     /// [`Micromath`]: approximate, smaller.
     Micromath,
+}
+
+/// Set-up arithmetic (`scanline3d::preset::Arithmetic`), chosen at run time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SetupArith {
+    /// [`preset::Precise`]: the default.
+    Precise,
+    /// [`preset::Quick`]: narrow at every stage.
+    Quick,
+    /// Precise but for the transform (`vertex::NarrowTransform`).
+    NarrowTransform,
+    /// Precise but for the projection (`project::Reciprocal`).
+    Reciprocal,
+    /// Precise but for the lighting normals (`math::NarrowNormals`).
+    NarrowNormals,
+}
+
+impl SetupArith {
+    /// Name in the trade-off table.
+    pub fn name(self) -> &'static str {
+        match self {
+            SetupArith::Precise => "precise",
+            SetupArith::Quick => "quick",
+            SetupArith::NarrowTransform => "narrow transform",
+            SetupArith::Reciprocal => "reciprocal projection",
+            SetupArith::NarrowNormals => "narrow normals",
+        }
+    }
+
+    /// The error it adds to the precise arithmetic's, as documented in the library, for a
+    /// `w × h` screen and a scene whose largest model coordinate is `max_model_coord`.
+    pub fn documented_error(self, w: usize, h: usize, max_model_coord: f64) -> ArithmeticError {
+        let narrow_transform = matches!(self, SetupArith::Quick | SetupArith::NarrowTransform);
+        let reciprocal = matches!(self, SetupArith::Quick | SetupArith::Reciprocal);
+        // The guard band's corner is 4 screen sizes from the centre in x and y.
+        let corner = 4.0 * (w.max(h) as f64) * std::f64::consts::SQRT_2;
+        ArithmeticError {
+            px: if reciprocal {
+                2f64.powi(-14) * corner
+            } else {
+                0.0
+            },
+            eye_units: if narrow_transform {
+                3.0 * 2f64.powi(-13) * max_model_coord
+            } else {
+                0.0
+            },
+        }
+    }
+}
+
+/// Every precision choice of one render.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Precision {
+    /// Sub-pixel bits (0, 2, 4 or 8).
+    pub sub_bits: u32,
+    /// Per-frame set-up math.
+    pub math: SetupMath,
+    /// Per-vertex and per-triangle set-up arithmetic.
+    pub arith: SetupArith,
+}
+
+impl Precision {
+    /// The default but for the sub-pixel bits.
+    pub const fn bits(sub_bits: u32) -> Precision {
+        Precision {
+            sub_bits,
+            math: SetupMath::Libm,
+            arith: SetupArith::Precise,
+        }
+    }
 }
 
 /// A precision preset of `scanline3d::preset`, chosen at run time (`sim render --preset`).
@@ -742,6 +832,35 @@ impl PresetChoice {
             PresetChoice::Fast => preset::Fast::SUB_BITS,
             PresetChoice::Balanced => preset::Balanced::SUB_BITS,
             PresetChoice::Exact => preset::Exact::SUB_BITS,
+        }
+    }
+
+    /// All its precision choices.
+    pub fn precision(self) -> Precision {
+        Precision {
+            sub_bits: self.sub_bits(),
+            math: self.math(),
+            arith: self.arith(),
+        }
+    }
+
+    /// Its set-up arithmetic.
+    pub fn arith(self) -> SetupArith {
+        fn of<P: Preset>() -> SetupArith {
+            use std::any::TypeId;
+            let a = TypeId::of::<P::Arithmetic>();
+            if a == TypeId::of::<preset::Precise>() {
+                SetupArith::Precise
+            } else if a == TypeId::of::<preset::Quick>() {
+                SetupArith::Quick
+            } else {
+                unreachable!("presets use Precise or Quick arithmetic")
+            }
+        }
+        match self {
+            PresetChoice::Fast => of::<preset::Fast>(),
+            PresetChoice::Balanced => of::<preset::Balanced>(),
+            PresetChoice::Exact => of::<preset::Exact>(),
         }
     }
 
@@ -933,6 +1052,81 @@ where
     }
     .map_err(|e| e.to_string())
 }
+
+/// Renders with arithmetic `Self`: every method for the precise default, the span z-buffer
+/// alone for the narrow ones (which exist to be measured; this keeps the tools' build small).
+trait Dispatch: Arithmetic + 'static {
+    #[allow(clippy::too_many_arguments)]
+    fn render<P: RowPixel, const S: u32, K: RowSink<P>>(
+        algorithm: Algorithm,
+        tree: Option<&BspTree<'_>>,
+        background: P,
+        w: usize,
+        h: usize,
+        scene: &Scene<'_>,
+        options: &RenderOptions<S, FrustumClip, Self>,
+        sink: &mut K,
+    ) -> Result<FrameStats, String>
+    where
+        K::Error: std::fmt::Debug;
+}
+
+impl Dispatch for Precise {
+    fn render<P: RowPixel, const S: u32, K: RowSink<P>>(
+        algorithm: Algorithm,
+        tree: Option<&BspTree<'_>>,
+        background: P,
+        w: usize,
+        h: usize,
+        scene: &Scene<'_>,
+        options: &RenderOptions<S>,
+        sink: &mut K,
+    ) -> Result<FrameStats, String>
+    where
+        K::Error: std::fmt::Debug,
+    {
+        render_with(algorithm, tree, background, w, h, scene, options, sink)
+    }
+}
+
+/// The narrow arithmetics: span z-buffer only.
+macro_rules! span_zbuffer_only {
+    ($($a:ty),*) => {$(
+        impl Dispatch for $a {
+            fn render<P: RowPixel, const S: u32, K: RowSink<P>>(
+                algorithm: Algorithm,
+                _: Option<&BspTree<'_>>,
+                background: P,
+                w: usize,
+                h: usize,
+                scene: &Scene<'_>,
+                options: &RenderOptions<S, FrustumClip, Self>,
+                sink: &mut K,
+            ) -> Result<FrameStats, String>
+            where
+                K::Error: std::fmt::Debug,
+            {
+                if algorithm != Algorithm::SpanZBuffer {
+                    return Err(format!(
+                        "narrow set-up arithmetic is built for {} only",
+                        Algorithm::SpanZBuffer
+                    ));
+                }
+                type Ws<P> = Workspace<P, Flat, MAX_SIZE, MAX_SIZE, TRIS, ACTIVE>;
+                let mut ws: Box<Ws<P>> = Box::new(Ws::new(background));
+                ws.render_sized(w, h, scene, options, sink)
+                    .map_err(|e| e.to_string())
+            }
+        }
+    )*};
+}
+
+span_zbuffer_only!(
+    preset::Quick,
+    Setup<NarrowTransform, ExactDivision, WideNormals>,
+    Setup<WideTransform, Reciprocal, WideNormals>,
+    Setup<WideTransform, ExactDivision, NarrowNormals>
+);
 
 /// An RGB image as an embedded-graphics `DrawTarget`: the colour pass reaches it through
 /// [`scanline3d::sink::DrawTargetSink`], the same path a display takes on firmware.

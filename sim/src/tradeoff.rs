@@ -3,7 +3,7 @@
 
 use crate::corpus;
 use crate::metrics::{self, ErrorBound, Metrics};
-use crate::scene::{LightSpec, PresetChoice, SceneSpec, SetupMath};
+use crate::scene::{LightSpec, Precision, PresetChoice, SceneSpec, SetupArith, SetupMath};
 
 /// One set of precision choices.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -12,38 +12,69 @@ pub struct Variant {
     pub name: &'static str,
     /// The preset, if this is one.
     pub preset: Option<PresetChoice>,
-    /// Sub-pixel bits.
-    pub sub_bits: u32,
-    /// Per-frame set-up math.
-    pub math: SetupMath,
+    /// Its choices.
+    pub precision: Precision,
 }
 
-const fn preset(p: PresetChoice, name: &'static str, sub_bits: u32, math: SetupMath) -> Variant {
+const fn preset(p: PresetChoice, name: &'static str, precision: Precision) -> Variant {
     Variant {
         name,
         preset: Some(p),
-        sub_bits,
-        math,
+        precision,
     }
 }
 
-const fn knob(name: &'static str, sub_bits: u32, math: SetupMath) -> Variant {
+/// The default (balanced) with one knob changed.
+const fn knob(name: &'static str, sub_bits: u32, math: SetupMath, arith: SetupArith) -> Variant {
     Variant {
         name,
         preset: None,
+        precision: Precision {
+            sub_bits,
+            math,
+            arith,
+        },
+    }
+}
+
+const fn choices(sub_bits: u32, arith: SetupArith) -> Precision {
+    Precision {
         sub_bits,
-        math,
+        math: SetupMath::Libm,
+        arith,
     }
 }
 
 /// Every variant, in the order of `examples/tradeoff.rs` (a test keeps the presets' entries
-/// equal to `scanline3d::preset`).
-pub const VARIANTS: [Variant; 5] = [
-    preset(PresetChoice::Fast, "fast", 2, SetupMath::Libm),
-    preset(PresetChoice::Balanced, "balanced", 4, SetupMath::Libm),
-    preset(PresetChoice::Exact, "exact", 8, SetupMath::Libm),
-    knob("bits:0", 0, SetupMath::Libm),
-    knob("micromath", 4, SetupMath::Micromath),
+/// equal to `scanline3d::preset`). A knob's name is also its `scanline3d_variant` cfg value with
+/// `:` and spaces removed.
+pub const VARIANTS: [Variant; 8] = [
+    preset(PresetChoice::Fast, "fast", choices(2, SetupArith::Quick)),
+    preset(
+        PresetChoice::Balanced,
+        "balanced",
+        choices(4, SetupArith::Precise),
+    ),
+    preset(
+        PresetChoice::Exact,
+        "exact",
+        choices(8, SetupArith::Precise),
+    ),
+    knob("bits:0", 0, SetupMath::Libm, SetupArith::Precise),
+    knob("micromath", 4, SetupMath::Micromath, SetupArith::Precise),
+    knob(
+        "narrow-transform",
+        4,
+        SetupMath::Libm,
+        SetupArith::NarrowTransform,
+    ),
+    knob("reciprocal", 4, SetupMath::Libm, SetupArith::Reciprocal),
+    knob(
+        "narrow-normals",
+        4,
+        SetupMath::Libm,
+        SetupArith::NarrowNormals,
+    ),
 ];
 
 /// One variant on one corpus scene and camera, against the f64 reference.
@@ -84,14 +115,17 @@ pub fn corpus_accuracy(
                 let fixed = spec.render_fixed_settings(
                     w,
                     h,
-                    v.sub_bits,
-                    v.math,
+                    v.precision,
                     crate::scene::Algorithm::SpanZBuffer,
                 )?;
                 let bound = ErrorBound {
-                    sub_bits: v.sub_bits,
+                    sub_bits: v.precision.sub_bits,
                     max_model_coord: spec.max_model_coord(),
                     focal_px: reference.camera.focal_px(h),
+                    arithmetic: v
+                        .precision
+                        .arith
+                        .documented_error(w, h, spec.max_model_coord()),
                 };
                 out.push(Accuracy {
                     variant: v.name,
@@ -115,10 +149,7 @@ mod tests {
     fn preset_variants_are_the_library_presets() {
         for v in VARIANTS {
             if let Some(p) = v.preset {
-                assert_eq!(
-                    (v.name, v.sub_bits, v.math),
-                    (p.name(), p.sub_bits(), p.math())
-                );
+                assert_eq!((v.name, v.precision), (p.name(), p.precision()));
             }
         }
         assert_eq!(

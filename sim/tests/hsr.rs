@@ -37,6 +37,7 @@ fn every_method_against_the_reference() {
                     sub_bits,
                     max_model_coord: spec.max_model_coord(),
                     focal_px: reference.camera.focal_px(H),
+                    arithmetic: Default::default(),
                 };
                 for algorithm in Algorithm::ALL {
                     let fixed = spec.render_fixed_with(W, H, sub_bits, algorithm).unwrap();

@@ -10,7 +10,16 @@ fn presets_meet_their_accuracy_claims_on_the_corpus() {
     let of = |name: &'static str| all.iter().filter(move |a| a.variant == name);
     // Every preset (and the coarsest setting) is free of real mismatches and keeps depth within
     // its bound everywhere.
-    for name in ["fast", "balanced", "exact", "bits:0"] {
+    // So is each narrow-arithmetic knob, under the error its arithmetic documents.
+    for name in [
+        "fast",
+        "balanced",
+        "exact",
+        "bits:0",
+        "narrow-transform",
+        "reciprocal",
+        "narrow-normals",
+    ] {
         for a in of(name) {
             let m = &a.metrics;
             assert_eq!(m.real, 0, "{name} on {} camera {}: {m}", a.scene, a.camera);

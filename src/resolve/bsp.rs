@@ -14,6 +14,7 @@
 //! and the rows are painted like the depth sort's, far to near.
 
 use crate::clip::Clipping;
+use crate::preset::Arithmetic;
 use crate::render::{
     drive, viewport, ActiveTri, CapacityKind, Frame, FrameStats, InstanceSetup, RenderError,
     RenderOptions, TriangleOrder, NO_ENTRY,
@@ -321,11 +322,11 @@ impl<
     }
 
     /// Renders `scene` (one instance, the mesh `tree` was built for) in BSP order.
-    pub fn render<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         scene: &Scene<'_>,
         tree: &BspTree<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         self.render_sized(W, H, scene, tree, options, sink)
@@ -333,13 +334,13 @@ impl<
 
     /// Renders a `width × height` target (at most `W × H`); see
     /// [`Workspace::render_sized`](crate::Workspace::render_sized).
-    pub fn render_sized<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render_sized<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         width: usize,
         height: usize,
         scene: &Scene<'_>,
         tree: &BspTree<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         let vp = viewport::<SUB_BITS, K::Error>(width, height, W, H, scene)?;
@@ -373,7 +374,7 @@ impl<
             eye,
             stack: &mut self.stack,
         };
-        drive::<P, S, SUB_BITS, C, K, 1, _>(
+        drive::<P, S, SUB_BITS, C, A, K, 1, _>(
             frame,
             &mut resolve,
             &mut order,

@@ -32,6 +32,7 @@
 //! [`Row::depth`]: crate::sink::Row::depth
 
 use crate::clip::Clipping;
+use crate::preset::Arithmetic;
 use crate::project::Depth;
 use crate::raster::PixelOrigin;
 use crate::render::{
@@ -205,10 +206,10 @@ impl<
     }
 
     /// Renders `scene`, handing each of the `H` rows to `sink` once, top to bottom.
-    pub fn render<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         self.render_sized(W, H, scene, options, sink)
@@ -216,12 +217,12 @@ impl<
 
     /// Renders a `width × height` target (at most `W × H`); see
     /// [`Workspace::render_sized`](crate::Workspace::render_sized).
-    pub fn render_sized<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render_sized<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         width: usize,
         height: usize,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         let vp = viewport::<SUB_BITS, K::Error>(width, height, W, H, scene)?;
@@ -251,7 +252,7 @@ impl<
             width,
             y0: 0,
         };
-        drive::<P, S, SUB_BITS, C, K, INSTANCES, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _>(
             frame,
             &mut band,
             &mut IdOrder,
@@ -491,10 +492,10 @@ impl<
     }
 
     /// Renders `scene`, handing each of the `H` rows to `sink` once, top to bottom.
-    pub fn render<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         self.render_sized(W, H, scene, options, sink)
@@ -502,12 +503,12 @@ impl<
 
     /// Renders a `width × height` target (at most `W × H`); see
     /// [`Workspace::render_sized`](crate::Workspace::render_sized).
-    pub fn render_sized<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render_sized<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         width: usize,
         height: usize,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         let vp = viewport::<SUB_BITS, K::Error>(width, height, W, H, scene)?;
@@ -528,7 +529,7 @@ impl<
             background: self.background,
             spans: self.spans.as_mut_view(),
         };
-        drive::<P, S, SUB_BITS, C, K, INSTANCES, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _>(
             frame,
             &mut resolve,
             &mut IdOrder,
@@ -645,10 +646,10 @@ impl<
     }
 
     /// Renders `scene`, handing each of the `H` rows to `sink` once, top to bottom.
-    pub fn render<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         self.render_sized(W, H, scene, options, sink)
@@ -656,12 +657,12 @@ impl<
 
     /// Renders a `width × height` target (at most `W × H`); see
     /// [`Workspace::render_sized`](crate::Workspace::render_sized).
-    pub fn render_sized<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render_sized<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         width: usize,
         height: usize,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         let vp = viewport::<SUB_BITS, K::Error>(width, height, W, H, scene)?;
@@ -682,7 +683,7 @@ impl<
             background: self.background,
             spans: 0,
         };
-        drive::<P, S, SUB_BITS, C, K, INSTANCES, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _>(
             frame,
             &mut resolve,
             &mut IdOrder,

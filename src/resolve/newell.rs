@@ -81,6 +81,7 @@
 //! [`NewellWorkspace::BYTES`] gives the total.
 
 use crate::clip::Clipping;
+use crate::preset::Arithmetic;
 use crate::render::{
     viewport, walk_rows, ActiveTri, CapacityKind, FrameStats, RenderError, RenderOptions,
     MAX_INSTANCES, NO_ENTRY,
@@ -224,10 +225,10 @@ impl<
     }
 
     /// Renders `scene`, handing each of the `H` rows to `sink` once, top to bottom.
-    pub fn render<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         self.render_sized(W, H, scene, options, sink)
@@ -237,12 +238,12 @@ impl<
     /// [`Workspace::render_sized`](crate::Workspace::render_sized). More pieces than `PIECES`
     /// (before or after splitting) or more than [`step_limit`]`(PIECES)` search steps is a
     /// [`RenderError::Capacity`] error before any row is sent.
-    pub fn render_sized<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render_sized<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         width: usize,
         height: usize,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         let vp = viewport::<SUB_BITS, K::Error>(width, height, W, H, scene)?;
@@ -251,7 +252,7 @@ impl<
         else {
             return Err(RenderError::InvalidTarget);
         };
-        let (n, stats) = store::collect::<S, SUB_BITS, C, K::Error, INSTANCES>(
+        let (n, stats) = store::collect::<S, SUB_BITS, C, A, K::Error, INSTANCES>(
             scene,
             options,
             &vp,

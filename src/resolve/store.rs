@@ -7,6 +7,7 @@
 //! there, and the eye is at `q = +∞` (larger `q` is nearer).
 
 use crate::clip::Clipping;
+use crate::preset::Arithmetic;
 use crate::project::{Depth, ScreenVertex, SubPx, Viewport};
 use crate::raster::{channel, color_channels, first_row};
 use crate::render::{
@@ -91,15 +92,22 @@ impl Default for StoredTriangle {
 
 /// Keeps every visible screen piece of `scene` in `store`, in id order. Returns how many and
 /// the frame statistics so far; a store too small is an error before anything is drawn.
-pub(crate) fn collect<S: Shading, const SUB: u32, C: Clipping, E, const INSTANCES: usize>(
+pub(crate) fn collect<
+    S: Shading,
+    const SUB: u32,
+    C: Clipping,
+    A: Arithmetic,
+    E,
+    const INSTANCES: usize,
+>(
     scene: &Scene<'_>,
-    options: &RenderOptions<SUB, C>,
+    options: &RenderOptions<SUB, C, A>,
     vp: &Viewport<SUB>,
     store: &mut [StoredTriangle],
 ) -> Result<(usize, FrameStats), RenderError<E>> {
     let mut n = 0usize;
     let stats =
-        for_each_screen_piece::<S, SUB, C, E, INSTANCES>(scene, options, vp, |s, face, id| {
+        for_each_screen_piece::<S, SUB, C, A, E, INSTANCES>(scene, options, vp, |s, face, id| {
             if let Some(slot) = store.get_mut(n) {
                 *slot = StoredTriangle::new(&s, face, id, S::PER_VERTEX);
             }

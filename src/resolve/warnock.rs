@@ -65,6 +65,7 @@
 //! [`WarnockWorkspace::subdivision`]. Nothing is ever dropped: the frame is always complete.
 
 use crate::clip::Clipping;
+use crate::preset::Arithmetic;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{DepthPlane, PlaneSolver, TriangleWalk};
 use crate::render::{
@@ -248,10 +249,10 @@ impl<
     }
 
     /// Renders `scene`, handing each of the `H` rows to `sink` once, top to bottom.
-    pub fn render<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         self.render_sized(W, H, scene, options, sink)
@@ -261,12 +262,12 @@ impl<
     /// [`Workspace::render_sized`](crate::Workspace::render_sized). A stack smaller than
     /// [`stack_needed`]`(width, height)` or more pieces than `PIECES` is a
     /// [`RenderError::Capacity`] error before any row is sent.
-    pub fn render_sized<const SUB_BITS: u32, C: Clipping, K: RowSink<P>>(
+    pub fn render_sized<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
         &mut self,
         width: usize,
         height: usize,
         scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C>,
+        options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         let vp = viewport::<SUB_BITS, K::Error>(width, height, W, H, scene)?;
@@ -278,7 +279,7 @@ impl<
                 capacity: STACK,
             });
         }
-        let (n, mut stats) = store::collect::<S, SUB_BITS, C, K::Error, INSTANCES>(
+        let (n, mut stats) = store::collect::<S, SUB_BITS, C, A, K::Error, INSTANCES>(
             scene,
             options,
             &vp,

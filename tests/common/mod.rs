@@ -142,6 +142,7 @@ pub fn compare(
         sub_bits: s,
         max_model_coord,
         focal_px: scene.camera.focal_px(h),
+        arithmetic: Default::default(),
     };
     let m = metrics::compare(&fixed, &wanted, &scene, &bound);
     (m.id_mismatches, m.real)

@@ -444,6 +444,7 @@ impl scanline3d_sim::hsr::Visit for HsrHostRun {
             sub_bits: 4,
             max_model_coord: spec.max_model_coord(),
             focal_px: reference.camera.focal_px(HEIGHT),
+            arithmetic: Default::default(),
         };
         self.entries.push(HsrHost {
             method: M::NAME,

@@ -71,6 +71,7 @@ struct Row {
     name: &'static str,
     sub_bits: u32,
     math: &'static str,
+    arith: &'static str,
     preset: bool,
     mean_id: f64,
     worst_id: f64,
@@ -129,7 +130,7 @@ pub fn tradeoff() -> Result<(), String> {
                 .args(["--target", target, "--", "--cfg"])
                 .arg(format!(
                     "scanline3d_variant=\"{}\"",
-                    v.name.replace(':', "")
+                    v.name.replace([':', '-'], "")
                 )))?;
             let elf = root()
                 .join("target")
@@ -186,8 +187,9 @@ pub fn tradeoff() -> Result<(), String> {
                 .collect();
             Row {
                 name: v.name,
-                sub_bits: v.sub_bits,
-                math: match v.math {
+                sub_bits: v.precision.sub_bits,
+                arith: v.precision.arith.name(),
+                math: match v.precision.math {
                     scanline3d_sim::scene::SetupMath::Libm => "libm",
                     scanline3d_sim::scene::SetupMath::Micromath => "micromath",
                 },
@@ -245,25 +247,28 @@ pub fn tradeoff() -> Result<(), String> {
     line(String::new());
     line("Written by `cargo xtask tradeoff`; do not edit by hand. The presets of `scanline3d::preset` (fast, balanced = the default, exact) and the default with one knob changed, so that each knob's own effect shows.".into());
     line(String::new());
+    line("Set-up arithmetic (`scanline3d::preset::Arithmetic`): *precise* transforms with 64-bit products, divides each coordinate exactly and normalizes normals to 30 bits; *quick* uses 32-bit transform products (`vertex::NarrowTransform`), one reciprocal per vertex (`project::Reciprocal`) and 15-bit normals (`math::NarrowNormals`). The three knob rows change one of these alone. Each variant is judged under its own documented error bound: sub-pixel snapping plus what its arithmetic adds (`SetupArith::documented_error`).".into());
+    line(String::new());
     line(format!("* **Accuracy:** every corpus scene from every camera ({} views) at {SIZE}×{SIZE} against the f64 reference, each variant judged under its own sub-pixel error bound (`metrics::compare`). Id mismatches: pixels showing another triangle than the reference (mean and worst view); real: mismatches the bound does not explain, summed over all views; depth: pixels beyond their depth bound, summed.", accuracy.len() / VARIANTS.len()));
     line(format!("* **Instructions:** the demo orbit (1420 triangles, 8 frames, mean per frame) on QEMU ({}, `-icount shift=0`): mps2-an386 for thumbv7em (Cortex-M4F), mps2-an385 for thumbv6m. `examples/tradeoff.rs` is built once per variant, so each image carries only its own code (in one image holding every variant, LLVM inlined each variant differently, and the counts no longer compared like with like); every frame hash equals the host's.", first_line(Command::new("qemu-system-arm").arg("--version"))));
     line(format!("* **Host time:** criterion (`cargo bench --bench tradeoff`), the sum over the corpus scenes (first camera each) of the mean time per frame, on {} ({}).", host_cpu(), first_line(Command::new("rustc").arg("--version"))));
     line(format!("* **Flash:** that variant's trade-off firmware (release profile, demo mesh data included). **RAM:** the workspace is the same for every variant, {} B; no knob changes memory yet.", thousands(workspace)));
     line("* **Pareto front:** variants without real mismatches that no other such variant beats on both thumbv6m instructions and mean id mismatches.".into());
     line(String::new());
-    line("| variant | sub-pixel bits | set-up math | id mismatches, mean / worst (scene) | real | depth beyond bound | worst colour PSNR | thumbv7em instr./frame | thumbv6m instr./frame | thumbv6m vs exact | host time, corpus | flash thumbv7em / thumbv6m | Pareto |".into());
-    line("|---|---|---|---|---|---|---|---|---|---|---|---|---|".into());
+    line("| variant | sub-pixel bits | set-up math | set-up arithmetic | id mismatches, mean / worst (scene) | real | depth beyond bound | worst colour PSNR | thumbv7em instr./frame | thumbv6m instr./frame | thumbv6m vs exact | host time, corpus | flash thumbv7em / thumbv6m | Pareto |".into());
+    line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|".into());
     for (r, on_front) in rows.iter().zip(&front) {
         let flash = match (r.flash[0], r.flash[1]) {
             (Some(a), Some(b)) => format!("{} / {} B", thousands(a), thousands(b)),
             _ => "n/a".into(),
         };
         line(format!(
-            "| {}{} | {} | {} | {:.3} % / {:.3} % ({}) | {} | {} | {:.1} dB | {} | {} | {:.2}× | {} | {} | {} |",
+            "| {}{} | {} | {} | {} | {:.3} % / {:.3} % ({}) | {} | {} | {:.1} dB | {} | {} | {:.2}× | {} | {} | {} |",
             if r.preset { "**" } else { "" },
             if r.preset { format!("{}**", r.name) } else { r.name.to_string() },
             r.sub_bits,
             r.math,
+            r.arith,
             r.mean_id,
             r.worst_id,
             r.worst_scene,
