@@ -130,10 +130,12 @@ fn main() {
     println!("cargo:rerun-if-changed=sim/src/meshgen.rs");
     // `examples/tradeoff.rs` renders every precision variant, or with
     // `--cfg scanline3d_variant="fast"` (passed by `cargo xtask tradeoff` through `cargo rustc`)
-    // only that preset, so each preset's flash can be measured alone.
+    // only that variant, so each variant's flash can be measured alone; with
+    // `--cfg scanline3d_corpus` it also renders the corpus file the xtask generates.
     println!(
-        "cargo::rustc-check-cfg=cfg(scanline3d_variant, values(\"fast\", \"balanced\", \"exact\", \"bits0\", \"micromath\", \"narrowtransform\", \"reciprocal\", \"narrownormals\"))"
+        "cargo::rustc-check-cfg=cfg(scanline3d_variant, values(\"fast\", \"balanced\", \"exact\", \"default\", \"bits0\", \"micromath\", \"narrowtransform\", \"reciprocal\", \"narrownormals\"))"
     );
+    println!("cargo::rustc-check-cfg=cfg(scanline3d_corpus)");
     // The firmware example links with the runtime's link.x. On Arm, cortex-m-rt's link.x
     // includes memory.x from the linker search path (the top-level one). On RISC-V,
     // `.cargo/config.toml` passes memory-riscv-virt.x (QEMU virt's RAM, with the region

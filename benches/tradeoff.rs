@@ -6,7 +6,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
 use scanline3d::math::{NarrowNormals, WideNormals};
-use scanline3d::preset::{Arithmetic, Precise, Quick, Setup};
+use scanline3d::preset::{Arithmetic, Frugal, Precise, Quick, Setup};
 use scanline3d::project::{ExactDivision, Reciprocal};
 use scanline3d::scene::Scene;
 use scanline3d::sink::HashSink;
@@ -69,6 +69,7 @@ fn bench(c: &mut Criterion) {
             spec.with_scene_math(p.math, |s| match (p.sub_bits, p.arith) {
                 (0, SetupArith::Precise) => time::<0, Precise>(&mut group, id, &mut ws, s, cull),
                 (2, SetupArith::Quick) => time::<2, Quick>(&mut group, id, &mut ws, s, cull),
+                (4, SetupArith::Frugal) => time::<4, Frugal>(&mut group, id, &mut ws, s, cull),
                 (4, SetupArith::Precise) => time::<4, Precise>(&mut group, id, &mut ws, s, cull),
                 (8, SetupArith::Precise) => time::<8, Precise>(&mut group, id, &mut ws, s, cull),
                 (4, SetupArith::NarrowTransform) => {

@@ -4,7 +4,9 @@
 //! its own code (`cargo rustc --example tradeoff -- --cfg 'scanline3d_variant="fast"'`; the
 //! default is `balanced`). On the host the example renders every variant. `cargo xtask
 //! tradeoff` builds and runs each variant on thumbv7em and thumbv6m and checks the hashes
-//! against the host's.
+//! against the host's. Built with `--cfg scanline3d_corpus` and `SCANLINE3D_CORPUS` naming
+//! the file `scanline3d_sim::export::corpus_source` writes (the xtask does both), it also
+//! renders every view of every corpus scene.
 //!
 //! ```sh
 //! cargo run --release --example tradeoff --target thumbv6m-none-eabi   # QEMU mps2-an385
@@ -15,6 +17,7 @@
 
 use embedded_graphics::pixelcolor::Rgb565;
 use scanline3d::clip::FrustumClip;
+use scanline3d::math::MathBackend;
 use scanline3d::preset::{self, Arithmetic, Preset};
 use scanline3d::scene::{Camera, Scene, SceneError};
 use scanline3d::sink::HashSink;
@@ -33,47 +36,68 @@ struct Frame {
     complete: bool,
 }
 
-/// Renders the orbit with `options` and cameras computed by `camera`, calling `report` per frame.
-fn orbit<const S: u32, A: Arithmetic>(
-    ws: &mut Ws,
-    options: RenderOptions<S, FrustumClip, A>,
-    camera: impl Fn(u32) -> Result<Camera, SceneError>,
+/// Renders one frame of `scene` into the panel model, counting its instructions.
+fn frame<const S: u32, A: Arithmetic, const T: usize, const ACT: usize, const I: usize>(
+    ws: &mut Workspace<Rgb565, Flat, 240, 240, T, ACT, I>,
+    scene: &Scene<'_>,
+    options: &RenderOptions<S, FrustumClip, A>,
     count: &impl Fn() -> Counter,
-    mut report: impl FnMut(u32, Frame),
-) -> Result<(), &'static str> {
-    let instances = demo::instances();
-    for frame in 0..demo::ORBIT_FRAMES {
-        let scene = Scene {
-            instances: &instances,
-            camera: camera(frame).map_err(|_| "camera")?,
-            light: demo::light().map_err(|_| "light")?,
-        };
-        let mut sink = HashSink::new();
-        let counter = count();
-        let stats = ws
-            .render(&scene, &options, &mut sink)
-            .map_err(|_| "render")?;
-        let instructions = counter.stop();
-        report(
-            frame,
-            Frame {
-                hash: sink.hash(),
-                instructions,
-                complete: stats.is_complete(),
-            },
-        );
-    }
-    Ok(())
+) -> Result<Frame, &'static str> {
+    let mut sink = HashSink::new();
+    let counter = count();
+    let stats = ws.render(scene, options, &mut sink).map_err(|_| "render")?;
+    let instructions = counter.stop();
+    Ok(Frame {
+        hash: sink.hash(),
+        instructions,
+        complete: stats.is_complete(),
+    })
 }
 
-fn preset_camera<P: Preset>(frame: u32) -> Result<Camera, SceneError> {
-    let (eye, target, up, fovy, near, far) = demo::camera_parameters(frame, demo::ORBIT_FRAMES);
-    P::camera(eye, target, up, fovy, near, far)
-}
-
-fn math_camera<M: scanline3d::math::MathBackend>(frame: u32) -> Result<Camera, SceneError> {
-    let (eye, target, up, fovy, near, far) = demo::camera_parameters(frame, demo::ORBIT_FRAMES);
+/// A `gluLookAt` · `gluPerspective` camera computed with math backend `M`.
+fn camera<M: MathBackend>(
+    (eye, target, up): ([f32; 3], [f32; 3], [f32; 3]),
+    (fovy, near, far): (f32, f32, f32),
+) -> Result<Camera, SceneError> {
     Camera::look_at_with::<M>(eye, target, up)?.perspective_with::<M>(fovy, near, far)
+}
+
+/// What to render with each variant.
+trait Renders {
+    /// Renders with variant `name`: `options`, and the camera computed with `M`.
+    fn variant<const S: u32, A: Arithmetic, M: MathBackend>(
+        &mut self,
+        name: &'static str,
+        options: RenderOptions<S, FrustumClip, A>,
+    ) -> Result<(), &'static str>;
+}
+
+/// The demo orbit; `report(variant, frame, result)`.
+struct Orbit<'a, C, R> {
+    ws: &'a mut Ws,
+    count: &'a C,
+    report: R,
+}
+
+impl<C: Fn() -> Counter, R: FnMut(&str, u32, Frame)> Renders for Orbit<'_, C, R> {
+    fn variant<const S: u32, A: Arithmetic, M: MathBackend>(
+        &mut self,
+        name: &'static str,
+        options: RenderOptions<S, FrustumClip, A>,
+    ) -> Result<(), &'static str> {
+        let instances = demo::instances();
+        for f in 0..demo::ORBIT_FRAMES {
+            let (eye, target, up, fovy, near, far) = demo::camera_parameters(f, demo::ORBIT_FRAMES);
+            let scene = Scene {
+                instances: &instances,
+                camera: camera::<M>((eye, target, up), (fovy, near, far)).map_err(|_| "camera")?,
+                light: demo::light().map_err(|_| "light")?,
+            };
+            let result = frame(self.ws, &scene, &options, self.count)?;
+            (self.report)(name, f, result);
+        }
+        Ok(())
+    }
 }
 
 /// The variant a target build renders (`--cfg scanline3d_variant="NAME"`, default `balanced`):
@@ -83,6 +107,8 @@ const BUILD_VARIANT: &str = if cfg!(scanline3d_variant = "fast") {
     "fast"
 } else if cfg!(scanline3d_variant = "exact") {
     "exact"
+} else if cfg!(scanline3d_variant = "default") {
+    "default"
 } else if cfg!(scanline3d_variant = "bits0") {
     "bits:0"
 } else if cfg!(scanline3d_variant = "micromath") {
@@ -116,75 +142,100 @@ const fn renders(name: &str) -> bool {
     true
 }
 
-/// The three presets, then the default with one knob changed (those this build renders).
-fn variants(
-    ws: &mut Ws,
-    count: &impl Fn() -> Counter,
-    mut report: impl FnMut(&str, u32, Frame),
-) -> Result<(), &'static str> {
-    use preset::Setup;
-    use preset::{Balanced, Exact, Fast};
+/// The three presets, then `RenderOptions::default()` alone and with one knob changed (those
+/// this build renders).
+fn variants(r: &mut impl Renders) -> Result<(), &'static str> {
+    use preset::{Balanced, Exact, Fast, Setup};
     use scanline3d::math::{Libm, Micromath, NarrowNormals, WideNormals};
     use scanline3d::project::{ExactDivision, Reciprocal};
     use scanline3d::vertex::{NarrowTransform, WideTransform};
-    const FAST: bool = renders(Fast::NAME);
-    const BALANCED: bool = renders(Balanced::NAME);
-    const EXACT: bool = renders(Exact::NAME);
-    const BITS0: bool = renders("bits:0");
-    const MICROMATH: bool = renders("micromath");
-    const NARROW_TRANSFORM: bool = renders("narrow-transform");
-    const RECIPROCAL: bool = renders("reciprocal");
-    const NARROW_NORMALS: bool = renders("narrow-normals");
+    type Math<P> = <P as Preset>::Math;
+    type Arith<P> = <P as Preset>::Arithmetic;
     let default = RenderOptions::default();
-    if FAST {
-        let camera = preset_camera::<Fast>;
-        orbit(ws, Fast::options(), camera, count, |f, l| {
-            report(Fast::NAME, f, l)
-        })?;
+    if renders(Fast::NAME) {
+        r.variant::<2, Arith<Fast>, Math<Fast>>(Fast::NAME, Fast::options())?;
     }
-    if BALANCED {
-        let camera = preset_camera::<Balanced>;
-        orbit(ws, Balanced::options(), camera, count, |f, l| {
-            report(Balanced::NAME, f, l)
-        })?;
+    if renders(Balanced::NAME) {
+        r.variant::<4, Arith<Balanced>, Math<Balanced>>(Balanced::NAME, Balanced::options())?;
     }
-    if EXACT {
-        let camera = preset_camera::<Exact>;
-        orbit(ws, Exact::options(), camera, count, |f, l| {
-            report(Exact::NAME, f, l)
-        })?;
+    if renders(Exact::NAME) {
+        r.variant::<8, Arith<Exact>, Math<Exact>>(Exact::NAME, Exact::options())?;
     }
-    if BITS0 {
+    if renders("default") {
+        r.variant::<4, _, Libm>("default", default)?;
+    }
+    if renders("bits:0") {
         let bits0 = default.with_sub_pixel_bits::<0>();
-        orbit(ws, bits0, math_camera::<Libm>, count, |f, l| {
-            report("bits:0", f, l)
-        })?;
+        r.variant::<0, _, Libm>("bits:0", bits0)?;
     }
-    if MICROMATH {
-        orbit(ws, default, math_camera::<Micromath>, count, |f, l| {
-            report("micromath", f, l)
-        })?;
+    if renders("micromath") {
+        r.variant::<4, _, Micromath>("micromath", default)?;
     }
-    let libm = math_camera::<Libm>;
-    if NARROW_TRANSFORM {
+    if renders("narrow-transform") {
         let a = Setup::<NarrowTransform, ExactDivision, WideNormals>::default();
-        orbit(ws, default.with_arithmetic(a), libm, count, |f, l| {
-            report("narrow-transform", f, l)
-        })?;
+        r.variant::<4, _, Libm>("narrow-transform", default.with_arithmetic(a))?;
     }
-    if RECIPROCAL {
+    if renders("reciprocal") {
         let a = Setup::<WideTransform, Reciprocal, WideNormals>::default();
-        orbit(ws, default.with_arithmetic(a), libm, count, |f, l| {
-            report("reciprocal", f, l)
-        })?;
+        r.variant::<4, _, Libm>("reciprocal", default.with_arithmetic(a))?;
     }
-    if NARROW_NORMALS {
+    if renders("narrow-normals") {
         let a = Setup::<WideTransform, ExactDivision, NarrowNormals>::default();
-        orbit(ws, default.with_arithmetic(a), libm, count, |f, l| {
-            report("narrow-normals", f, l)
-        })?;
+        r.variant::<4, _, Libm>("narrow-normals", default.with_arithmetic(a))?;
     }
     Ok(())
+}
+
+/// Every view of every corpus scene, when built with `--cfg scanline3d_corpus` and the file
+/// `scanline3d_sim::export::corpus_source` wrote at `SCANLINE3D_CORPUS` (`cargo xtask tradeoff`
+/// does both); `report(variant, scene, view, result)`.
+#[cfg(scanline3d_corpus)]
+mod corpus_views {
+    use super::*;
+    use scanline3d::scene::{Instance, Light, Transform};
+
+    #[allow(clippy::all, missing_docs)]
+    pub mod corpus {
+        include!(env!("SCANLINE3D_CORPUS"));
+    }
+
+    /// A workspace for the largest corpus scene.
+    pub type CorpusWs =
+        Workspace<Rgb565, Flat, 240, 240, { corpus::MAX_TRIANGLES }, { corpus::MAX_ACTIVE }, 1>;
+
+    pub struct Views<'a, C, R> {
+        pub ws: &'a mut CorpusWs,
+        pub count: &'a C,
+        pub report: R,
+    }
+
+    impl<C: Fn() -> Counter, R: FnMut(&str, &str, usize, Frame)> Renders for Views<'_, C, R> {
+        fn variant<const S: u32, A: Arithmetic, M: MathBackend>(
+            &mut self,
+            name: &'static str,
+            options: RenderOptions<S, FrustumClip, A>,
+        ) -> Result<(), &'static str> {
+            for s in &corpus::SCENES {
+                let instances = [Instance {
+                    mesh: s.mesh,
+                    transform: Transform::IDENTITY,
+                }];
+                let (towards, ambient, diffuse) = s.light;
+                let light = Light::new(towards, ambient, diffuse).map_err(|_| "light")?;
+                let options = options.with_back_face_culling(s.cull_back_faces);
+                for (k, (&view, &projection)) in s.views.iter().zip(s.projections).enumerate() {
+                    let scene = Scene {
+                        instances: &instances,
+                        camera: camera::<M>(view, projection).map_err(|_| "camera")?,
+                        light,
+                    };
+                    let result = frame(self.ws, &scene, &options, self.count)?;
+                    (self.report)(name, s.name, k, result);
+                }
+            }
+            Ok(())
+        }
+    }
 }
 
 /// Host: the same frames, hashes only (`cargo xtask tradeoff` compares them with the targets').
@@ -200,12 +251,31 @@ impl Counter {
 #[cfg(not(target_os = "none"))]
 fn main() -> Result<(), &'static str> {
     let mut ws = Box::new(Ws::new(Rgb565::new(0, 0, 0)));
-    variants(&mut ws, &|| Counter, |name, frame, f| {
-        println!(
-            "variant {name} frame {frame} hash {:08x} complete {}",
-            f.hash, f.complete
-        )
-    })
+    variants(&mut Orbit {
+        ws: &mut ws,
+        count: &|| Counter,
+        report: |name: &str, frame, f: Frame| {
+            println!(
+                "variant {name} frame {frame} hash {:08x} complete {}",
+                f.hash, f.complete
+            )
+        },
+    })?;
+    #[cfg(scanline3d_corpus)]
+    {
+        let mut ws = Box::new(corpus_views::CorpusWs::new(Rgb565::new(0, 0, 0)));
+        variants(&mut corpus_views::Views {
+            ws: &mut ws,
+            count: &|| Counter,
+            report: |name: &str, scene: &str, view, f: Frame| {
+                println!(
+                    "corpus {name} scene {scene} view {view} hash {:08x} complete {}",
+                    f.hash, f.complete
+                )
+            },
+        })?;
+    }
+    Ok(())
 }
 
 #[cfg(target_os = "none")]
@@ -234,15 +304,36 @@ mod firmware {
     fn run() -> Result<(), &'static str> {
         arch::start_counter()?;
         measure::calibrate()?;
-        let mut ws = Ws::new(Rgb565::new(0, 0, 0));
         let mut complete = true;
-        variants(&mut ws, &|| Counter(arch::start()), |name, frame, f| {
-            complete &= f.complete;
-            println!(
-                "variant {} frame {} hash {:08x} complete {} instructions {}",
-                name, frame, f.hash, f.complete, f.instructions
-            )
-        })?;
+        {
+            let mut ws = Ws::new(Rgb565::new(0, 0, 0));
+            variants(&mut Orbit {
+                ws: &mut ws,
+                count: &|| Counter(arch::start()),
+                report: |name: &str, frame, f: Frame| {
+                    complete &= f.complete;
+                    println!(
+                        "variant {} frame {} hash {:08x} complete {} instructions {}",
+                        name, frame, f.hash, f.complete, f.instructions
+                    )
+                },
+            })?;
+        }
+        #[cfg(scanline3d_corpus)]
+        {
+            let mut ws = corpus_views::CorpusWs::new(Rgb565::new(0, 0, 0));
+            variants(&mut corpus_views::Views {
+                ws: &mut ws,
+                count: &|| Counter(arch::start()),
+                report: |name: &str, scene: &str, view, f: Frame| {
+                    complete &= f.complete;
+                    println!(
+                        "corpus {} scene {} view {} hash {:08x} complete {} instructions {}",
+                        name, scene, view, f.hash, f.complete, f.instructions
+                    )
+                },
+            })?;
+        }
         println!("summary workspace {}", Ws::BYTES);
         if complete {
             Ok(())

@@ -1,24 +1,27 @@
 //! Named precision presets: each choice that trades accuracy for speed or size, bundled and
 //! fixed at compile time so a build pays only for the one it uses.
 //!
-//! | preset | sub-pixel bits | set-up math |
-//! |---|---|---|
-//! | [`Fast`] | 2 | [`Libm`] |
-//! | [`Balanced`] (the default) | 4 | [`Libm`] |
-//! | [`Exact`] | 8 | [`Libm`] |
+//! | preset | sub-pixel bits | set-up arithmetic | set-up math |
+//! |---|---|---|---|
+//! | [`Fast`] | 2 | [`Quick`]: narrow transform, reciprocal projection, 15-bit normals | [`Libm`] |
+//! | [`Balanced`] | 4 | [`Frugal`]: wide transform, reciprocal projection, 15-bit normals | [`Libm`] |
+//! | [`Exact`] | 8 | [`Precise`]: wide transform, exact division, 30-bit normals | [`Libm`] |
 //!
-//! Sub-pixel bits set how finely vertices snap (`2^-S` pixel), the math backend how per-frame
-//! camera and model matrices are computed; everything after the transform is integer
-//! arithmetic in every preset. What each preset costs and how accurate it is are measured, not
-//! assumed: `cargo xtask tradeoff` writes `docs/tradeoff.md` (accuracy against the f64
-//! reference on every corpus scene, instructions on thumbv7em and thumbv6m, host time, flash).
-//! [`Micromath`] set-up is measured there as a single-knob variation and is in no preset: its
-//! camera error moves vertices beyond the sub-pixel error bound (real mismatches) and saves
-//! about 1.1 KiB of flash.
+//! Sub-pixel bits set how finely vertices snap (`2^-S` pixel); the set-up [`Arithmetic`] how
+//! vertices are transformed, projected and lit; the math backend how per-frame camera and model
+//! matrices are computed. Everything per pixel is exact integer arithmetic in every preset.
+//! [`RenderOptions::default`] (4 sub-pixel bits, [`Precise`] arithmetic) is not a preset: it is
+//! the exactly rounded reference the conformance tests and tools are built on, and what a
+//! build gets without choosing.
 //!
-//! So far the knobs trade accuracy for little speed (`Fast` takes about 8 % fewer instructions
-//! than `Exact` on thumbv6m): per-triangle set-up, which dominates the frame, costs nearly the
-//! same at every setting.
+//! What each preset costs and how accurate it is are measured, not assumed: `cargo xtask
+//! tradeoff` writes `docs/tradeoff.md` (accuracy against the f64 reference on every corpus
+//! scene, instructions on thumbv7em and thumbv6m for the demo orbit and every corpus scene, host
+//! time, flash), with the default and single-knob variations beside the presets. On thumbv6m,
+//! which multiplies and divides 64-bit integers in software, `Fast` takes about 1.6× fewer
+//! instructions per demo frame than `Exact`. [`Micromath`] set-up is in no preset: its camera
+//! error moves vertices beyond the sub-pixel error bound (real mismatches) and saves about
+//! 1.1 KiB of flash.
 //!
 //! A preset gives the [`RenderOptions`] and the [`Camera`] of a frame:
 //!
@@ -75,6 +78,10 @@ impl<T: TransformPrecision, P: ProjectionPrecision, N: NormalPrecision> Arithmet
 /// 30-bit normals. The default.
 pub type Precise = Setup<WideTransform, ExactDivision, WideNormals>;
 
+/// Wide transform, with the two narrow knobs that cost no measured accuracy on the corpus: one
+/// reciprocal per vertex and 15-bit normals (the [`Balanced`] preset's arithmetic).
+pub type Frugal = Setup<WideTransform, Reciprocal, NarrowNormals>;
+
 /// Narrow arithmetic everywhere: 32-bit transform products, one reciprocal per vertex, 15-bit
 /// normals. Vertices move by about 10^-4 of their offsets, shades by far less than a colour
 /// step; on cores without 64-bit multiply and divide this removes most of the set-up's cost.
@@ -117,8 +124,8 @@ pub trait Preset {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Fast;
 
-/// The default: 4 sub-pixel bits, [`Precise`] arithmetic, [`Libm`] set-up (what
-/// [`RenderOptions::default`] and [`Camera::look_at`] give).
+/// Middle: 4 sub-pixel bits (as [`RenderOptions::default`]), [`Frugal`] arithmetic, [`Libm`]
+/// set-up.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Balanced;
 
@@ -142,11 +149,11 @@ impl Preset for Fast {
 impl Preset for Balanced {
     const NAME: &'static str = "balanced";
     const SUB_BITS: u32 = 4;
-    type Options = RenderOptions<4, FrustumClip>;
+    type Options = RenderOptions<4, FrustumClip, Frugal>;
     type Math = Libm;
-    type Arithmetic = Precise;
+    type Arithmetic = Frugal;
     fn options() -> Self::Options {
-        RenderOptions::default()
+        RenderOptions::default().with_arithmetic(Frugal::default())
     }
 }
 
@@ -176,9 +183,13 @@ mod tests {
     }
 
     #[test]
-    fn balanced_is_the_default() {
+    fn balanced_has_the_default_bits_and_camera() {
         let d = RenderOptions::default();
         assert_eq!(d.cull_back_faces, Balanced::options().cull_back_faces);
+        assert_eq!(
+            RenderOptions::default().with_arithmetic(Frugal::default()),
+            Balanced::options()
+        );
         let c = Camera::look_at([1.0, 2.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0])
             .and_then(|v| v.perspective(50.0, 0.5, 9.0));
         assert_eq!(c.map(|c| c.focal()), Ok(camera::<Balanced>().focal()));
@@ -194,7 +205,7 @@ mod tests {
         let bits = |o: &dyn core::any::Any| {
             if o.is::<RenderOptions<2, FrustumClip, Quick>>() {
                 2
-            } else if o.is::<RenderOptions<4>>() {
+            } else if o.is::<RenderOptions<4, FrustumClip, Frugal>>() {
                 4
             } else if o.is::<RenderOptions<8>>() {
                 8

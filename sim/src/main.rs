@@ -8,7 +8,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use scanline3d_sim::metrics::{self, ErrorBound};
 use scanline3d_sim::reference::Image;
 use scanline3d_sim::scene::{
-    self, Algorithm, CameraSpec, LightSpec, MeshData, PresetChoice, SceneSpec,
+    self, Algorithm, CameraSpec, LightSpec, MeshData, PresetChoice, SceneSpec, SetupArith,
 };
 use scanline3d_sim::{accuracy, accuracy_preset, accuracy_with, analyze, corpus};
 use std::io::Write;
@@ -137,8 +137,10 @@ struct View {
     /// Sub-pixel bits of the fixed-point renderer: 0, 2, 4 (default) or 8.
     #[arg(long, default_value_t = 4)]
     sub_pixel_bits: u32,
-    /// Precision preset (scanline3d::preset): fast, balanced (the default settings) or exact.
-    /// Sets the sub-pixel bits and the set-up math together.
+    /// Precision preset (scanline3d::preset): fast, balanced or exact. Sets the sub-pixel
+    /// bits, the set-up arithmetic and the set-up math together. Without it the renderer uses
+    /// the library default (RenderOptions::default(): precise arithmetic, libm). The narrow
+    /// arithmetic of fast and balanced is built for span-zbuffer only.
     #[arg(long, conflicts_with = "sub_pixel_bits")]
     preset: Option<PresetChoice>,
     /// Draw back faces too (open surfaces).
@@ -455,8 +457,13 @@ fn render(a: RenderArgs) -> Result<(), String> {
                 .view
                 .preset
                 .map_or("null".to_string(), |p| format!("\"{p}\""));
+            let arithmetic = a
+                .view
+                .preset
+                .map_or(SetupArith::Precise, |p| p.arith())
+                .name();
             let json = format!(
-                "{{\"renderer\": \"fixed\", \"algorithm\": \"{algorithm}\", \"preset\": {preset}, \"sub_pixel_bits\": {}, \"width\": {w}, \"height\": {h}, \"triangles_in\": {}, \"culled\": {}, \"clipped\": {}, \"rejected\": {}, \"drawn\": {}, \"spans\": {}, \"fragments\": {}, \"pixels_written\": {}, \"peak_active\": {}, \"dropped\": {}}}\n",
+                "{{\"renderer\": \"fixed\", \"algorithm\": \"{algorithm}\", \"preset\": {preset}, \"arithmetic\": \"{arithmetic}\", \"sub_pixel_bits\": {}, \"width\": {w}, \"height\": {h}, \"triangles_in\": {}, \"culled\": {}, \"clipped\": {}, \"rejected\": {}, \"drawn\": {}, \"spans\": {}, \"fragments\": {}, \"pixels_written\": {}, \"peak_active\": {}, \"dropped\": {}}}\n",
                 a.view.sub_bits(), s.triangles_in, s.culled, s.clipped, s.rejected, s.activated, s.spans, s.fragments, s.pixels_written, s.peak_active, s.dropped
             );
             (r.image, json)

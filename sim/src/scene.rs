@@ -618,6 +618,7 @@ impl SceneSpec {
         match precision.arith {
             SetupArith::Precise => bits!(Precise),
             SetupArith::Quick => bits!(Quick),
+            SetupArith::Frugal => bits!(preset::Frugal),
             SetupArith::NarrowTransform => {
                 bits!(Setup<NarrowTransform, ExactDivision, WideNormals>)
             }
@@ -734,6 +735,8 @@ pub enum SetupArith {
     Precise,
     /// [`preset::Quick`]: narrow at every stage.
     Quick,
+    /// [`preset::Frugal`]: reciprocal projection and narrow normals.
+    Frugal,
     /// Precise but for the transform (`vertex::NarrowTransform`).
     NarrowTransform,
     /// Precise but for the projection (`project::Reciprocal`).
@@ -748,6 +751,7 @@ impl SetupArith {
         match self {
             SetupArith::Precise => "precise",
             SetupArith::Quick => "quick",
+            SetupArith::Frugal => "frugal",
             SetupArith::NarrowTransform => "narrow transform",
             SetupArith::Reciprocal => "reciprocal projection",
             SetupArith::NarrowNormals => "narrow normals",
@@ -758,7 +762,10 @@ impl SetupArith {
     /// `w × h` screen and a scene whose largest model coordinate is `max_model_coord`.
     pub fn documented_error(self, w: usize, h: usize, max_model_coord: f64) -> ArithmeticError {
         let narrow_transform = matches!(self, SetupArith::Quick | SetupArith::NarrowTransform);
-        let reciprocal = matches!(self, SetupArith::Quick | SetupArith::Reciprocal);
+        let reciprocal = matches!(
+            self,
+            SetupArith::Quick | SetupArith::Frugal | SetupArith::Reciprocal
+        );
         // The guard band's corner is 4 screen sizes from the centre in x and y.
         let corner = 4.0 * (w.max(h) as f64) * std::f64::consts::SQRT_2;
         ArithmeticError {
@@ -803,7 +810,7 @@ impl Precision {
 pub enum PresetChoice {
     /// [`preset::Fast`].
     Fast,
-    /// [`preset::Balanced`] (the default).
+    /// [`preset::Balanced`].
     Balanced,
     /// [`preset::Exact`].
     Exact,
@@ -853,8 +860,10 @@ impl PresetChoice {
                 SetupArith::Precise
             } else if a == TypeId::of::<preset::Quick>() {
                 SetupArith::Quick
+            } else if a == TypeId::of::<preset::Frugal>() {
+                SetupArith::Frugal
             } else {
-                unreachable!("presets use Precise or Quick arithmetic")
+                unreachable!("presets use Precise, Frugal or Quick arithmetic")
             }
         }
         match self {
@@ -1123,6 +1132,7 @@ macro_rules! span_zbuffer_only {
 
 span_zbuffer_only!(
     preset::Quick,
+    preset::Frugal,
     Setup<NarrowTransform, ExactDivision, WideNormals>,
     Setup<WideTransform, Reciprocal, WideNormals>,
     Setup<WideTransform, ExactDivision, NarrowNormals>

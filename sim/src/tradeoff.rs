@@ -24,7 +24,8 @@ const fn preset(p: PresetChoice, name: &'static str, precision: Precision) -> Va
     }
 }
 
-/// The default (balanced) with one knob changed.
+/// The library default (`RenderOptions::default()`: 4 sub-pixel bits, precise arithmetic,
+/// libm) with one knob changed, or (`"default"`) unchanged.
 const fn knob(name: &'static str, sub_bits: u32, math: SetupMath, arith: SetupArith) -> Variant {
     Variant {
         name,
@@ -48,18 +49,19 @@ const fn choices(sub_bits: u32, arith: SetupArith) -> Precision {
 /// Every variant, in the order of `examples/tradeoff.rs` (a test keeps the presets' entries
 /// equal to `scanline3d::preset`). A knob's name is also its `scanline3d_variant` cfg value with
 /// `:` and spaces removed.
-pub const VARIANTS: [Variant; 8] = [
+pub const VARIANTS: [Variant; 9] = [
     preset(PresetChoice::Fast, "fast", choices(2, SetupArith::Quick)),
     preset(
         PresetChoice::Balanced,
         "balanced",
-        choices(4, SetupArith::Precise),
+        choices(4, SetupArith::Frugal),
     ),
     preset(
         PresetChoice::Exact,
         "exact",
         choices(8, SetupArith::Precise),
     ),
+    knob("default", 4, SetupMath::Libm, SetupArith::Precise),
     knob("bits:0", 0, SetupMath::Libm, SetupArith::Precise),
     knob("micromath", 4, SetupMath::Micromath, SetupArith::Precise),
     knob(

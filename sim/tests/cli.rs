@@ -258,27 +258,49 @@ fn presets_set_sub_pixel_bits_and_set_up_math_together() {
         let stats = std::fs::read_to_string(dir.join(format!("{name}.json"))).unwrap();
         (std::fs::read(dir.join(name)).unwrap(), stats)
     };
-    // Balanced is the default settings exactly; exact is 8 sub-pixel bits with libm set-up.
-    let (default, _) = ids(&[], "default.ids");
-    let (balanced, stats) = ids(&["--preset", "balanced"], "balanced.ids");
-    assert_eq!(default, balanced);
-    assert!(
-        stats.contains("\"preset\": \"balanced\", \"sub_pixel_bits\": 4"),
-        "{stats}"
-    );
+    // Exact is 8 sub-pixel bits with the default (precise) arithmetic and libm set-up.
     let (bits8, _) = ids(&["--sub-pixel-bits", "8"], "bits8.ids");
     let (exact, stats) = ids(&["--preset", "exact"], "exact.ids");
     assert_eq!(bits8, exact);
-    assert!(stats.contains("\"sub_pixel_bits\": 8"), "{stats}");
-    // Fast is 2 bits with libm set-up, a coarser frame than the default.
-    let (bits2, _) = ids(&["--sub-pixel-bits", "2"], "bits2.ids");
-    let (fast, stats) = ids(&["--preset", "fast"], "fast.ids");
-    assert_eq!(bits2, fast);
-    assert_ne!(fast, balanced);
     assert!(
-        stats.contains("\"preset\": \"fast\", \"sub_pixel_bits\": 2"),
+        stats.contains("\"arithmetic\": \"precise\", \"sub_pixel_bits\": 8"),
         "{stats}"
     );
+    // Balanced keeps the default's 4 bits with frugal arithmetic; fast is 2 bits, quick.
+    let (_, stats) = ids(&["--preset", "balanced"], "balanced.ids");
+    assert!(
+        stats.contains(
+            "\"preset\": \"balanced\", \"arithmetic\": \"frugal\", \"sub_pixel_bits\": 4"
+        ),
+        "{stats}"
+    );
+    let (default, stats) = ids(&[], "default.ids");
+    assert!(
+        stats.contains("\"preset\": null, \"arithmetic\": \"precise\""),
+        "{stats}"
+    );
+    let (fast, stats) = ids(&["--preset", "fast"], "fast.ids");
+    assert_ne!(fast, default);
+    assert!(
+        stats.contains("\"preset\": \"fast\", \"arithmetic\": \"quick\", \"sub_pixel_bits\": 2"),
+        "{stats}"
+    );
+    // The narrow arithmetic is built for the span z-buffer only, and says so.
+    let (code, _, stderr) = sim(
+        &[
+            "render",
+            &corpus("cube"),
+            "--preset",
+            "fast",
+            "--algorithm",
+            "zbuffer",
+            "--ids",
+            "x.ids",
+        ],
+        &dir,
+    );
+    assert_ne!(code, 0);
+    assert!(stderr.contains("span-zbuffer only"), "{stderr}");
     // A preset and explicit sub-pixel bits conflict; unknown presets are named.
     for (args, says) in [
         (

@@ -15,6 +15,7 @@ fn presets_meet_their_accuracy_claims_on_the_corpus() {
         "fast",
         "balanced",
         "exact",
+        "default",
         "bits:0",
         "narrow-transform",
         "reciprocal",

@@ -20,6 +20,9 @@ use std::process::Command;
 /// Targets whose instruction counts the table shows.
 const TARGETS: [&str; 2] = ["thumbv7em-none-eabihf", "thumbv6m-none-eabi"];
 const SIZE: usize = 240;
+/// Margin on the measured capacities of the corpus firmware's workspace: the narrow variants
+/// move vertices slightly, so a view may file a triangle or two more.
+const CORPUS_MARGIN_PERCENT: u32 = 10;
 
 /// `variant frame hash [instructions]` lines of the trade-off example's output.
 fn frames(output: &str) -> Vec<(String, u32, u32, Option<u64>)> {
@@ -35,6 +38,54 @@ fn frames(output: &str) -> Vec<(String, u32, u32, Option<u64>)> {
             Some((w[1].to_string(), w[3].parse().ok()?, hash, instructions))
         })
         .collect()
+}
+
+/// `corpus variant scene S view K hash H complete B [instructions N]` lines: ((variant, scene,
+/// view), hash, instructions).
+type CorpusFrame = ((String, String, usize), u32, Option<u64>);
+
+fn corpus_frames(output: &str) -> Vec<CorpusFrame> {
+    output
+        .lines()
+        .filter_map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            if w.first() != Some(&"corpus") || w.len() < 10 {
+                return None;
+            }
+            let hash = u32::from_str_radix(w[7], 16).ok()?;
+            let instructions = w.get(11).and_then(|v| v.parse().ok());
+            let key = (w[1].to_string(), w[3].to_string(), w[5].parse().ok()?);
+            Some((key, hash, instructions))
+        })
+        .collect()
+}
+
+/// Builds `examples/tradeoff.rs` in release for `target` (the host if `None`) with extra
+/// `--cfg`s; with `corpus`, also the generated corpus at that path. Returns the ELF path.
+fn build_tradeoff(
+    target: Option<&str>,
+    cfgs: &[String],
+    corpus: Option<&std::path::Path>,
+) -> Result<std::path::PathBuf, String> {
+    let mut cmd = cargo();
+    cmd.args(["rustc", "--quiet", "--release", "--example", "tradeoff"]);
+    if let Some(t) = target {
+        cmd.args(["--target", t]);
+    }
+    cmd.arg("--");
+    for c in cfgs {
+        cmd.args(["--cfg", c]);
+    }
+    if let Some(path) = corpus {
+        cmd.args(["--cfg", "scanline3d_corpus"]);
+        cmd.env("SCANLINE3D_CORPUS", path);
+    }
+    run(&mut cmd)?;
+    let mut elf = root().join("target");
+    if let Some(t) = target {
+        elf.push(t);
+    }
+    Ok(elf.join("release/examples/tradeoff"))
 }
 
 /// Runs a firmware ELF with the runner `.cargo/config.toml` gives for `target` (QEMU with a
@@ -100,16 +151,24 @@ pub fn tradeoff() -> Result<(), String> {
     step("host time per frame (cargo bench --bench tradeoff)");
     run(cargo().args(["bench", "--bench", "tradeoff"]))?;
 
-    step("host hashes of the trade-off example");
-    let host = cargo()
-        .args(["run", "--quiet", "--release", "--example", "tradeoff"])
-        .current_dir(root())
+    step("every corpus scene as firmware data (scanline3d_sim::export::corpus_source)");
+    let corpus_dir = root().join("target/tradeoff-corpus");
+    std::fs::create_dir_all(&corpus_dir).map_err(|e| e.to_string())?;
+    let corpus_file = corpus_dir.join("corpus.rs");
+    let corpus = scanline3d_sim::export::corpus_source(SIZE, SIZE, CORPUS_MARGIN_PERCENT)?;
+    std::fs::write(&corpus_file, corpus).map_err(|e| e.to_string())?;
+
+    step("host hashes of the trade-off example (demo orbit and corpus)");
+    let host_elf = build_tradeoff(None, &[], Some(&corpus_file))?;
+    let host = Command::new(&host_elf)
         .output()
         .map_err(|e| e.to_string())?;
     if !host.status.success() {
         return Err("the trade-off example failed on the host".into());
     }
-    let host_frames = frames(&String::from_utf8_lossy(&host.stdout));
+    let host_out = String::from_utf8_lossy(&host.stdout);
+    let host_frames = frames(&host_out);
+    let host_corpus = corpus_frames(&host_out);
     let host_hashes: Vec<_> = host_frames
         .iter()
         .map(|f| (f.0.clone(), f.1, f.2))
@@ -118,6 +177,7 @@ pub fn tradeoff() -> Result<(), String> {
     let mut instructions: HashMap<(&str, &str), f64> = HashMap::new();
     let mut flash: HashMap<(&str, &str), u64> = HashMap::new();
     let mut workspace = 0u64;
+    let mut corpus_instructions: HashMap<(&str, &str, String), f64> = HashMap::new();
     for target in TARGETS {
         for v in VARIANTS {
             step(&format!(
@@ -125,17 +185,8 @@ pub fn tradeoff() -> Result<(), String> {
                 v.name
             ));
             // The cfg goes to the example alone (the final compilation unit).
-            run(cargo()
-                .args(["rustc", "--quiet", "--release", "--example", "tradeoff"])
-                .args(["--target", target, "--", "--cfg"])
-                .arg(format!(
-                    "scanline3d_variant=\"{}\"",
-                    v.name.replace([':', '-'], "")
-                )))?;
-            let elf = root()
-                .join("target")
-                .join(target)
-                .join("release/examples/tradeoff");
+            let variant = format!("scanline3d_variant=\"{}\"", v.name.replace([':', '-'], ""));
+            let elf = build_tradeoff(Some(target), std::slice::from_ref(&variant), None)?;
             flash.insert((v.name, target), flash_bytes(&elf)?);
             let out = run_on_qemu(target, &elf)?;
             let f = frames(&out);
@@ -166,6 +217,38 @@ pub fn tradeoff() -> Result<(), String> {
                 .find_map(|l| l.strip_prefix("summary workspace "))
                 .and_then(|v| v.trim().parse().ok())
                 .unwrap_or(0);
+
+            // The same variant over every corpus view (a separate image: the corpus data would
+            // swamp the flash figure).
+            let elf = build_tradeoff(Some(target), &[variant], Some(&corpus_file))?;
+            let out = run_on_qemu(target, &elf)?;
+            let mine: Vec<_> = corpus_frames(&out)
+                .into_iter()
+                .filter(|f| f.0 .0 == v.name)
+                .collect();
+            let host: Vec<_> = host_corpus.iter().filter(|f| f.0 .0 == v.name).collect();
+            let same = mine.len() == host.len()
+                && mine
+                    .iter()
+                    .zip(&host)
+                    .all(|(a, b)| a.0 == b.0 && a.1 == b.1);
+            if !same || mine.is_empty() {
+                return Err(format!(
+                    "{target}, {}: corpus hashes differ from the host's",
+                    v.name
+                ));
+            }
+            let mut per_scene: HashMap<String, Vec<u64>> = HashMap::new();
+            for f in &mine {
+                let n =
+                    f.2.ok_or_else(|| format!("{target}: no corpus counts for {}", v.name))?;
+                per_scene.entry(f.0 .1.clone()).or_default().push(n);
+            }
+            println!("{} corpus views, hashes equal the host's", mine.len());
+            for (scene, counts) in per_scene {
+                let mean = counts.iter().sum::<u64>() as f64 / counts.len() as f64;
+                corpus_instructions.insert((v.name, target, scene), mean);
+            }
         }
     }
 
@@ -285,6 +368,32 @@ pub fn tradeoff() -> Result<(), String> {
     }
     line(String::new());
     line("![instructions against id mismatches](tradeoff.png)".into());
+    line(String::new());
+    line("## Instructions per frame on each corpus scene".into());
+    line(String::new());
+    line(format!("Every view of every corpus scene rendered by the trade-off firmware built with that scene data (`scanline3d_sim::export::corpus_source`, capacities with a {CORPUS_MARGIN_PERCENT} % margin), one image per variant; mean per view, thumbv6m / thumbv7em, in millions of instructions. Every hash equals the host's."));
+    line(String::new());
+    let names: Vec<&str> = VARIANTS.iter().map(|v| v.name).collect();
+    line(format!(
+        "| scene | {} | fast vs exact, thumbv6m |",
+        names.join(" | ")
+    ));
+    line(format!("|---|{}---|", "---|".repeat(names.len())));
+    for scene in &scenes {
+        let at = |v: &str, t: &str| corpus_instructions.get(&(v, t, scene.to_string())).copied();
+        let cells: Vec<String> = names
+            .iter()
+            .map(|v| match (at(v, TARGETS[1]), at(v, TARGETS[0])) {
+                (Some(a), Some(b)) => format!("{:.2} / {:.2}", a / 1e6, b / 1e6),
+                _ => "n/a".into(),
+            })
+            .collect();
+        let ratio = match (at("exact", TARGETS[1]), at("fast", TARGETS[1])) {
+            (Some(e), Some(f)) if f > 0.0 => format!("{:.2}×", e / f),
+            _ => "n/a".into(),
+        };
+        line(format!("| {scene} | {} | {ratio} |", cells.join(" | ")));
+    }
     line(String::new());
     line("## Presets per scene".into());
     line(String::new());
