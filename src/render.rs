@@ -640,22 +640,24 @@ impl<
 }
 
 /// Per-instance constants for one frame.
-pub(crate) struct InstanceSetup<'a> {
+pub(crate) struct InstanceSetup<'a, T: TransformPrecision> {
     instance: &'a Instance<'a>,
-    mv: ModelView,
+    mv: T::Matrix,
     lighting: Lighting,
     first_id: u32,
 }
 
-fn setup_instances<'a, E, const N: usize>(
+fn setup_instances<'a, T: TransformPrecision, E, const N: usize>(
     scene: &'a Scene<'a>,
-) -> Result<Vec<InstanceSetup<'a>, N>, RenderError<E>> {
+) -> Result<Vec<InstanceSetup<'a, T>, N>, RenderError<E>> {
     let mut out = Vec::new();
     let view = &scene.camera.view().world_to_eye;
     let mut first_id = 0u32;
     for (i, inst) in scene.instances.iter().enumerate() {
-        let mv = ModelView::new(&inst.transform, view, inst.mesh.max_abs_bits())
+        let max_abs_bits = inst.mesh.max_abs_bits();
+        let mv = ModelView::new(&inst.transform, view, max_abs_bits)
             .map_err(|error| RenderError::Transform { instance: i, error })?;
+        let mv = T::prepare(mv, max_abs_bits);
         let lighting = Lighting::new(&scene.light, &inst.transform);
         let setup = InstanceSetup {
             instance: inst,
@@ -683,7 +685,7 @@ enum Fate {
     Visible { first_row: i32, clipped: bool },
 }
 
-impl InstanceSetup<'_> {
+impl<T: TransformPrecision> InstanceSetup<'_, T> {
     fn vertex_colors(&self, tri: usize, idx: [u16; 3]) -> [Rgb888; 3] {
         let mesh = self.instance.mesh;
         let pick = |i: u16| match mesh.colors() {
@@ -703,7 +705,7 @@ impl InstanceSetup<'_> {
     }
 
     /// Transforms (and, for Gouraud, lights) the three vertices of triangle `tri`.
-    fn clip_vertices<A: Arithmetic>(
+    fn clip_vertices<A: Arithmetic<Transform = T>>(
         &self,
         tri: usize,
         idx: [u16; 3],
@@ -734,7 +736,7 @@ impl InstanceSetup<'_> {
 
     /// Clips and projects triangle `tri`, calling `f` with each visible screen triangle (whose
     /// depths are 0 unless `depth`).
-    fn screen_triangles<const S: u32, C: Clipping, A: Arithmetic>(
+    fn screen_triangles<const S: u32, C: Clipping, A: Arithmetic<Transform = T>>(
         &self,
         tri: usize,
         vp: &Viewport<S>,
@@ -797,10 +799,10 @@ impl InstanceSetup<'_> {
 }
 
 /// Finds the instance owning global triangle id `id`.
-fn locate<'s, 'a>(
-    setups: &'s [InstanceSetup<'a>],
+fn locate<'s, 'a, T: TransformPrecision>(
+    setups: &'s [InstanceSetup<'a, T>],
     id: u32,
-) -> Option<(&'s InstanceSetup<'a>, usize)> {
+) -> Option<(&'s InstanceSetup<'a, T>, usize)> {
     setups
         .iter()
         .rev()
@@ -812,10 +814,10 @@ fn locate<'s, 'a>(
 pub(crate) trait TriangleOrder {
     /// Calls `f(instance, triangle, rank)` for every triangle to draw; `rank` is its place in a
     /// far-to-near drawing order, if this order is one.
-    fn visit<'s, E>(
+    fn visit<'s, T: TransformPrecision, E>(
         &mut self,
-        setups: &[InstanceSetup<'s>],
-        f: impl FnMut(&InstanceSetup<'s>, usize, Option<u32>),
+        setups: &[InstanceSetup<'s, T>],
+        f: impl FnMut(&InstanceSetup<'s, T>, usize, Option<u32>),
     ) -> Result<(), RenderError<E>>;
 }
 
@@ -824,10 +826,10 @@ pub(crate) struct IdOrder;
 
 impl TriangleOrder for IdOrder {
     #[inline(always)]
-    fn visit<'s, E>(
+    fn visit<'s, T: TransformPrecision, E>(
         &mut self,
-        setups: &[InstanceSetup<'s>],
-        mut f: impl FnMut(&InstanceSetup<'s>, usize, Option<u32>),
+        setups: &[InstanceSetup<'s, T>],
+        mut f: impl FnMut(&InstanceSetup<'s, T>, usize, Option<u32>),
     ) -> Result<(), RenderError<E>> {
         for setup in setups.iter().rev() {
             for tri in (0..setup.instance.mesh.triangles().len()).rev() {
@@ -858,7 +860,7 @@ pub(crate) fn drive<
     vp: &Viewport<SUB>,
     sink: &mut K,
 ) -> Result<FrameStats, RenderError<K::Error>> {
-    let setups = setup_instances::<K::Error, INSTANCES>(scene)?;
+    let setups = setup_instances::<A::Transform, K::Error, INSTANCES>(scene)?;
     let mut stats = FrameStats::default();
     let width = vp.width as i32;
     let capacity = ws.refs.len().min(ws.next.len());
@@ -951,8 +953,8 @@ pub(crate) trait ActivePieces<const SUB: u32> {
 }
 
 /// Pieces of mesh triangles, transformed, clipped and projected again on activation.
-struct MeshPieces<'a, 's, const SUB: u32, C, A> {
-    setups: &'a [InstanceSetup<'s>],
+struct MeshPieces<'a, 's, const SUB: u32, C, A: Arithmetic> {
+    setups: &'a [InstanceSetup<'s, A::Transform>],
     refs: &'a [u16],
     keys: &'a [u32],
     vp: &'a Viewport<SUB>,
@@ -1172,7 +1174,7 @@ pub(crate) fn for_each_screen_piece<
     vp: &Viewport<SUB>,
     mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32),
 ) -> Result<FrameStats, RenderError<E>> {
-    let setups = setup_instances::<E, INSTANCES>(scene)?;
+    let setups = setup_instances::<A::Transform, E, INSTANCES>(scene)?;
     let mut stats = FrameStats::default();
     for setup in &setups {
         let triangles = setup.instance.mesh.triangles();

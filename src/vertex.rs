@@ -48,8 +48,13 @@ pub trait TransformPrecision:
 {
     /// Name in the trade-off table.
     const NAME: &'static str;
-    /// Transforms a model vertex of the mesh `mv` was made for.
-    fn apply(mv: &ModelView, v: &Vertex) -> EyePoint;
+    /// The per-instance transform in the form [`TransformPrecision::apply`] reads.
+    type Matrix: Copy + core::fmt::Debug;
+    /// Prepares `mv`, made for a mesh whose coordinates are within `max_abs_bits`, once per
+    /// instance and frame.
+    fn prepare(mv: ModelView, max_abs_bits: i32) -> Self::Matrix;
+    /// Transforms a model vertex of the mesh `m` was prepared for.
+    fn apply(m: &Self::Matrix, v: &Vertex) -> EyePoint;
 }
 
 mod sealed {
@@ -64,14 +69,18 @@ mod sealed {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct WideTransform;
 
-/// 15-bit × 16-bit products summed in `i32` ([`ModelView::apply_narrow`]): one 32-bit multiply
+/// 15-bit × 16-bit products summed in `i32` ([`NarrowModelView`]): one 32-bit multiply
 /// per product instead of a 64-bit one, for an eye-space error of about 2^-14 of the mesh's
-/// extent times the matrix's largest entry (see [`ModelView`]).
+/// extent times the matrix's largest entry (see [`NarrowModelView`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct NarrowTransform;
 
 impl TransformPrecision for WideTransform {
     const NAME: &'static str = "wide";
+    type Matrix = ModelView;
+    fn prepare(mv: ModelView, _: i32) -> ModelView {
+        mv
+    }
     #[inline]
     fn apply(mv: &ModelView, v: &Vertex) -> EyePoint {
         mv.apply(v)
@@ -80,16 +89,25 @@ impl TransformPrecision for WideTransform {
 
 impl TransformPrecision for NarrowTransform {
     const NAME: &'static str = "narrow";
+    type Matrix = NarrowModelView;
+    fn prepare(mv: ModelView, max_abs_bits: i32) -> NarrowModelView {
+        NarrowModelView::new(&mv, max_abs_bits)
+    }
     #[inline]
-    fn apply(mv: &ModelView, v: &Vertex) -> EyePoint {
-        mv.apply_narrow(v)
+    fn apply(m: &NarrowModelView, v: &Vertex) -> EyePoint {
+        m.apply(v)
     }
 }
 
 /// The model→eye transform of one instance, in I16F16, with the third row negated so that it
 /// yields `w = −z` directly.
-///
-/// It also keeps a narrow copy for [`NarrowTransform`]: vertices are shifted right by
+#[derive(Clone, Copy, Debug)]
+pub struct ModelView {
+    m: [[I16F16; 3]; 3],
+    t: [I16F16; 3],
+}
+
+/// A [`ModelView`] narrowed for [`NarrowTransform`]: vertices are shifted right by
 /// `vertex_shift` so they fit 16 bits (`|v| <= 2^15` for the mesh's largest coordinate), the
 /// matrix entries are rounded to `|m| <= 2^14` by a common `matrix_shift`, so a row's three
 /// products sum below `3 · 2^29` in `i32`; the sum is scaled back by `2^(matrix_shift +
@@ -99,10 +117,9 @@ impl TransformPrecision for NarrowTransform {
 /// product) plus one unit of I16F16 rounding: below 4·10^-4 of the mesh's extent for a
 /// rotation, and typically far less.
 #[derive(Clone, Copy, Debug)]
-pub struct ModelView {
-    m: [[I16F16; 3]; 3],
-    t: [I16F16; 3],
+pub struct NarrowModelView {
     narrow: [[i32; 3]; 3],
+    t: [I16F16; 3],
     vertex_shift: u32,
     /// `matrix_shift + vertex_shift − 16`: positive scales up, negative down.
     narrow_scale: i32,
@@ -139,25 +156,7 @@ impl ModelView {
                 return Err(TransformError::OutOfEnvelope);
             }
         }
-        let bits = |v: u32| 32 - v.leading_zeros();
-        let vertex_shift = bits(max_abs_bits.unsigned_abs()).saturating_sub(15);
-        let largest = m.iter().flatten().map(|e| e.to_bits().unsigned_abs()).max();
-        let matrix_shift = bits(largest.unwrap_or(0)).saturating_sub(14);
-        let narrow = m.map(|row| {
-            row.map(|e| {
-                let e = e.to_bits() as i64;
-                // Round to nearest; |e| < 2^(matrix_shift + 14), so the result is within ±2^14.
-                let half = (1i64 << matrix_shift) >> 1;
-                ((e + half) >> matrix_shift) as i32
-            })
-        });
-        Ok(ModelView {
-            m,
-            t,
-            narrow,
-            vertex_shift,
-            narrow_scale: matrix_shift as i32 + vertex_shift as i32 - 16,
-        })
+        Ok(ModelView { m, t })
     }
 
     /// Transforms a model vertex (validated mesh, so inside the proven envelope).
@@ -177,10 +176,38 @@ impl ModelView {
             w: row(2),
         }
     }
+}
 
-    /// [`ModelView::apply`] with 32-bit products ([`NarrowTransform`]; error bound above).
+impl NarrowModelView {
+    /// Narrows `mv`, made for a mesh whose coordinates are within `max_abs_bits` (I16F16 bits).
+    pub fn new(mv: &ModelView, max_abs_bits: i32) -> Self {
+        let bits = |v: u32| 32 - v.leading_zeros();
+        let vertex_shift = bits(max_abs_bits.unsigned_abs()).saturating_sub(15);
+        let largest =
+            mv.m.iter()
+                .flatten()
+                .map(|e| e.to_bits().unsigned_abs())
+                .max();
+        let matrix_shift = bits(largest.unwrap_or(0)).saturating_sub(14);
+        let narrow = mv.m.map(|row| {
+            row.map(|e| {
+                let e = e.to_bits() as i64;
+                // Round to nearest; |e| < 2^(matrix_shift + 14), so the result is within ±2^14.
+                let half = (1i64 << matrix_shift) >> 1;
+                ((e + half) >> matrix_shift) as i32
+            })
+        });
+        NarrowModelView {
+            narrow,
+            t: mv.t,
+            vertex_shift,
+            narrow_scale: matrix_shift as i32 + vertex_shift as i32 - 16,
+        }
+    }
+
+    /// [`ModelView::apply`] with 32-bit products (error bound above).
     #[inline]
-    pub fn apply_narrow(&self, v: &Vertex) -> EyePoint {
+    pub fn apply(&self, v: &Vertex) -> EyePoint {
         let v = v.map(|c| c.to_bits() >> self.vertex_shift);
         let scale = self.narrow_scale;
         let row = |r: usize| {
@@ -399,7 +426,7 @@ mod tests {
                 let p = v(next(extent), next(extent), next(extent));
                 let max = (extent * 65536.0) as i32;
                 let mv = ModelView::new(&model, &view, max).unwrap();
-                let (wide, narrow) = (mv.apply(&p), mv.apply_narrow(&p));
+                let (wide, narrow) = (mv.apply(&p), NarrowModelView::new(&mv, max).apply(&p));
                 // The documented bound, in I16F16 bits.
                 let m =
                     mv.m.iter()

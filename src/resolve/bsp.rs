@@ -22,6 +22,7 @@ use crate::render::{
 use crate::scene::{Scene, Transform};
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
+use crate::vertex::TransformPrecision;
 use heapless::Vec;
 
 use super::{check_sizes, Painter};
@@ -218,10 +219,10 @@ struct BspOrder<'t, 'w> {
 }
 
 impl TriangleOrder for BspOrder<'_, '_> {
-    fn visit<'s, E>(
+    fn visit<'s, T: TransformPrecision, E>(
         &mut self,
-        setups: &[InstanceSetup<'s>],
-        mut f: impl FnMut(&InstanceSetup<'s>, usize, Option<u32>),
+        setups: &[InstanceSetup<'s, T>],
+        mut f: impl FnMut(&InstanceSetup<'s, T>, usize, Option<u32>),
     ) -> Result<(), RenderError<E>> {
         let Some(setup) = setups.first() else {
             return Ok(());

@@ -516,6 +516,8 @@ fn plot(rows: &[Row], front: &[bool]) -> Result<(), String> {
         .draw(&mut img)
         .map_err(e)?;
     }
+    // Labels are moved up or down until they clear the ones already placed.
+    let mut placed: Vec<Rectangle> = Vec::new();
     for (i, r) in rows.iter().enumerate() {
         let colour = if front[i] {
             Rgb888::new(30, 150, 60)
@@ -529,13 +531,20 @@ fn plot(rows: &[Row], front: &[bool]) -> Result<(), String> {
             .into_styled(PrimitiveStyle::with_fill(colour))
             .draw(&mut img)
             .map_err(e)?;
-        Text::new(
-            r.name,
-            c + Point::new(7, -4),
-            MonoTextStyle::new(&FONT_6X10, colour),
-        )
-        .draw(&mut img)
-        .map_err(e)?;
+        let size = Size::new(6 * r.name.len() as u32, 10);
+        let clear = |at: Point| {
+            let b = Rectangle::new(at - Point::new(0, 8), size);
+            !placed.iter().any(|p| !p.intersection(&b).is_zero_sized())
+        };
+        let at = [-4, 8, -16, 20, -28, 32]
+            .iter()
+            .map(|&dy| c + Point::new(7, dy))
+            .find(|&at| clear(at))
+            .unwrap_or(c + Point::new(7, -4));
+        placed.push(Rectangle::new(at - Point::new(0, 8), size));
+        Text::new(r.name, at, MonoTextStyle::new(&FONT_6X10, colour))
+            .draw(&mut img)
+            .map_err(e)?;
     }
     Text::new(
         "green: Pareto front; red: real mismatches; grey: dominated; large: preset",
