@@ -82,13 +82,7 @@ impl MathBackend for Micromath {
 /// shifted right until every component fits in 30 bits, which keeps the squared length below
 /// `3 * 2^60` (fits `u64`) while losing at most 2^-29 of relative precision.
 pub(crate) fn normalize_i64(v: [i64; 3]) -> Option<[i32; 3]> {
-    let max = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
-    if max == 0 {
-        return None;
-    }
-    let bits = 64 - max.leading_zeros();
-    let shift = bits.saturating_sub(30);
-    let s = v.map(|c| c >> shift);
+    let s = fit_bits(v, 30)?;
     let len_sq: u64 = s.iter().map(|&c| (c * c) as u64).sum();
     let len = len_sq.isqrt() as i64;
     if len == 0 {
@@ -98,13 +92,22 @@ pub(crate) fn normalize_i64(v: [i64; 3]) -> Option<[i32; 3]> {
     Some(s.map(|c| ((c << 30) / len) as i32))
 }
 
+/// `v` shifted right (the same for every component) until each fits `bits` bits (`|c| <=
+/// 2^bits`); `None` for the zero vector.
+fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i64; 3]> {
+    let max = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
+    if max == 0 {
+        return None;
+    }
+    let shift = (64 - max.leading_zeros()).saturating_sub(bits);
+    Some(v.map(|c| c >> shift))
+}
+
 /// How precisely lighting normalizes normals, chosen at compile time (see
 /// [`crate::preset::Arithmetic`]).
 pub trait NormalPrecision:
     Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed + 'static
 {
-    /// Name in the trade-off table.
-    const NAME: &'static str;
     /// Unit vector in I2F30 bits along `v`; `None` for the zero vector.
     fn normalize(v: [i64; 3]) -> Option<[i32; 3]>;
 }
@@ -126,7 +129,6 @@ pub struct WideNormals;
 pub struct NarrowNormals;
 
 impl NormalPrecision for WideNormals {
-    const NAME: &'static str = "wide";
     #[inline]
     fn normalize(v: [i64; 3]) -> Option<[i32; 3]> {
         normalize_i64(v)
@@ -134,7 +136,6 @@ impl NormalPrecision for WideNormals {
 }
 
 impl NormalPrecision for NarrowNormals {
-    const NAME: &'static str = "narrow";
     #[inline]
     fn normalize(v: [i64; 3]) -> Option<[i32; 3]> {
         normalize_i32(v)
@@ -146,14 +147,8 @@ impl NormalPrecision for NarrowNormals {
 /// component is divided in `i32` (`|c| << 15 <= 2^30`). The result is in I2F30 bits with its
 /// low 15 bits zero.
 pub(crate) fn normalize_i32(v: [i64; 3]) -> Option<[i32; 3]> {
-    let max = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
-    if max == 0 {
-        return None;
-    }
-    let bits = 64 - max.leading_zeros();
-    let shift = bits.saturating_sub(15);
     // Each component is now within ±2^15.
-    let s = v.map(|c| (c >> shift) as i32);
+    let s = fit_bits(v, 15)?.map(|c| c as i32);
     let len_sq: u32 = s.iter().map(|&c| (c * c) as u32).sum();
     let len = len_sq.isqrt() as i32;
     if len == 0 {

@@ -250,8 +250,6 @@ impl<const S: u32> Viewport<S> {
 pub trait ProjectionPrecision:
     Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed + 'static
 {
-    /// Name in the trade-off table.
-    const NAME: &'static str;
     /// Projects a point inside all clip planes; the depth is 0 unless `depth`.
     fn project<const S: u32>(
         vp: &Viewport<S>,
@@ -279,7 +277,6 @@ pub struct ExactDivision;
 pub struct Reciprocal;
 
 impl ProjectionPrecision for ExactDivision {
-    const NAME: &'static str = "division";
     #[inline]
     fn project<const S: u32>(
         vp: &Viewport<S>,
@@ -292,7 +289,6 @@ impl ProjectionPrecision for ExactDivision {
 }
 
 impl ProjectionPrecision for Reciprocal {
-    const NAME: &'static str = "reciprocal";
     #[inline]
     fn project<const S: u32>(
         vp: &Viewport<S>,

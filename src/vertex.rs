@@ -46,8 +46,6 @@ pub enum TransformError {
 pub trait TransformPrecision:
     Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed + 'static
 {
-    /// Name in the trade-off table.
-    const NAME: &'static str;
     /// The per-instance transform in the form [`TransformPrecision::apply`] reads.
     type Matrix: Copy + core::fmt::Debug;
     /// Prepares `mv`, made for a mesh whose coordinates are within `max_abs_bits`, once per
@@ -76,7 +74,6 @@ pub struct WideTransform;
 pub struct NarrowTransform;
 
 impl TransformPrecision for WideTransform {
-    const NAME: &'static str = "wide";
     type Matrix = ModelView;
     fn prepare(mv: ModelView, _: i32) -> ModelView {
         mv
@@ -88,7 +85,6 @@ impl TransformPrecision for WideTransform {
 }
 
 impl TransformPrecision for NarrowTransform {
-    const NAME: &'static str = "narrow";
     type Matrix = NarrowModelView;
     fn prepare(mv: ModelView, max_abs_bits: i32) -> NarrowModelView {
         NarrowModelView::new(&mv, max_abs_bits)

@@ -569,7 +569,7 @@ impl SceneSpec {
         };
         let mut sink = scanline3d::sink::HashSink::new();
         let options = RenderOptions::default().with_back_face_culling(self.cull_back_faces);
-        render_with(
+        Precise::render(
             algorithm,
             tree.as_ref(),
             Rgb565::new(0, 0, 0),
@@ -1006,62 +1006,6 @@ const ACTIVE: usize = 4096;
 /// BSP traversal stack: enough for a chain as deep as the largest mesh.
 const BSP_STACK: usize = 2 * 65535 + 1;
 
-/// Renders through the workspace of `algorithm` (built here, with host-sized capacities).
-#[allow(clippy::too_many_arguments)]
-fn render_with<P: RowPixel, const S: u32, K: RowSink<P>>(
-    algorithm: Algorithm,
-    tree: Option<&BspTree<'_>>,
-    background: P,
-    w: usize,
-    h: usize,
-    scene: &Scene<'_>,
-    options: &RenderOptions<S>,
-    sink: &mut K,
-) -> Result<FrameStats, String>
-where
-    K::Error: std::fmt::Debug,
-{
-    const M: usize = MAX_SIZE;
-    const Z: usize = ZBUFFER_MAX_SIZE;
-    macro_rules! with {
-        ($ws:ty) => {{
-            let mut ws: Box<$ws> = Box::new(<$ws>::new(background));
-            ws.render_sized(w, h, scene, options, sink)
-        }};
-    }
-    match algorithm {
-        Algorithm::SpanZBuffer => with!(Workspace<P, Flat, M, M, TRIS, ACTIVE>),
-        Algorithm::ZBuffer => with!(ZBufferWorkspace<P, Flat, Z, Z, TRIS>),
-        Algorithm::Band(1) => with!(BandWorkspace<P, Flat, M, M, 1, TRIS, ACTIVE>),
-        Algorithm::Band(2) => with!(BandWorkspace<P, Flat, M, M, 2, TRIS, ACTIVE>),
-        Algorithm::Band(4) => with!(BandWorkspace<P, Flat, M, M, 4, TRIS, ACTIVE>),
-        Algorithm::Band(8) => with!(BandWorkspace<P, Flat, M, M, 8, TRIS, ACTIVE>),
-        Algorithm::Band(16) => with!(BandWorkspace<P, Flat, M, M, 16, TRIS, ACTIVE>),
-        Algorithm::Band(32) => with!(BandWorkspace<P, Flat, M, M, 32, TRIS, ACTIVE>),
-        Algorithm::Band(64) => with!(BandWorkspace<P, Flat, M, M, 64, TRIS, ACTIVE>),
-        Algorithm::Band(128) => with!(BandWorkspace<P, Flat, M, M, 128, TRIS, ACTIVE>),
-        Algorithm::Band(n) => {
-            return Err(format!(
-                "band height must be one of {BAND_CHOICES:?}, not {n}"
-            ))
-        }
-        Algorithm::DepthSort => with!(DepthSortWorkspace<P, Flat, M, M, TRIS, ACTIVE>),
-        Algorithm::SpanSort => with!(SpanSortWorkspace<P, Flat, M, M, TRIS, ACTIVE>),
-        Algorithm::Bsp => {
-            let tree = tree.ok_or("bsp needs a tree")?;
-            type Ws<P> = BspWorkspace<P, Flat, M, M, TRIS, ACTIVE, BSP_STACK>;
-            let mut ws: Box<Ws<P>> = Box::new(Ws::new(background));
-            ws.render_sized(w, h, scene, tree, options, sink)
-        }
-        Algorithm::Warnock => {
-            const STACK: usize = warnock::stack_needed(Z, Z);
-            with!(WarnockWorkspace<P, Flat, Z, Z, TRIS, ACTIVE, STACK>)
-        }
-        Algorithm::Newell => with!(NewellWorkspace<P, Flat, M, M, TRIS, ACTIVE>),
-    }
-    .map_err(|e| e.to_string())
-}
-
 /// Renders with arithmetic `Self`: every method for the precise default, the span z-buffer
 /// alone for the narrow ones (which exist to be measured; this keeps the tools' build small).
 trait Dispatch: Arithmetic + 'static {
@@ -1080,6 +1024,7 @@ trait Dispatch: Arithmetic + 'static {
         K::Error: std::fmt::Debug;
 }
 
+/// Every method, through the workspace of `algorithm` (built here, with host-sized capacities).
 impl Dispatch for Precise {
     fn render<P: RowPixel, const S: u32, K: RowSink<P>>(
         algorithm: Algorithm,
@@ -1094,7 +1039,45 @@ impl Dispatch for Precise {
     where
         K::Error: std::fmt::Debug,
     {
-        render_with(algorithm, tree, background, w, h, scene, options, sink)
+        const M: usize = MAX_SIZE;
+        const Z: usize = ZBUFFER_MAX_SIZE;
+        macro_rules! with {
+            ($ws:ty) => {{
+                let mut ws: Box<$ws> = Box::new(<$ws>::new(background));
+                ws.render_sized(w, h, scene, options, sink)
+            }};
+        }
+        match algorithm {
+            Algorithm::SpanZBuffer => with!(Workspace<P, Flat, M, M, TRIS, ACTIVE>),
+            Algorithm::ZBuffer => with!(ZBufferWorkspace<P, Flat, Z, Z, TRIS>),
+            Algorithm::Band(1) => with!(BandWorkspace<P, Flat, M, M, 1, TRIS, ACTIVE>),
+            Algorithm::Band(2) => with!(BandWorkspace<P, Flat, M, M, 2, TRIS, ACTIVE>),
+            Algorithm::Band(4) => with!(BandWorkspace<P, Flat, M, M, 4, TRIS, ACTIVE>),
+            Algorithm::Band(8) => with!(BandWorkspace<P, Flat, M, M, 8, TRIS, ACTIVE>),
+            Algorithm::Band(16) => with!(BandWorkspace<P, Flat, M, M, 16, TRIS, ACTIVE>),
+            Algorithm::Band(32) => with!(BandWorkspace<P, Flat, M, M, 32, TRIS, ACTIVE>),
+            Algorithm::Band(64) => with!(BandWorkspace<P, Flat, M, M, 64, TRIS, ACTIVE>),
+            Algorithm::Band(128) => with!(BandWorkspace<P, Flat, M, M, 128, TRIS, ACTIVE>),
+            Algorithm::Band(n) => {
+                return Err(format!(
+                    "band height must be one of {BAND_CHOICES:?}, not {n}"
+                ))
+            }
+            Algorithm::DepthSort => with!(DepthSortWorkspace<P, Flat, M, M, TRIS, ACTIVE>),
+            Algorithm::SpanSort => with!(SpanSortWorkspace<P, Flat, M, M, TRIS, ACTIVE>),
+            Algorithm::Bsp => {
+                let tree = tree.ok_or("bsp needs a tree")?;
+                type Ws<P> = BspWorkspace<P, Flat, M, M, TRIS, ACTIVE, BSP_STACK>;
+                let mut ws: Box<Ws<P>> = Box::new(Ws::new(background));
+                ws.render_sized(w, h, scene, tree, options, sink)
+            }
+            Algorithm::Warnock => {
+                const STACK: usize = warnock::stack_needed(Z, Z);
+                with!(WarnockWorkspace<P, Flat, Z, Z, TRIS, ACTIVE, STACK>)
+            }
+            Algorithm::Newell => with!(NewellWorkspace<P, Flat, M, M, TRIS, ACTIVE>),
+        }
+        .map_err(|e| e.to_string())
     }
 }
 
