@@ -189,12 +189,7 @@ impl<const S: u32> Viewport<S> {
         } else {
             0
         };
-        Some(ScreenVertex {
-            x: SubPx(x as i32),
-            y: SubPx(y as i32),
-            q: Depth::from_bits(q.min(i32::MAX as i64) as i32),
-            color,
-        })
+        Some(screen_vertex(x, y, q, color))
     }
 
     /// [`Viewport::project_with`] with one reciprocal per vertex instead of a division per
@@ -236,27 +231,29 @@ impl<const S: u32> Viewport<S> {
         } else {
             0
         };
-        Some(ScreenVertex {
-            x: SubPx(x as i32),
-            y: SubPx(y as i32),
-            q: Depth::from_bits(q.min(i32::MAX as i64) as i32),
-            color,
-        })
+        Some(screen_vertex(x, y, q, color))
+    }
+}
+
+/// A projected vertex from its position and depth bits (within range after clipping; the
+/// depth saturates at the top of I2F30).
+#[inline]
+fn screen_vertex<const S: u32>(x: i64, y: i64, q: i64, color: [I16F16; 3]) -> ScreenVertex<S> {
+    ScreenVertex {
+        x: SubPx(x as i32),
+        y: SubPx(y as i32),
+        q: Depth::from_bits(q.min(i32::MAX as i64) as i32),
+        color,
     }
 }
 
 /// How vertices are divided by `w`, chosen at compile time (see
-/// [`crate::preset::Arithmetic`]).
+/// [`crate::preset::Arithmetic`]); [`Viewport::project_as`] projects with it.
 pub trait ProjectionPrecision:
     Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed + 'static
 {
-    /// Projects a point inside all clip planes; the depth is 0 unless `depth`.
-    fn project<const S: u32>(
-        vp: &Viewport<S>,
-        p: &EyePoint,
-        color: [I16F16; 3],
-        depth: bool,
-    ) -> Option<ScreenVertex<S>>;
+    /// Whether this is [`Reciprocal`] (else [`ExactDivision`]).
+    const RECIPROCAL: bool;
 }
 
 mod sealed {
@@ -277,26 +274,28 @@ pub struct ExactDivision;
 pub struct Reciprocal;
 
 impl ProjectionPrecision for ExactDivision {
-    #[inline]
-    fn project<const S: u32>(
-        vp: &Viewport<S>,
-        p: &EyePoint,
-        color: [I16F16; 3],
-        depth: bool,
-    ) -> Option<ScreenVertex<S>> {
-        vp.project_with(p, color, depth)
-    }
+    const RECIPROCAL: bool = false;
 }
 
 impl ProjectionPrecision for Reciprocal {
+    const RECIPROCAL: bool = true;
+}
+
+impl<const S: u32> Viewport<S> {
+    /// Projects a point inside all clip planes with projection `P`; the depth is 0 unless
+    /// `depth`.
     #[inline]
-    fn project<const S: u32>(
-        vp: &Viewport<S>,
+    pub fn project_as<P: ProjectionPrecision>(
+        &self,
         p: &EyePoint,
         color: [I16F16; 3],
         depth: bool,
     ) -> Option<ScreenVertex<S>> {
-        vp.project_reciprocal(p, color, depth)
+        if P::RECIPROCAL {
+            self.project_reciprocal(p, color, depth)
+        } else {
+            self.project_with(p, color, depth)
+        }
     }
 }
 

@@ -20,7 +20,7 @@
 use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping, FrustumClip};
 use crate::math::NormalPrecision;
 use crate::preset::{Arithmetic, Precise};
-use crate::project::{Depth, ProjectionPrecision, ScreenVertex, Viewport};
+use crate::project::{Depth, ScreenVertex, Viewport};
 use crate::raster::{
     color_channels, first_row, signed_area, xy, DepthPlane, PlaneSolver, TriangleWalk,
 };
@@ -767,7 +767,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                 f(s);
             }
         };
-        let project = |c: &ClipVertex| A::Projection::project(vp, &c.p, c.color, depth);
+        let project = |c: &ClipVertex| vp.project_as::<A::Projection>(&c.p, c.color, depth);
         let mut polygon = ClipPolygon::new();
         let clipped = match C::clip(vp, &cv, &mut polygon) {
             Clipped::Outside => return Fate::Rejected,

@@ -20,6 +20,7 @@ use scanline3d::sink::{FnSink, Row, RowPixel, RowSink, TriangleId};
 use scanline3d::vertex::{NarrowTransform, WideTransform};
 use scanline3d::{Flat, FrameStats, RenderOptions, Workspace};
 use std::convert::Infallible;
+use std::fmt::Debug;
 use std::path::Path;
 
 /// Camera parameters (`gluLookAt` + `gluPerspective`).
@@ -569,16 +570,14 @@ impl SceneSpec {
         };
         let mut sink = scanline3d::sink::HashSink::new();
         let options = RenderOptions::default().with_back_face_culling(self.cull_back_faces);
-        Precise::render(
+        let target = Target::new(
             algorithm,
             tree.as_ref(),
             Rgb565::new(0, 0, 0),
-            w,
-            h,
-            &scene,
-            &options,
+            (w, h),
             &mut sink,
-        )?;
+        );
+        Precise::render(target, &scene, &options)?;
         Ok(sink.hash())
     }
 
@@ -675,16 +674,8 @@ impl SceneSpec {
             let mut sink = FnSink(|row: Row<'_, Rgb888>| {
                 scanline3d::sink::RowSink::write_row(&mut display, row)
             });
-            A::render(
-                algorithm,
-                tree.as_ref(),
-                Rgb888::BLACK,
-                w,
-                h,
-                &scene,
-                &options,
-                &mut sink,
-            )?
+            let target = Target::new(algorithm, tree.as_ref(), Rgb888::BLACK, (w, h), &mut sink);
+            A::render(target, &scene, &options)?
         };
         image.color = target.pixels;
         // The id pass also records depth (NaN over surfaces where the method keeps none).
@@ -700,16 +691,14 @@ impl SceneSpec {
             }
             Ok(())
         });
-        A::render(
+        let target = Target::new(
             algorithm,
             tree.as_ref(),
             TriangleId::NONE,
-            w,
-            h,
-            &scene,
-            &options,
+            (w, h),
             &mut sink,
-        )?;
+        );
+        A::render(target, &scene, &options)?;
         if let Some(b) = &bsp {
             for id in image.ids.iter_mut().filter(|id| **id >= 0) {
                 *id = b.origin[*id as usize] as i32;
@@ -1009,36 +998,55 @@ const BSP_STACK: usize = 2 * 65535 + 1;
 /// Renders with arithmetic `Self`: every method for the precise default, the span z-buffer
 /// alone for the narrow ones (which exist to be measured; this keeps the tools' build small).
 trait Dispatch: Arithmetic + 'static {
-    #[allow(clippy::too_many_arguments)]
-    fn render<P: RowPixel, const S: u32, K: RowSink<P>>(
-        algorithm: Algorithm,
-        tree: Option<&BspTree<'_>>,
-        background: P,
-        w: usize,
-        h: usize,
+    fn render<P: RowPixel, const S: u32, K: RowSink<P, Error: Debug>>(
+        target: Target<'_, P, K>,
         scene: &Scene<'_>,
         options: &RenderOptions<S, FrustumClip, Self>,
-        sink: &mut K,
-    ) -> Result<FrameStats, String>
-    where
-        K::Error: std::fmt::Debug;
+    ) -> Result<FrameStats, String>;
+}
+
+/// Where and how a frame is rendered: method, BSP tree (for [`Algorithm::Bsp`]), background,
+/// size and sink.
+struct Target<'a, P, K> {
+    algorithm: Algorithm,
+    tree: Option<&'a BspTree<'a>>,
+    background: P,
+    size: (usize, usize),
+    sink: &'a mut K,
+}
+
+impl<'a, P, K> Target<'a, P, K> {
+    fn new(
+        algorithm: Algorithm,
+        tree: Option<&'a BspTree<'a>>,
+        background: P,
+        size: (usize, usize),
+        sink: &'a mut K,
+    ) -> Self {
+        Target {
+            algorithm,
+            tree,
+            background,
+            size,
+            sink,
+        }
+    }
 }
 
 /// Every method, through the workspace of `algorithm` (built here, with host-sized capacities).
 impl Dispatch for Precise {
-    fn render<P: RowPixel, const S: u32, K: RowSink<P>>(
-        algorithm: Algorithm,
-        tree: Option<&BspTree<'_>>,
-        background: P,
-        w: usize,
-        h: usize,
+    fn render<P: RowPixel, const S: u32, K: RowSink<P, Error: Debug>>(
+        t: Target<'_, P, K>,
         scene: &Scene<'_>,
         options: &RenderOptions<S>,
-        sink: &mut K,
-    ) -> Result<FrameStats, String>
-    where
-        K::Error: std::fmt::Debug,
-    {
+    ) -> Result<FrameStats, String> {
+        let Target {
+            algorithm,
+            tree,
+            background,
+            size: (w, h),
+            sink,
+        } = t;
         const M: usize = MAX_SIZE;
         const Z: usize = ZBUFFER_MAX_SIZE;
         macro_rules! with {
@@ -1085,19 +1093,12 @@ impl Dispatch for Precise {
 macro_rules! span_zbuffer_only {
     ($($a:ty),*) => {$(
         impl Dispatch for $a {
-            fn render<P: RowPixel, const S: u32, K: RowSink<P>>(
-                algorithm: Algorithm,
-                _: Option<&BspTree<'_>>,
-                background: P,
-                w: usize,
-                h: usize,
+            fn render<P: RowPixel, const S: u32, K: RowSink<P, Error: Debug>>(
+                t: Target<'_, P, K>,
                 scene: &Scene<'_>,
                 options: &RenderOptions<S, FrustumClip, Self>,
-                sink: &mut K,
-            ) -> Result<FrameStats, String>
-            where
-                K::Error: std::fmt::Debug,
-            {
+            ) -> Result<FrameStats, String> {
+                let Target { algorithm, background, size: (w, h), sink, .. } = t;
                 if algorithm != Algorithm::SpanZBuffer {
                     return Err(format!(
                         "narrow set-up arithmetic is built for {} only",
