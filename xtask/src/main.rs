@@ -5,6 +5,7 @@
 use std::io::{BufRead, BufReader};
 use std::process::{Command, ExitCode, Stdio};
 
+mod profile;
 mod tradeoff;
 
 const TARGETS: [&str; 3] = [
@@ -1173,6 +1174,10 @@ fn main() -> ExitCode {
         "lean" => install().and_then(|_| lean()),
         "peers" => peers(),
         "tradeoff" => install().and_then(|_| tradeoff::tradeoff()),
+        "profile" => {
+            let variant = std::env::args().nth(2).unwrap_or_else(|| "balanced".into());
+            install().and_then(|_| profile::profile(&variant))
+        }
         // The host renders build whole-frame workspaces (megabytes at 60,000 polygons) by value:
         // give them a thread with room for that.
         "hsr-table" => install().and_then(|_| {
@@ -1192,7 +1197,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | lean | hsr-table | peers | tradeoff | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | lean | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }

@@ -62,7 +62,7 @@ fn corpus_frames(output: &str) -> Vec<CorpusFrame> {
 
 /// Builds `examples/tradeoff.rs` in release for `target` (the host if `None`) with extra
 /// `--cfg`s; with `corpus`, also the generated corpus at that path. Returns the ELF path.
-fn build_tradeoff(
+pub(crate) fn build_tradeoff(
     target: Option<&str>,
     cfgs: &[String],
     corpus: Option<&std::path::Path>,
@@ -91,6 +91,15 @@ fn build_tradeoff(
 /// Runs a firmware ELF with the runner `.cargo/config.toml` gives for `target` (QEMU with a
 /// deterministic instruction clock); its standard output.
 fn run_on_qemu(target: &str, elf: &std::path::Path) -> Result<String, String> {
+    run_on_qemu_with(target, elf, &[])
+}
+
+/// [`run_on_qemu`] with `extra` QEMU arguments.
+pub(crate) fn run_on_qemu_with(
+    target: &str,
+    elf: &std::path::Path,
+    extra: &[&std::ffi::OsStr],
+) -> Result<String, String> {
     let config = std::fs::read_to_string(root().join(".cargo/config.toml"))
         .map_err(|e| format!(".cargo/config.toml: {e}"))?;
     let section = format!("[target.{target}]");
@@ -108,6 +117,7 @@ fn run_on_qemu(target: &str, elf: &std::path::Path) -> Result<String, String> {
     let out = Command::new(program)
         .args(words)
         .arg(elf)
+        .args(extra)
         .output()
         .map_err(|e| format!("{program}: {e}"))?;
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
