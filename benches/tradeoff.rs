@@ -5,28 +5,30 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
+use scanline3d::depth::{Depth16, DepthFormat};
 use scanline3d::math::{NarrowNormals, WideNormals};
 use scanline3d::preset::{Arithmetic, Frugal, Precise, Quick, Setup};
 use scanline3d::project::{ExactDivision, Reciprocal};
+use scanline3d::render::MAX_INSTANCES;
 use scanline3d::scene::Scene;
 use scanline3d::sink::HashSink;
 use scanline3d::vertex::{NarrowTransform, WideTransform};
-use scanline3d::{Flat, RenderOptions, Workspace};
+use scanline3d::{Depth, Flat, RenderOptions, Workspace};
 use scanline3d_sim::corpus;
-use scanline3d_sim::scene::{LightSpec, SceneSpec, SetupArith};
+use scanline3d_sim::scene::{DepthChoice, LightSpec, SceneSpec, SetupArith};
 use scanline3d_sim::tradeoff::VARIANTS;
 use std::hint::black_box;
 use std::time::Duration;
 
 /// Room for the largest corpus scene (10,082 triangles) and 240 slivers crossing one row.
-type Ws = Workspace<Rgb565, Flat, 240, 240, 16384, 1024>;
+type Ws<Z> = Workspace<Rgb565, Flat, 240, 240, 16384, 1024, MAX_INSTANCES, Z>;
 
 type Group<'c> = criterion::BenchmarkGroup<'c, criterion::measurement::WallTime>;
 
-fn time<const S: u32, A: Arithmetic>(
+fn time<const S: u32, A: Arithmetic, Z: DepthFormat>(
     group: &mut Group<'_>,
     (variant, scene_name): (&str, &str),
-    ws: &mut Ws,
+    ws: &mut Ws<Z>,
     scene: &Scene<'_>,
     cull: bool,
 ) {
@@ -54,7 +56,8 @@ fn bench(c: &mut Criterion) {
         .sample_size(10)
         .warm_up_time(Duration::from_millis(300))
         .measurement_time(Duration::from_millis(1000));
-    let mut ws: Box<Ws> = Box::new(Workspace::new(Rgb565::BLACK));
+    let mut ws: Box<Ws<Depth>> = Box::new(Workspace::new(Rgb565::BLACK));
+    let mut ws16: Box<Ws<Depth16>> = Box::new(Workspace::new(Rgb565::BLACK));
     for scene in corpus::all() {
         let spec = SceneSpec::single(
             scene.mesh.clone(),
@@ -67,22 +70,26 @@ fn bench(c: &mut Criterion) {
             let cull = spec.cull_back_faces;
             let p = v.precision;
             spec.with_scene_math(p.math, |s| match (p.sub_bits, p.arith) {
-                (0, SetupArith::Precise) => time::<0, Precise>(&mut group, id, &mut ws, s, cull),
-                (2, SetupArith::Quick) => time::<2, Quick>(&mut group, id, &mut ws, s, cull),
-                (4, SetupArith::Frugal) => time::<4, Frugal>(&mut group, id, &mut ws, s, cull),
-                (4, SetupArith::Precise) => time::<4, Precise>(&mut group, id, &mut ws, s, cull),
-                (8, SetupArith::Precise) => time::<8, Precise>(&mut group, id, &mut ws, s, cull),
+                _ if p.depth == DepthChoice::Q16 => {
+                    assert_eq!((p.sub_bits, p.arith), (4, SetupArith::Precise));
+                    time::<4, Precise, Depth16>(&mut group, id, &mut ws16, s, cull)
+                }
+                (0, SetupArith::Precise) => time::<0, Precise, _>(&mut group, id, &mut ws, s, cull),
+                (2, SetupArith::Quick) => time::<2, Quick, _>(&mut group, id, &mut ws, s, cull),
+                (4, SetupArith::Frugal) => time::<4, Frugal, _>(&mut group, id, &mut ws, s, cull),
+                (4, SetupArith::Precise) => time::<4, Precise, _>(&mut group, id, &mut ws, s, cull),
+                (8, SetupArith::Precise) => time::<8, Precise, _>(&mut group, id, &mut ws, s, cull),
                 (4, SetupArith::NarrowTransform) => {
                     type A = Setup<NarrowTransform, ExactDivision, WideNormals>;
-                    time::<4, A>(&mut group, id, &mut ws, s, cull)
+                    time::<4, A, _>(&mut group, id, &mut ws, s, cull)
                 }
                 (4, SetupArith::Reciprocal) => {
                     type A = Setup<WideTransform, Reciprocal, WideNormals>;
-                    time::<4, A>(&mut group, id, &mut ws, s, cull)
+                    time::<4, A, _>(&mut group, id, &mut ws, s, cull)
                 }
                 (4, SetupArith::NarrowNormals) => {
                     type A = Setup<WideTransform, ExactDivision, NarrowNormals>;
-                    time::<4, A>(&mut group, id, &mut ws, s, cull)
+                    time::<4, A, _>(&mut group, id, &mut ws, s, cull)
                 }
                 other => panic!("no benchmark for {other:?}"),
             })

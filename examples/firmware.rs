@@ -46,7 +46,7 @@ mod firmware {
     /// One flat span fill, called the way the renderer calls it: through row slices.
     #[inline(never)]
     fn fill_span(span: SpanDepth, depth: &mut [Depth], pixels: &mut [Rgb565]) -> u32 {
-        Flat::fill(
+        Flat::fill::<_, Depth>(
             &Rgb565::new(31, 0, 0),
             &PixelOrigin::new(0, 0),
             span,

@@ -17,15 +17,27 @@
 
 use embedded_graphics::pixelcolor::Rgb565;
 use scanline3d::clip::FrustumClip;
+use scanline3d::depth::{Depth16, DepthFormat};
 use scanline3d::math::MathBackend;
 use scanline3d::preset::{self, Arithmetic, Preset};
 use scanline3d::scene::{Camera, Scene, SceneError};
 use scanline3d::sink::HashSink;
-use scanline3d::{demo, Flat, RenderOptions, Workspace};
+use scanline3d::{demo, Depth, Flat, RenderOptions, Workspace};
 
 /// The demo's panel workspace with room to spare: the approximate set-up of some variants moves
 /// the camera slightly, so the exact capacities `sim analyze --demo` measured may not cover it.
-type Ws = Workspace<Rgb565, Flat, 240, 240, 640, 80, 3>;
+type Ws<Z> = Workspace<Rgb565, Flat, 240, 240, 640, 80, 3, Z>;
+
+/// A new workspace: boxed on the host (a debug build would need a large main stack), on the
+/// stack on targets (no allocator; the variant's frame holds it while it renders).
+#[cfg(not(target_os = "none"))]
+fn fresh<T>(make: impl FnOnce() -> T) -> Box<T> {
+    Box::new(make())
+}
+#[cfg(target_os = "none")]
+fn fresh<T>(make: impl FnOnce() -> T) -> T {
+    make()
+}
 
 /// One frame's result.
 struct Frame {
@@ -37,8 +49,15 @@ struct Frame {
 }
 
 /// Renders one frame of `scene` into the panel model, counting its instructions.
-fn frame<const S: u32, A: Arithmetic, const T: usize, const ACT: usize, const I: usize>(
-    ws: &mut Workspace<Rgb565, Flat, 240, 240, T, ACT, I>,
+fn frame<
+    const S: u32,
+    A: Arithmetic,
+    const T: usize,
+    const ACT: usize,
+    const I: usize,
+    Z: DepthFormat,
+>(
+    ws: &mut Workspace<Rgb565, Flat, 240, 240, T, ACT, I, Z>,
     scene: &Scene<'_>,
     options: &RenderOptions<S, FrustumClip, A>,
     count: &impl Fn() -> Counter,
@@ -64,8 +83,8 @@ fn camera<M: MathBackend>(
 
 /// What to render with each variant.
 trait Renders {
-    /// Renders with variant `name`: `options`, and the camera computed with `M`.
-    fn variant<const S: u32, A: Arithmetic, M: MathBackend>(
+    /// Renders with variant `name`: `options`, the camera computed with `M`, depth format `Z`.
+    fn variant<const S: u32, A: Arithmetic, M: MathBackend, Z: DepthFormat>(
         &mut self,
         name: &'static str,
         options: RenderOptions<S, FrustumClip, A>,
@@ -74,17 +93,17 @@ trait Renders {
 
 /// The demo orbit; `report(variant, frame, result)`.
 struct Orbit<'a, C, R> {
-    ws: &'a mut Ws,
     count: &'a C,
     report: R,
 }
 
 impl<C: Fn() -> Counter, R: FnMut(&str, u32, Frame)> Renders for Orbit<'_, C, R> {
-    fn variant<const S: u32, A: Arithmetic, M: MathBackend>(
+    fn variant<const S: u32, A: Arithmetic, M: MathBackend, Z: DepthFormat>(
         &mut self,
         name: &'static str,
         options: RenderOptions<S, FrustumClip, A>,
     ) -> Result<(), &'static str> {
+        let mut ws = fresh(|| Ws::<Z>::new(Rgb565::new(0, 0, 0)));
         let instances = demo::instances();
         for f in 0..demo::ORBIT_FRAMES {
             let (eye, target, up, fovy, near, far) = demo::camera_parameters(f, demo::ORBIT_FRAMES);
@@ -93,7 +112,7 @@ impl<C: Fn() -> Counter, R: FnMut(&str, u32, Frame)> Renders for Orbit<'_, C, R>
                 camera: camera::<M>((eye, target, up), (fovy, near, far)).map_err(|_| "camera")?,
                 light: demo::light().map_err(|_| "light")?,
             };
-            let result = frame(self.ws, &scene, &options, self.count)?;
+            let result = frame(&mut ws, &scene, &options, self.count)?;
             (self.report)(name, f, result);
         }
         Ok(())
@@ -119,6 +138,8 @@ const BUILD_VARIANT: &str = if cfg!(scanline3d_variant = "fast") {
     "reciprocal"
 } else if cfg!(scanline3d_variant = "narrownormals") {
     "narrow-normals"
+} else if cfg!(scanline3d_variant = "depth16") {
+    "depth16"
 } else {
     "balanced"
 };
@@ -153,35 +174,41 @@ fn variants(r: &mut impl Renders) -> Result<(), &'static str> {
     type Arith<P> = <P as Preset>::Arithmetic;
     let default = RenderOptions::default();
     if renders(Fast::NAME) {
-        r.variant::<2, Arith<Fast>, Math<Fast>>(Fast::NAME, Fast::options())?;
+        r.variant::<2, Arith<Fast>, Math<Fast>, Depth>(Fast::NAME, Fast::options())?;
     }
     if renders(Balanced::NAME) {
-        r.variant::<4, Arith<Balanced>, Math<Balanced>>(Balanced::NAME, Balanced::options())?;
+        r.variant::<4, Arith<Balanced>, Math<Balanced>, Depth>(
+            Balanced::NAME,
+            Balanced::options(),
+        )?;
     }
     if renders(Exact::NAME) {
-        r.variant::<8, Arith<Exact>, Math<Exact>>(Exact::NAME, Exact::options())?;
+        r.variant::<8, Arith<Exact>, Math<Exact>, Depth>(Exact::NAME, Exact::options())?;
     }
     if renders("default") {
-        r.variant::<4, _, Libm>("default", default)?;
+        r.variant::<4, _, Libm, Depth>("default", default)?;
     }
     if renders("bits:0") {
         let bits0 = default.with_sub_pixel_bits::<0>();
-        r.variant::<0, _, Libm>("bits:0", bits0)?;
+        r.variant::<0, _, Libm, Depth>("bits:0", bits0)?;
     }
     if renders("micromath") {
-        r.variant::<4, _, Micromath>("micromath", default)?;
+        r.variant::<4, _, Micromath, Depth>("micromath", default)?;
     }
     if renders("narrow-transform") {
         let a = Setup::<NarrowTransform, ExactDivision, WideNormals>::default();
-        r.variant::<4, _, Libm>("narrow-transform", default.with_arithmetic(a))?;
+        r.variant::<4, _, Libm, Depth>("narrow-transform", default.with_arithmetic(a))?;
     }
     if renders("reciprocal") {
         let a = Setup::<WideTransform, Reciprocal, WideNormals>::default();
-        r.variant::<4, _, Libm>("reciprocal", default.with_arithmetic(a))?;
+        r.variant::<4, _, Libm, Depth>("reciprocal", default.with_arithmetic(a))?;
     }
     if renders("narrow-normals") {
         let a = Setup::<WideTransform, ExactDivision, NarrowNormals>::default();
-        r.variant::<4, _, Libm>("narrow-normals", default.with_arithmetic(a))?;
+        r.variant::<4, _, Libm, Depth>("narrow-normals", default.with_arithmetic(a))?;
+    }
+    if renders("depth16") {
+        r.variant::<4, _, Libm, Depth16>("depth16", default)?;
     }
     Ok(())
 }
@@ -200,21 +227,21 @@ mod corpus_views {
     }
 
     /// A workspace for the largest corpus scene.
-    pub type CorpusWs =
-        Workspace<Rgb565, Flat, 240, 240, { corpus::MAX_TRIANGLES }, { corpus::MAX_ACTIVE }, 1>;
+    type CorpusWs<Z> =
+        Workspace<Rgb565, Flat, 240, 240, { corpus::MAX_TRIANGLES }, { corpus::MAX_ACTIVE }, 1, Z>;
 
     pub struct Views<'a, C, R> {
-        pub ws: &'a mut CorpusWs,
         pub count: &'a C,
         pub report: R,
     }
 
     impl<C: Fn() -> Counter, R: FnMut(&str, &str, usize, Frame)> Renders for Views<'_, C, R> {
-        fn variant<const S: u32, A: Arithmetic, M: MathBackend>(
+        fn variant<const S: u32, A: Arithmetic, M: MathBackend, Z: DepthFormat>(
             &mut self,
             name: &'static str,
             options: RenderOptions<S, FrustumClip, A>,
         ) -> Result<(), &'static str> {
+            let mut ws = fresh(|| CorpusWs::<Z>::new(Rgb565::new(0, 0, 0)));
             for s in &corpus::SCENES {
                 let instances = [Instance {
                     mesh: s.mesh,
@@ -229,7 +256,7 @@ mod corpus_views {
                         camera: camera::<M>(view, projection).map_err(|_| "camera")?,
                         light,
                     };
-                    let result = frame(self.ws, &scene, &options, self.count)?;
+                    let result = frame(&mut ws, &scene, &options, self.count)?;
                     (self.report)(name, s.name, k, result);
                 }
             }
@@ -250,9 +277,7 @@ impl Counter {
 
 #[cfg(not(target_os = "none"))]
 fn main() -> Result<(), &'static str> {
-    let mut ws = Box::new(Ws::new(Rgb565::new(0, 0, 0)));
     variants(&mut Orbit {
-        ws: &mut ws,
         count: &|| Counter,
         report: |name: &str, frame, f: Frame| {
             println!(
@@ -263,9 +288,7 @@ fn main() -> Result<(), &'static str> {
     })?;
     #[cfg(scanline3d_corpus)]
     {
-        let mut ws = Box::new(corpus_views::CorpusWs::new(Rgb565::new(0, 0, 0)));
         variants(&mut corpus_views::Views {
-            ws: &mut ws,
             count: &|| Counter,
             report: |name: &str, scene: &str, view, f: Frame| {
                 println!(
@@ -306,9 +329,7 @@ mod firmware {
         measure::calibrate()?;
         let mut complete = true;
         {
-            let mut ws = Ws::new(Rgb565::new(0, 0, 0));
             variants(&mut Orbit {
-                ws: &mut ws,
                 count: &|| Counter(arch::start()),
                 report: |name: &str, frame, f: Frame| {
                     complete &= f.complete;
@@ -321,9 +342,7 @@ mod firmware {
         }
         #[cfg(scanline3d_corpus)]
         {
-            let mut ws = corpus_views::CorpusWs::new(Rgb565::new(0, 0, 0));
             variants(&mut corpus_views::Views {
-                ws: &mut ws,
                 count: &|| Counter(arch::start()),
                 report: |name: &str, scene: &str, view, f: Frame| {
                     complete &= f.complete;
@@ -334,7 +353,13 @@ mod firmware {
                 },
             })?;
         }
-        println!("summary workspace {}", Ws::BYTES);
+        // The one variant this image renders: its demo workspace.
+        let workspace = if renders("depth16") {
+            Ws::<Depth16>::BYTES
+        } else {
+            Ws::<Depth>::BYTES
+        };
+        println!("summary workspace {}", workspace);
         if complete {
             Ok(())
         } else {

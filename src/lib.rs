@@ -45,7 +45,8 @@
 //! ## Pipeline (one module per stage)
 //!
 //! [`scene`] → [`vertex`] (transform, lighting) → [`clip`] → [`project`] → [`raster`] (setup,
-//! edge walk) → [`render`] (buckets, active list, span z-buffer) with [`shading`] → [`sink`].
+//! edge walk) → [`render`] (buckets, active list, span z-buffer in a [`depth`] format) with
+//! [`shading`] → [`sink`].
 //!
 //! ## Rules
 //!
@@ -85,6 +86,7 @@ extern crate std;
 
 pub mod clip;
 pub mod demo;
+pub mod depth;
 pub mod math;
 pub mod preset;
 pub mod project;

@@ -18,6 +18,7 @@
 //! [`Workspace::BYTES`].
 
 use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping, FrustumClip};
+use crate::depth::{DepthFormat, DepthRow};
 use crate::math::NormalPrecision;
 use crate::preset::{Arithmetic, Precise};
 use crate::project::{Depth, ScreenVertex, Viewport};
@@ -340,35 +341,35 @@ pub(crate) trait Resolve<P: RowPixel, S: Shading> {
 /// What [`Resolve::finish_row`] hands back.
 pub(crate) struct FinishedRow<'a, P> {
     pub(crate) pixels: &'a [P],
-    pub(crate) depth: &'a [Depth],
+    pub(crate) depth: DepthRow<'a>,
     pub(crate) spans: u16,
     pub(crate) written: u32,
 }
 
 /// The span z-buffer: one row of depth, spans depth-tested as they come.
-struct SpanZBuffer<'a, P> {
-    depth: &'a mut [Depth],
+struct SpanZBuffer<'a, P, Z> {
+    depth: &'a mut [Z],
     pixels: &'a mut [P],
     background: P,
     spans: u16,
 }
 
-impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanZBuffer<'_, P> {
+impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for SpanZBuffer<'_, P, Z> {
     type Key = ();
     fn begin_band(&mut self, _: i32, _: usize) {
-        self.depth.fill(Depth::ZERO);
+        self.depth.fill(Z::FAR);
         self.pixels.fill(self.background);
         self.spans = 0;
     }
     #[inline(always)]
     fn span(&mut self, t: &ActiveTri<S::Payload<P>>, _: usize, y: i32, l: i32, r: i32) -> u32 {
         self.spans += 1;
-        fill_span::<P, S, ()>(t, y, l, r, self.depth, self.pixels)
+        fill_span::<P, S, Z, ()>(t, y, l, r, self.depth, self.pixels)
     }
     fn finish_row(&mut self, _: i32) -> FinishedRow<'_, P> {
         FinishedRow {
             pixels: self.pixels,
-            depth: self.depth,
+            depth: Z::row(self.depth),
             spans: self.spans,
             written: 0,
         }
@@ -377,12 +378,12 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanZBuffer<'_, P> {
 
 /// Depth-tests and writes `t`'s span `[l, r)` of row `y` into one row of depth and pixels.
 #[inline(always)]
-pub(crate) fn fill_span<P: RowPixel, S: Shading, K>(
+pub(crate) fn fill_span<P: RowPixel, S: Shading, Z: DepthFormat, K>(
     t: &ActiveTri<S::Payload<P>, K>,
     y: i32,
     l: i32,
     r: i32,
-    depth: &mut [Depth],
+    depth: &mut [Z],
     pixels: &mut [P],
 ) -> u32 {
     let (q, dq) = t.depth.span_start(l, y);
@@ -405,13 +406,18 @@ pub(crate) const NO_ENTRY: u16 = u16::MAX;
 /// * `INSTANCES`: mesh instances a scene may have (their set-up lives on the stack during a
 ///   render; default [`MAX_INSTANCES`]);
 /// * `ACTIVE`: triangles that may cross one row (more are dropped and reported in
-///   [`FrameStats::dropped`], [`FrameStats::dropped_pieces`] and [`Row::complete`]).
+///   [`FrameStats::dropped`], [`FrameStats::dropped_pieces`] and [`Row::complete`]);
+/// * `Z`: the depth format of the row's z-buffer ([`crate::depth`]): [`Depth`] (32-bit, the
+///   default) or [`Depth16`](crate::depth::Depth16) (half the depth row, coarser ties).
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
-/// use scanline3d::{Flat, Workspace};
+/// use scanline3d::{depth::Depth16, Flat, Workspace};
 /// type Ws = Workspace<Rgb565, Flat, 240, 240, 1280, 64>;
 /// assert!(Ws::BYTES < 16 * 1024);
+/// // The same with a 16-bit depth row: 2 bytes less per column.
+/// type Ws16 = Workspace<Rgb565, Flat, 240, 240, 1280, 64, 8, Depth16>;
+/// assert_eq!(Ws::BYTES - Ws16::BYTES, 2 * 240);
 /// ```
 pub struct Workspace<
     P: RowPixel,
@@ -421,8 +427,9 @@ pub struct Workspace<
     const TRIS: usize = 1024,
     const ACTIVE: usize = 64,
     const INSTANCES: usize = MAX_INSTANCES,
+    Z: DepthFormat = Depth,
 > {
-    depth: [Depth; W],
+    depth: [Z; W],
     pixels: [P; W],
     background: P,
     heads: [u16; H],
@@ -431,19 +438,23 @@ pub struct Workspace<
     active: Vec<ActiveTri<S::Payload<P>>, ACTIVE>,
 }
 
-/// Bytes of a [`Workspace`] for pixel type `P` and shading `S` with the given size and
-/// capacities: what `Workspace::<P, S, W, H, TRIS, ACTIVE>::BYTES` is, computed at run time
-/// (for tools such as `sim analyze` that choose the capacities).
+/// Bytes of a [`Workspace`] for pixel type `P`, shading `S` and depth format `Z` with the given
+/// size and capacities: what `Workspace::<P, S, W, H, TRIS, ACTIVE, INSTANCES, Z>::BYTES` is,
+/// computed at run time (for tools such as `sim analyze` that choose the capacities).
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
-/// use scanline3d::{render::workspace_bytes, Flat, Workspace};
+/// use scanline3d::{depth::Depth16, render::workspace_bytes, Depth, Flat, Workspace};
 /// assert_eq!(
-///     workspace_bytes::<Rgb565, Flat>(240, 240, 100, 12),
+///     workspace_bytes::<Rgb565, Flat, Depth>(240, 240, 100, 12),
 ///     Workspace::<Rgb565, Flat, 240, 240, 100, 12>::BYTES
 /// );
+/// assert_eq!(
+///     workspace_bytes::<Rgb565, Flat, Depth16>(240, 240, 100, 12),
+///     Workspace::<Rgb565, Flat, 240, 240, 100, 12, 8, Depth16>::BYTES
+/// );
 /// ```
-pub const fn workspace_bytes<P: RowPixel, S: Shading>(
+pub const fn workspace_bytes<P: RowPixel, S: Shading, Z: DepthFormat>(
     width: usize,
     height: usize,
     triangles: usize,
@@ -459,7 +470,7 @@ pub const fn workspace_bytes<P: RowPixel, S: Shading>(
             align_of::<usize>()
         }
     };
-    let unpadded = width * (size_of::<Depth>() + size_of::<P>())
+    let unpadded = width * (size_of::<Z>() + size_of::<P>())
         + size_of::<P>()
         + height * size_of::<u16>()
         + triangles * 2 * size_of::<u16>()
@@ -503,7 +514,8 @@ impl<
         const TRIS: usize,
         const ACTIVE: usize,
         const INSTANCES: usize,
-    > Workspace<P, S, W, H, TRIS, ACTIVE, INSTANCES>
+        Z: DepthFormat,
+    > Workspace<P, S, W, H, TRIS, ACTIVE, INSTANCES, Z>
 {
     /// Size of this workspace in bytes.
     pub const BYTES: usize = core::mem::size_of::<Self>();
@@ -525,7 +537,7 @@ impl<
         #[allow(clippy::let_unit_value)]
         let () = Self::VALID;
         Workspace {
-            depth: [Depth::ZERO; W],
+            depth: [Z::FAR; W],
             pixels: [background; W],
             background,
             heads: [NO_ENTRY; H],

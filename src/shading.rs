@@ -5,7 +5,8 @@
 //! in screen space). Depth is always perspective-correct: the span loop steps `q = near/w`,
 //! which is linear in screen space.
 
-use crate::project::{Depth, ScreenVertex};
+use crate::depth::DepthFormat;
+use crate::project::ScreenVertex;
 use crate::raster::{channel, ColorPlanes, PixelOrigin, PlaneSolver};
 use crate::sink::RowPixel;
 use embedded_graphics::pixelcolor::Rgb888;
@@ -43,13 +44,13 @@ pub trait Shading: sealed::Sealed + Copy + Default {
         v: &[ScreenVertex<S>; 3],
     ) -> Self::Payload<P>;
 
-    /// Depth-tests and writes one span; `depth` and `pixels` are exactly the span's columns.
-    /// Returns the number of pixels written.
-    fn fill<P: RowPixel>(
+    /// Depth-tests and writes one span; `depth` (in format `Z`) and `pixels` are exactly the
+    /// span's columns. Returns the number of pixels written.
+    fn fill<P: RowPixel, Z: DepthFormat>(
         payload: &Self::Payload<P>,
         origin: &PixelOrigin,
         span: SpanDepth,
-        depth: &mut [Depth],
+        depth: &mut [Z],
         pixels: &mut [P],
     ) -> u32;
 
@@ -94,19 +95,20 @@ impl Shading for Flat {
     }
 
     #[inline]
-    fn fill<P: RowPixel>(
+    fn fill<P: RowPixel, Z: DepthFormat>(
         color: &P,
         _: &PixelOrigin,
         span: SpanDepth,
-        depth: &mut [Depth],
+        depth: &mut [Z],
         pixels: &mut [P],
     ) -> u32 {
         let mut q = span.q;
         let mut written = 0;
         for (z, p) in depth.iter_mut().zip(pixels.iter_mut()) {
             // Strictly nearer wins: on an exact tie the surface drawn first keeps the pixel.
-            if q > z.to_bits() {
-                *z = Depth::from_bits(q);
+            let stored = Z::store(q);
+            if stored > *z {
+                *z = stored;
                 *p = *color;
                 written += 1;
             }
@@ -145,19 +147,20 @@ impl Shading for Gouraud {
     }
 
     #[inline]
-    fn fill<P: RowPixel>(
+    fn fill<P: RowPixel, Z: DepthFormat>(
         payload: &GouraudPayload,
         origin: &PixelOrigin,
         span: SpanDepth,
-        depth: &mut [Depth],
+        depth: &mut [Z],
         pixels: &mut [P],
     ) -> u32 {
         let (mut c, dc) = payload.planes.span_start(origin, span.x0, span.y);
         let mut q = span.q;
         let mut written = 0;
         for (z, p) in depth.iter_mut().zip(pixels.iter_mut()) {
-            if q > z.to_bits() {
-                *z = Depth::from_bits(q);
+            let stored = Z::store(q);
+            if stored > *z {
+                *z = stored;
                 let rgb = Rgb888::new(channel(c[0]), channel(c[1]), channel(c[2]));
                 *p = P::from_shade(rgb, payload.id);
                 written += 1;

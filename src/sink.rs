@@ -5,6 +5,8 @@
 //! [`OrderedDither`] for monochrome targets, [`FrameBuffer`] for a frame in RAM and [`FnSink`]
 //! for a closure (for example a panel driver that streams the row over SPI).
 
+use crate::depth::DepthRow;
+#[cfg(test)]
 use crate::project::Depth;
 use embedded_graphics::pixelcolor::raw::RawData;
 use embedded_graphics::pixelcolor::{
@@ -84,8 +86,9 @@ pub struct Row<'a, P> {
     pub y: u16,
     /// The row's pixels, left to right (length = target width).
     pub pixels: &'a [P],
-    /// The row's depth (`near / w`, 0 = background), same length.
-    pub depth: &'a [Depth],
+    /// The row's depth (`near / w`, 0 = background) in the z-buffer's format, same length;
+    /// empty for methods that keep no depth.
+    pub depth: DepthRow<'a>,
     /// `false` if a triangle piece that spans this row was dropped because the active list was
     /// full (see [`FrameStats::dropped_pieces`](crate::render::FrameStats::dropped_pieces)).
     pub complete: bool,
@@ -108,11 +111,11 @@ pub trait RowSink<P> {
 /// ```
 /// use embedded_graphics::mock_display::MockDisplay;
 /// use embedded_graphics::pixelcolor::BinaryColor;
-/// use scanline3d::sink::{DrawTargetSink, Row, RowSink};
+/// use scanline3d::{depth::DepthRow, sink::{DrawTargetSink, Row, RowSink}};
 /// let mut display = MockDisplay::<BinaryColor>::new();
 /// let mut sink = DrawTargetSink::new(&mut display);
 /// let pixels = [BinaryColor::On, BinaryColor::Off];
-/// sink.write_row(Row { y: 1, pixels: &pixels, depth: &[Default::default(); 2], complete: true }).unwrap();
+/// sink.write_row(Row { y: 1, pixels: &pixels, depth: DepthRow::NONE, complete: true }).unwrap();
 /// display.assert_pattern(&[
 ///     "  ",
 ///     "#.",
@@ -199,10 +202,10 @@ pub enum FrameBufferError {
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Gray8;
-/// use scanline3d::sink::{FrameBuffer, Row, RowSink};
+/// use scanline3d::{depth::DepthRow, sink::{FrameBuffer, Row, RowSink}};
 /// let mut pixels = [Gray8::new(0); 6];
 /// let mut fb = FrameBuffer::new(&mut pixels, 3);
-/// fb.write_row(Row { y: 1, pixels: &[Gray8::new(9); 3], depth: &[Default::default(); 3], complete: true }).unwrap();
+/// fb.write_row(Row { y: 1, pixels: &[Gray8::new(9); 3], depth: DepthRow::NONE, complete: true }).unwrap();
 /// assert_eq!(pixels[3], Gray8::new(9));
 /// ```
 pub struct FrameBuffer<'a, P> {
@@ -239,7 +242,7 @@ impl<P: Copy> RowSink<P> for FrameBuffer<'_, P> {
 /// use scanline3d::sink::{FnSink, Row, RowSink};
 /// let mut rows = 0;
 /// let mut sink = FnSink(|row: Row<'_, Rgb565>| -> Result<(), ()> { rows += row.y as usize; Ok(()) });
-/// sink.write_row(Row { y: 2, pixels: &[], depth: &[], complete: true }).unwrap();
+/// sink.write_row(Row { y: 2, pixels: &[], depth: DepthRow::NONE, complete: true }).unwrap();
 /// assert_eq!(rows, 2);
 /// ```
 pub struct FnSink<F>(pub F);
@@ -258,11 +261,11 @@ impl<P, E, F: FnMut(Row<'_, P>) -> Result<(), E>> RowSink<P> for FnSink<F> {
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
-/// use scanline3d::sink::{HashSink, Row, RowSink};
+/// use scanline3d::{depth::DepthRow, sink::{HashSink, Row, RowSink}};
 /// let mut a = HashSink::new();
-/// a.write_row(Row { y: 0, pixels: &[Rgb565::new(1, 2, 3)], depth: &[Default::default()], complete: true }).unwrap();
+/// a.write_row(Row { y: 0, pixels: &[Rgb565::new(1, 2, 3)], depth: DepthRow::NONE, complete: true }).unwrap();
 /// let mut b = HashSink::new();
-/// b.write_row(Row { y: 0, pixels: &[Rgb565::new(1, 2, 4)], depth: &[Default::default()], complete: true }).unwrap();
+/// b.write_row(Row { y: 0, pixels: &[Rgb565::new(1, 2, 4)], depth: DepthRow::NONE, complete: true }).unwrap();
 /// assert_ne!(a.hash(), b.hash());
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -350,7 +353,7 @@ mod tests {
         let row = Row {
             y: 2,
             pixels: &[1u8, 2],
-            depth: &[Depth::ZERO; 2],
+            depth: DepthRow::Q30(&[Depth::ZERO; 2]),
             complete: true,
         };
         assert_eq!(fb.write_row(row), Err(FrameBufferError::OutOfBounds));

@@ -555,13 +555,20 @@ fn micromath_backend_renders_nearly_the_same_image() {
 
 #[test]
 fn workspace_bytes_matches_the_compiled_layout() {
-    use scanline3d::render::workspace_bytes;
+    use scanline3d::depth::Depth16;
+    use scanline3d::render::{workspace_bytes, MAX_INSTANCES};
+    use scanline3d::Depth;
     macro_rules! check {
         ($p:ty, $s:ty, $w:literal, $h:literal, $t:literal, $a:literal) => {
             assert_eq!(
-                workspace_bytes::<$p, $s>($w, $h, $t, $a),
+                workspace_bytes::<$p, $s, Depth>($w, $h, $t, $a),
                 Workspace::<$p, $s, $w, $h, $t, $a>::BYTES,
                 stringify!($p, $s, $w, $h, $t, $a)
+            );
+            assert_eq!(
+                workspace_bytes::<$p, $s, Depth16>($w, $h, $t, $a),
+                Workspace::<$p, $s, $w, $h, $t, $a, MAX_INSTANCES, Depth16>::BYTES,
+                stringify!($p, $s, $w, $h, $t, $a, Depth16)
             );
         };
     }
@@ -606,4 +613,93 @@ fn instance_capacity_is_a_workspace_parameter() {
         .render(&scene, &RenderOptions::default(), &mut sink)
         .unwrap();
     assert_eq!((stats.triangles_in, rows.get()), (2, 16));
+}
+
+/// Ids and depth of `scene` at 96×96 with depth format `Z`, from a span z-buffer or (`full`) a
+/// full-frame z-buffer.
+fn ids_and_depth<Z: scanline3d::depth::DepthFormat>(
+    scene: &Scene<'_>,
+    full: bool,
+) -> (Vec<i32>, Vec<i32>) {
+    use scanline3d::render::MAX_INSTANCES;
+    use scanline3d::resolve::ZBufferWorkspace;
+    let (mut ids, mut depth) = (Vec::new(), Vec::new());
+    let mut sink = FnSink(|row: Row<'_, TriangleId>| -> Result<(), ()> {
+        ids.extend(row.pixels.iter().map(|p| p.0));
+        depth.extend((0..row.pixels.len()).map(|x| row.depth.get(x).map_or(-1, |q| q.to_bits())));
+        Ok(())
+    });
+    let options = RenderOptions::default();
+    let stats = if full {
+        type Ws<Z> = ZBufferWorkspace<TriangleId, Flat, 96, 96, 1536, MAX_INSTANCES, Z>;
+        let mut ws: Box<Ws<Z>> = Box::new(Ws::new(TriangleId::NONE));
+        ws.render(scene, &options, &mut sink)
+    } else {
+        type Ws<Z> = Workspace<TriangleId, Flat, 96, 96, 1536, 96, MAX_INSTANCES, Z>;
+        let mut ws: Box<Ws<Z>> = Box::new(Ws::new(TriangleId::NONE));
+        ws.render(scene, &options, &mut sink)
+    };
+    assert!(stats.unwrap().is_complete());
+    (ids, depth)
+}
+
+#[test]
+fn sixteen_bit_depth_differs_from_32_bit_only_by_its_resolution() {
+    use scanline3d::depth::Depth16;
+    use scanline3d::Depth;
+    let instances = scanline3d::demo::instances();
+    for frame in 0..8 {
+        let scene = scanline3d::demo::scene(&instances, frame, 8).unwrap();
+        let (ids32, depth32) = ids_and_depth::<Depth>(&scene, false);
+        let (ids16, depth16) = ids_and_depth::<Depth16>(&scene, false);
+        // The full-frame z-buffer with 16-bit cells settles ties exactly as the span z-buffer.
+        let full16 = ids_and_depth::<Depth16>(&scene, true);
+        assert_eq!((&ids16, &depth16), (&full16.0, &full16.1));
+        // The demo has no surfaces within 2^-16 of each other in q: the same ids everywhere,
+        // each depth the 32-bit one truncated to 16 fractional bits.
+        assert_eq!(ids32, ids16, "frame {frame}");
+        for (q, z) in depth32.iter().zip(&depth16) {
+            assert!(z <= q && q - z < 1 << 14, "{q} stored as {z}");
+            assert_eq!(z & ((1 << 14) - 1), 0);
+        }
+    }
+}
+
+#[test]
+fn sixteen_bit_depth_gives_surfaces_closer_than_its_resolution_to_the_first_drawn() {
+    use scanline3d::depth::Depth16;
+    use scanline3d::Depth;
+    // Two squares facing the camera 5·10^-5 apart at distance 3: Δq ≈ 2.8·10^-6, far below
+    // 2^-16 ≈ 1.5·10^-5 but far above 2^-30. The far square (ids 0, 1) is drawn first.
+    let square = |z: f64| {
+        [
+            [-1.0, -1.0, z],
+            [1.0, -1.0, z],
+            [1.0, 1.0, z],
+            [-1.0, 1.0, z],
+        ]
+    };
+    let (far, near) = (square(0.0), square(0.00005));
+    let positions: Vec<[f64; 3]> = far.iter().chain(&near).copied().collect();
+    let data = mesh_data(&positions, &[[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]]);
+    let mesh = data.mesh().unwrap();
+    let instances = [instance(&mesh)];
+    let scene = Scene {
+        instances: &instances,
+        camera: front_camera().fixed().unwrap(),
+        light: light(),
+    };
+    let count = |ids: &[i32], which: [i32; 2]| ids.iter().filter(|i| which.contains(i)).count();
+    let (ids32, _) = ids_and_depth::<Depth>(&scene, false);
+    let (ids16, _) = ids_and_depth::<Depth16>(&scene, false);
+    let covered = count(&ids32, [0, 1]) + count(&ids32, [2, 3]);
+    assert!(covered > 1000);
+    assert_eq!(
+        count(&ids32, [2, 3]),
+        covered,
+        "32 bits resolve the gap everywhere"
+    );
+    // 16 bits: q is constant over each square (they face the camera), 2^16 · q = 10922.67 and
+    // 10922.85, both cell 10922: a tie at every pixel, and the far square, drawn first, keeps it.
+    assert_eq!(count(&ids16, [0, 1]), covered);
 }

@@ -8,7 +8,7 @@ use crate::scene::{CameraSpec, SceneSpec, SUB_PIXEL_CHOICES};
 use embedded_graphics::pixelcolor::Rgb565;
 use scanline3d::render::workspace_bytes;
 use scanline3d::scene::MAX_EYE_DISTANCE;
-use scanline3d::Flat;
+use scanline3d::{Depth, Flat};
 use std::fmt;
 
 /// `count` cameras on a sphere of directions (a Fibonacci lattice) at `distance` from
@@ -170,8 +170,8 @@ impl Analysis {
             self.triangle_capacity(margin_percent),
             self.active_capacity(margin_percent),
         );
-        let entry = workspace_bytes::<Rgb565, Flat>(w, h, 0, 1)
-            - workspace_bytes::<Rgb565, Flat>(w, h, 0, 0);
+        let entry = workspace_bytes::<Rgb565, Flat, Depth>(w, h, 0, 1)
+            - workspace_bytes::<Rgb565, Flat, Depth>(w, h, 0, 0);
         vec![
             (format!("depth row ({w} × 4 B)"), 4 * w),
             (format!("pixel row ({w} × 2 B, RGB565)"), 2 * w),
@@ -183,7 +183,7 @@ impl Analysis {
             ),
             (
                 "workspace total (Workspace::BYTES)".to_string(),
-                workspace_bytes::<Rgb565, Flat>(w, h, tris, active),
+                workspace_bytes::<Rgb565, Flat, Depth>(w, h, tris, active),
             ),
         ]
     }

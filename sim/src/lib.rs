@@ -88,9 +88,7 @@ fn judge(
         sub_bits: precision.sub_bits,
         max_model_coord: spec.max_model_coord(),
         focal_px: reference.camera.focal_px(h),
-        arithmetic: precision
-            .arith
-            .documented_error(w, h, spec.max_model_coord()),
+        arithmetic: precision.documented_error(w, h, spec.max_model_coord()),
     };
     let m = metrics::compare(&fixed.image, &ref_image, &reference, &bound);
     Ok((m, fixed, ref_image))

@@ -41,10 +41,14 @@ pub struct ErrorBound {
     pub arithmetic: ArithmeticError,
 }
 
-/// The documented error a set-up arithmetic (`scanline3d::preset::Arithmetic`) adds to the
-/// precise one's, for one scene and screen.
+/// The documented error that narrow choices (a set-up arithmetic of
+/// `scanline3d::preset::Arithmetic`, a 16-bit depth format) add to the default's, for one scene
+/// and screen.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ArithmeticError {
+    /// Depth resolution in `q = near / w` beyond the default's (`DepthFormat::RESOLUTION`:
+    /// 2^-16 for `depth::Depth16`).
+    pub depth_q: f64,
     /// Screen position error in pixels (`project::Reciprocal`: 2^-14 of a vertex's offset from
     /// the screen centre, at most the guard band's corner).
     pub px: f64,
@@ -69,11 +73,13 @@ impl ErrorBound {
     /// position error (the caller adds the depth change of the surface within `ε`):
     /// * the depth format: `q = near/w` in I2F30 evaluated from an I24F40 plane, ≤ 2^-25
     ///   absolute in q (a generous bound on rounding in set-up, stepping and storage), so
-    ///   `Δw/w = Δq/q ≤ 2^-25 · w/near`;
+    ///   `Δw/w = Δq/q ≤ 2^-25 · w/near`, plus a narrower format's resolution in `q` the same way;
     /// * the transform moving vertices along the view axis: `E / w`;
     /// * the f32 depth image's own rounding: 2^-24.
     pub fn depth_relative(&self, w: f64, near: f64) -> f64 {
-        2f64.powi(-25) * w / near + self.eye_units() / w + 2f64.powi(-24)
+        (2f64.powi(-25) + self.arithmetic.depth_q) * w / near
+            + self.eye_units() / w
+            + 2f64.powi(-24)
     }
 }
 

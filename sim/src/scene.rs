@@ -7,9 +7,11 @@ use crate::reference::{self, Image};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::I16F16;
 use scanline3d::clip::FrustumClip;
+use scanline3d::depth::{Depth16, DepthFormat};
 use scanline3d::math::{Libm, MathBackend, Micromath, NarrowNormals, WideNormals};
 use scanline3d::preset::{self, Arithmetic, Precise, Preset, Setup};
 use scanline3d::project::{ExactDivision, Reciprocal};
+use scanline3d::render::MAX_INSTANCES;
 use scanline3d::resolve::bsp::{BspTree, BspWorkspace};
 use scanline3d::resolve::{
     warnock, BandWorkspace, DepthSortWorkspace, NewellWorkspace, SpanSortWorkspace,
@@ -18,7 +20,7 @@ use scanline3d::resolve::{
 use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
 use scanline3d::sink::{FnSink, Row, RowPixel, RowSink, TriangleId};
 use scanline3d::vertex::{NarrowTransform, WideTransform};
-use scanline3d::{Flat, FrameStats, RenderOptions, Workspace};
+use scanline3d::{Depth, Flat, FrameStats, RenderOptions, Workspace};
 use std::convert::Infallible;
 use std::fmt::Debug;
 use std::path::Path;
@@ -600,14 +602,14 @@ impl SceneSpec {
         algorithm: Algorithm,
     ) -> Result<FixedRender, String> {
         use preset::Quick;
-        let math = precision.math;
+        let p = precision;
         macro_rules! bits {
             ($a:ty) => {
                 match precision.sub_bits {
-                    0 => self.render_fixed_s::<0, $a>(w, h, math, algorithm),
-                    2 => self.render_fixed_s::<2, $a>(w, h, math, algorithm),
-                    4 => self.render_fixed_s::<4, $a>(w, h, math, algorithm),
-                    8 => self.render_fixed_s::<8, $a>(w, h, math, algorithm),
+                    0 => self.render_fixed_s::<0, $a>(w, h, p, algorithm),
+                    2 => self.render_fixed_s::<2, $a>(w, h, p, algorithm),
+                    4 => self.render_fixed_s::<4, $a>(w, h, p, algorithm),
+                    8 => self.render_fixed_s::<8, $a>(w, h, p, algorithm),
                     _ => Err(format!(
                         "sub-pixel bits must be one of {SUB_PIXEL_CHOICES:?}"
                     )),
@@ -630,7 +632,7 @@ impl SceneSpec {
         &self,
         w: usize,
         h: usize,
-        math: SetupMath,
+        precision: Precision,
         algorithm: Algorithm,
     ) -> Result<FixedRender, String> {
         let max = algorithm.max_size();
@@ -647,7 +649,7 @@ impl SceneSpec {
             None => self.meshes()?,
         };
         let instances = self.library_instances(&meshes);
-        let camera = self.camera.fixed_with(math)?;
+        let camera = self.camera.fixed_with(precision.math)?;
         let scene = Scene {
             instances: &instances,
             camera,
@@ -674,7 +676,8 @@ impl SceneSpec {
             let mut sink = FnSink(|row: Row<'_, Rgb888>| {
                 scanline3d::sink::RowSink::write_row(&mut display, row)
             });
-            let target = Target::new(algorithm, tree.as_ref(), Rgb888::BLACK, (w, h), &mut sink);
+            let target = Target::new(algorithm, tree.as_ref(), Rgb888::BLACK, (w, h), &mut sink)
+                .with_depth(precision.depth);
             A::render(target, &scene, &options)?
         };
         image.color = target.pixels;
@@ -684,7 +687,7 @@ impl SceneSpec {
             for (x, id) in row.pixels.iter().enumerate() {
                 image.ids[at + x] = id.0;
                 image.depth[at + x] = match row.depth.get(x) {
-                    Some(q) => camera.eye_distance(*q).unwrap_or(f32::INFINITY),
+                    Some(q) => camera.eye_distance(q).unwrap_or(f32::INFINITY),
                     None if id.0 >= 0 => f32::NAN,
                     None => f32::INFINITY,
                 };
@@ -697,7 +700,8 @@ impl SceneSpec {
             TriangleId::NONE,
             (w, h),
             &mut sink,
-        );
+        )
+        .with_depth(precision.depth);
         A::render(target, &scene, &options)?;
         if let Some(b) = &bsp {
             for id in image.ids.iter_mut().filter(|id| **id >= 0) {
@@ -758,6 +762,7 @@ impl SetupArith {
         // The guard band's corner is 4 screen sizes from the centre in x and y.
         let corner = 4.0 * (w.max(h) as f64) * std::f64::consts::SQRT_2;
         ArithmeticError {
+            depth_q: 0.0,
             px: if reciprocal {
                 2f64.powi(-14) * corner
             } else {
@@ -772,6 +777,33 @@ impl SetupArith {
     }
 }
 
+/// Depth format of the z-buffer (`scanline3d::depth`), chosen at run time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthChoice {
+    /// `scanline3d::Depth`, 32 bits: the default.
+    Q30,
+    /// `scanline3d::depth::Depth16`, 16 bits.
+    Q16,
+}
+
+impl DepthChoice {
+    /// Name in the trade-off table.
+    pub fn name(self) -> &'static str {
+        match self {
+            DepthChoice::Q30 => "32-bit",
+            DepthChoice::Q16 => "16-bit",
+        }
+    }
+
+    /// Its documented resolution in `q = near / w` (`DepthFormat::RESOLUTION`).
+    pub fn resolution(self) -> f64 {
+        match self {
+            DepthChoice::Q30 => <Depth as DepthFormat>::RESOLUTION,
+            DepthChoice::Q16 => <Depth16 as DepthFormat>::RESOLUTION,
+        }
+    }
+}
+
 /// Every precision choice of one render.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Precision {
@@ -781,6 +813,8 @@ pub struct Precision {
     pub math: SetupMath,
     /// Per-vertex and per-triangle set-up arithmetic.
     pub arith: SetupArith,
+    /// Depth format of the z-buffer.
+    pub depth: DepthChoice,
 }
 
 impl Precision {
@@ -790,6 +824,16 @@ impl Precision {
             sub_bits,
             math: SetupMath::Libm,
             arith: SetupArith::Precise,
+            depth: DepthChoice::Q30,
+        }
+    }
+
+    /// The error these choices add to the default's, as the library documents it, for a
+    /// `w × h` screen and a scene whose largest model coordinate is `max_model_coord`.
+    pub fn documented_error(self, w: usize, h: usize, max_model_coord: f64) -> ArithmeticError {
+        ArithmeticError {
+            depth_q: self.depth.resolution(),
+            ..self.arith.documented_error(w, h, max_model_coord)
         }
     }
 }
@@ -837,6 +881,7 @@ impl PresetChoice {
             sub_bits: self.sub_bits(),
             math: self.math(),
             arith: self.arith(),
+            depth: DepthChoice::Q30,
         }
     }
 
@@ -1009,6 +1054,7 @@ trait Dispatch: Arithmetic + 'static {
 /// size and sink.
 struct Target<'a, P, K> {
     algorithm: Algorithm,
+    depth: DepthChoice,
     tree: Option<&'a BspTree<'a>>,
     background: P,
     size: (usize, usize),
@@ -1025,12 +1071,27 @@ impl<'a, P, K> Target<'a, P, K> {
     ) -> Self {
         Target {
             algorithm,
+            depth: DepthChoice::Q30,
             tree,
             background,
             size,
             sink,
         }
     }
+
+    /// The same with depth format `depth`.
+    fn with_depth(self, depth: DepthChoice) -> Self {
+        Target { depth, ..self }
+    }
+}
+
+/// The error for a depth format a method is not built with.
+fn depth_unsupported(algorithm: Algorithm) -> String {
+    format!(
+        "16-bit depth is built for {} and {} only, not {algorithm}",
+        Algorithm::SpanZBuffer,
+        Algorithm::ZBuffer
+    )
 }
 
 /// Every method, through the workspace of `algorithm` (built here, with host-sized capacities).
@@ -1042,6 +1103,7 @@ impl Dispatch for Precise {
     ) -> Result<FrameStats, String> {
         let Target {
             algorithm,
+            depth,
             tree,
             background,
             size: (w, h),
@@ -1049,11 +1111,24 @@ impl Dispatch for Precise {
         } = t;
         const M: usize = MAX_SIZE;
         const Z: usize = ZBUFFER_MAX_SIZE;
+        const I: usize = MAX_INSTANCES;
         macro_rules! with {
             ($ws:ty) => {{
                 let mut ws: Box<$ws> = Box::new(<$ws>::new(background));
                 ws.render_sized(w, h, scene, options, sink)
             }};
+        }
+        match (depth, algorithm) {
+            (DepthChoice::Q30, _) => {}
+            (DepthChoice::Q16, Algorithm::SpanZBuffer) => {
+                return with!(Workspace<P, Flat, M, M, TRIS, ACTIVE, I, Depth16>)
+                    .map_err(|e| e.to_string())
+            }
+            (DepthChoice::Q16, Algorithm::ZBuffer) => {
+                return with!(ZBufferWorkspace<P, Flat, Z, Z, TRIS, I, Depth16>)
+                    .map_err(|e| e.to_string())
+            }
+            (DepthChoice::Q16, _) => return Err(depth_unsupported(algorithm)),
         }
         match algorithm {
             Algorithm::SpanZBuffer => with!(Workspace<P, Flat, M, M, TRIS, ACTIVE>),
@@ -1098,17 +1173,26 @@ macro_rules! span_zbuffer_only {
                 scene: &Scene<'_>,
                 options: &RenderOptions<S, FrustumClip, Self>,
             ) -> Result<FrameStats, String> {
-                let Target { algorithm, background, size: (w, h), sink, .. } = t;
+                let Target { algorithm, depth, background, size: (w, h), sink, .. } = t;
                 if algorithm != Algorithm::SpanZBuffer {
                     return Err(format!(
                         "narrow set-up arithmetic is built for {} only",
                         Algorithm::SpanZBuffer
                     ));
                 }
-                type Ws<P> = Workspace<P, Flat, MAX_SIZE, MAX_SIZE, TRIS, ACTIVE>;
-                let mut ws: Box<Ws<P>> = Box::new(Ws::new(background));
-                ws.render_sized(w, h, scene, options, sink)
-                    .map_err(|e| e.to_string())
+                type Ws<P, Z> =
+                    Workspace<P, Flat, MAX_SIZE, MAX_SIZE, TRIS, ACTIVE, MAX_INSTANCES, Z>;
+                match depth {
+                    DepthChoice::Q30 => {
+                        let mut ws: Box<Ws<P, Depth>> = Box::new(Ws::new(background));
+                        ws.render_sized(w, h, scene, options, sink)
+                    }
+                    DepthChoice::Q16 => {
+                        let mut ws: Box<Ws<P, Depth16>> = Box::new(Ws::new(background));
+                        ws.render_sized(w, h, scene, options, sink)
+                    }
+                }
+                .map_err(|e| e.to_string())
             }
         }
     )*};

@@ -3,7 +3,9 @@
 
 use crate::corpus;
 use crate::metrics::{self, ErrorBound, Metrics};
-use crate::scene::{LightSpec, Precision, PresetChoice, SceneSpec, SetupArith, SetupMath};
+use crate::scene::{
+    DepthChoice, LightSpec, Precision, PresetChoice, SceneSpec, SetupArith, SetupMath,
+};
 
 /// One set of precision choices.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -25,31 +27,30 @@ const fn preset(p: PresetChoice, name: &'static str, precision: Precision) -> Va
 }
 
 /// The library default (`RenderOptions::default()`: 4 sub-pixel bits, precise arithmetic,
-/// libm) with one knob changed, or (`"default"`) unchanged.
-const fn knob(name: &'static str, sub_bits: u32, math: SetupMath, arith: SetupArith) -> Variant {
+/// libm, 32-bit depth) with the choices `precision` changes, or (`"default"`) unchanged.
+const fn knob(name: &'static str, precision: Precision) -> Variant {
     Variant {
         name,
         preset: None,
-        precision: Precision {
-            sub_bits,
-            math,
-            arith,
-        },
+        precision,
     }
 }
+
+/// The default's choices.
+const DEFAULT: Precision = Precision::bits(4);
 
 const fn choices(sub_bits: u32, arith: SetupArith) -> Precision {
     Precision {
         sub_bits,
-        math: SetupMath::Libm,
         arith,
+        ..DEFAULT
     }
 }
 
 /// Every variant, in the order of `examples/tradeoff.rs` (a test keeps the presets' entries
 /// equal to `scanline3d::preset`). A knob's name is also its `scanline3d_variant` cfg value with
 /// `:` and spaces removed.
-pub const VARIANTS: [Variant; 9] = [
+pub const VARIANTS: [Variant; 10] = [
     preset(PresetChoice::Fast, "fast", choices(2, SetupArith::Quick)),
     preset(
         PresetChoice::Balanced,
@@ -61,21 +62,24 @@ pub const VARIANTS: [Variant; 9] = [
         "exact",
         choices(8, SetupArith::Precise),
     ),
-    knob("default", 4, SetupMath::Libm, SetupArith::Precise),
-    knob("bits:0", 0, SetupMath::Libm, SetupArith::Precise),
-    knob("micromath", 4, SetupMath::Micromath, SetupArith::Precise),
+    knob("default", DEFAULT),
+    knob("bits:0", Precision::bits(0)),
     knob(
-        "narrow-transform",
-        4,
-        SetupMath::Libm,
-        SetupArith::NarrowTransform,
+        "micromath",
+        Precision {
+            math: SetupMath::Micromath,
+            ..DEFAULT
+        },
     ),
-    knob("reciprocal", 4, SetupMath::Libm, SetupArith::Reciprocal),
+    knob("narrow-transform", choices(4, SetupArith::NarrowTransform)),
+    knob("reciprocal", choices(4, SetupArith::Reciprocal)),
+    knob("narrow-normals", choices(4, SetupArith::NarrowNormals)),
     knob(
-        "narrow-normals",
-        4,
-        SetupMath::Libm,
-        SetupArith::NarrowNormals,
+        "depth16",
+        Precision {
+            depth: DepthChoice::Q16,
+            ..DEFAULT
+        },
     ),
 ];
 
@@ -124,10 +128,7 @@ pub fn corpus_accuracy(
                     sub_bits: v.precision.sub_bits,
                     max_model_coord: spec.max_model_coord(),
                     focal_px: reference.camera.focal_px(h),
-                    arithmetic: v
-                        .precision
-                        .arith
-                        .documented_error(w, h, spec.max_model_coord()),
+                    arithmetic: v.precision.documented_error(w, h, spec.max_model_coord()),
                 };
                 out.push(Accuracy {
                     variant: v.name,

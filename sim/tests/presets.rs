@@ -10,7 +10,7 @@ fn presets_meet_their_accuracy_claims_on_the_corpus() {
     let of = |name: &'static str| all.iter().filter(move |a| a.variant == name);
     // Every preset (and the coarsest setting) is free of real mismatches and keeps depth within
     // its bound everywhere.
-    // So is each narrow-arithmetic knob, under the error its arithmetic documents.
+    // So is each narrow knob, under the error it documents (arithmetic, depth resolution).
     for name in [
         "fast",
         "balanced",
@@ -20,6 +20,7 @@ fn presets_meet_their_accuracy_claims_on_the_corpus() {
         "narrow-transform",
         "reciprocal",
         "narrow-normals",
+        "depth16",
     ] {
         for a in of(name) {
             let m = &a.metrics;

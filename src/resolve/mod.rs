@@ -32,6 +32,7 @@
 //! [`Row::depth`]: crate::sink::Row::depth
 
 use crate::clip::Clipping;
+use crate::depth::{DepthFormat, DepthRow};
 use crate::preset::Arithmetic;
 use crate::project::Depth;
 use crate::raster::PixelOrigin;
@@ -94,8 +95,9 @@ pub struct BandWorkspace<
     const TRIS: usize = 1024,
     const ACTIVE: usize = 64,
     const INSTANCES: usize = MAX_INSTANCES,
+    Z: DepthFormat = Depth,
 > {
-    depth: [[Depth; W]; B],
+    depth: [[Z; W]; B],
     pixels: [[P; W]; B],
     spans: [u16; B],
     background: P,
@@ -114,11 +116,12 @@ pub type ZBufferWorkspace<
     const H: usize,
     const TRIS: usize = 1024,
     const INSTANCES: usize = MAX_INSTANCES,
-> = BandWorkspace<P, S, W, H, H, TRIS, 0, INSTANCES>;
+    Z = Depth,
+> = BandWorkspace<P, S, W, H, H, TRIS, 0, INSTANCES, Z>;
 
 /// The band resolver: `B` rows of depth and pixels, rows `y0 ..`.
-struct Band<'a, P> {
-    depth: &'a mut [Depth],
+struct Band<'a, P, Z> {
+    depth: &'a mut [Z],
     pixels: &'a mut [P],
     spans: &'a mut [u16],
     background: P,
@@ -126,21 +129,21 @@ struct Band<'a, P> {
     y0: i32,
 }
 
-impl<P: RowPixel> Band<'_, P> {
+impl<P: RowPixel, Z> Band<'_, P, Z> {
     /// Offset of row `y`'s first column in the band buffers.
     fn row_start(&self, y: i32) -> usize {
         (y - self.y0).max(0) as usize * self.width
     }
 }
 
-impl<P: RowPixel, S: Shading> Resolve<P, S> for Band<'_, P> {
+impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for Band<'_, P, Z> {
     type Key = ();
     fn band_rows(&self) -> usize {
         self.spans.len()
     }
     fn begin_band(&mut self, y0: i32, _: usize) {
         self.y0 = y0;
-        self.depth.fill(Depth::ZERO);
+        self.depth.fill(Z::FAR);
         self.pixels.fill(self.background);
         self.spans.fill(0);
     }
@@ -156,14 +159,14 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for Band<'_, P> {
         ) else {
             return 0;
         };
-        fill_span::<P, S, ()>(t, y, l, r, depth, pixels)
+        fill_span::<P, S, Z, ()>(t, y, l, r, depth, pixels)
     }
     fn finish_row(&mut self, y: i32) -> FinishedRow<'_, P> {
         let at = self.row_start(y);
         let rows = at..at + self.width;
         FinishedRow {
             pixels: self.pixels.get(rows.clone()).unwrap_or(&[]),
-            depth: self.depth.get(rows).unwrap_or(&[]),
+            depth: Z::row(self.depth.get(rows).unwrap_or(&[])),
             spans: self.spans.get((y - self.y0) as usize).copied().unwrap_or(0),
             written: 0,
         }
@@ -179,7 +182,8 @@ impl<
         const TRIS: usize,
         const ACTIVE: usize,
         const INSTANCES: usize,
-    > BandWorkspace<P, S, W, H, B, TRIS, ACTIVE, INSTANCES>
+        Z: DepthFormat,
+    > BandWorkspace<P, S, W, H, B, TRIS, ACTIVE, INSTANCES, Z>
 {
     /// Size of this workspace in bytes.
     pub const BYTES: usize = core::mem::size_of::<Self>();
@@ -194,7 +198,7 @@ impl<
         #[allow(clippy::let_unit_value)]
         let () = Self::VALID;
         BandWorkspace {
-            depth: [[Depth::ZERO; W]; B],
+            depth: [[Z::FAR; W]; B],
             pixels: [[background; W]; B],
             spans: [0; B],
             background,
@@ -362,7 +366,7 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanSort<'_, P, S::Payload<P>> {
         let written = sweep::<P, S>(self.spans.as_mut_slice(), y, self.pixels);
         FinishedRow {
             pixels: self.pixels,
-            depth: &[],
+            depth: DepthRow::NONE,
             spans: self.spans.len() as u16,
             written,
         }
@@ -608,7 +612,7 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for Painter<'_, P> {
     fn finish_row(&mut self, _: i32) -> FinishedRow<'_, P> {
         FinishedRow {
             pixels: self.pixels,
-            depth: &[],
+            depth: DepthRow::NONE,
             spans: self.spans,
             written: 0,
         }

@@ -65,6 +65,7 @@
 //! [`WarnockWorkspace::subdivision`]. Nothing is ever dropped: the frame is always complete.
 
 use crate::clip::Clipping;
+use crate::depth::DepthRow;
 use crate::preset::Arithmetic;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{DepthPlane, PlaneSolver, TriangleWalk};
@@ -311,7 +312,7 @@ impl<
             sink.write_row(Row {
                 y: y as u16,
                 pixels: row.get(..width).unwrap_or(&[]),
-                depth: &[],
+                depth: DepthRow::NONE,
                 complete: true,
             })
             .map_err(|error| RenderError::Sink {

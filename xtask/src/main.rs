@@ -431,7 +431,7 @@ impl scanline3d_sim::hsr::Visit for HsrHostRun {
                 for (x, id) in row.pixels.iter().enumerate() {
                     image.ids[start + x] = id.0;
                     image.depth[start + x] = match row.depth.get(x) {
-                        Some(q) => scene.camera.eye_distance(*q).unwrap_or(f32::INFINITY),
+                        Some(q) => scene.camera.eye_distance(q).unwrap_or(f32::INFINITY),
                         None if id.0 >= 0 => f32::NAN,
                         None => f32::INFINITY,
                     };
