@@ -1,14 +1,23 @@
 //! Shading models and the span fill (the per-pixel loop of the span z-buffer).
 //!
 //! A shading model is a type, chosen at compile time: [`Flat`] (Lambert + ambient per face, one
-//! precomputed pixel per triangle) or [`Gouraud`] (lit per vertex, colour interpolated linearly
-//! in screen space). Depth is always perspective-correct: the span loop steps `q = near/w`,
-//! which is linear in screen space.
+//! precomputed pixel per triangle) or [`Gouraud`] (lit per vertex, colour interpolated across
+//! the triangle). Depth is always perspective-correct: the span loop steps `q = near/w`, which
+//! is linear in screen space.
+//!
+//! How Gouraud colour is interpolated is its type parameter, an [`Interpolation`]:
+//!
+//! | interpolation | per pixel | per segment of `N` pixels | error |
+//! |---|---|---|---|
+//! | [`Affine`] (default) | 3 adds | — | grows with how steeply the triangle recedes |
+//! | [`PerSegment<N>`] | 3 adds | 3 divisions (one evaluation of [`PerspectivePlanes`]) | affine within each segment of `N` pixels |
+//! | [`PerPixel`] | 4 adds, 3 divisions where a pixel is written | — | rounding only |
 
 use crate::depth::DepthFormat;
 use crate::project::ScreenVertex;
-use crate::raster::{channel, ColorPlanes, PixelOrigin, PlaneSolver};
+use crate::raster::{channel, ColorPlanes, PerspectivePlanes, PixelOrigin, PlaneSolver};
 use crate::sink::RowPixel;
+use core::marker::PhantomData;
 use embedded_graphics::pixelcolor::Rgb888;
 
 mod sealed {
@@ -70,15 +79,208 @@ pub trait Shading: sealed::Sealed + Copy + Default {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Flat;
 
-/// Gouraud shading: Lambert + ambient per vertex, colour interpolated across the triangle.
+/// Gouraud shading: Lambert + ambient per vertex, colour interpolated across the triangle as
+/// `I` says ([`Affine`] by default).
 ///
 /// Vertex normals come from the mesh; a mesh without normals uses its face normal at each
 /// vertex (so lighting is flat, but per-vertex colours still blend).
+///
+/// ```
+/// use scanline3d::shading::{Gouraud, PerSegment};
+/// // Perspective-correct every 16 pixels, affine between.
+/// type Shade = Gouraud<PerSegment<16>>;
+/// # let _ = Shade::default();
+/// ```
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Gouraud;
+pub struct Gouraud<I: Interpolation = Affine>(PhantomData<I>);
+
+/// How [`Gouraud`] colour is interpolated. Implemented by [`Affine`], [`PerSegment`] and
+/// [`PerPixel`] only.
+pub trait Interpolation: sealed::Sealed + Copy + Default + core::fmt::Debug + 'static {
+    /// Per-triangle planes.
+    type Planes: Copy + core::fmt::Debug;
+    /// Position within one span.
+    type Cursor;
+    /// The planes of triangle `v`.
+    fn planes<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> Self::Planes;
+    /// A cursor at the first of the `len` pixels starting at column `x0` of row `y`.
+    fn cursor(
+        planes: &Self::Planes,
+        origin: &PixelOrigin,
+        x0: i32,
+        y: i32,
+        len: usize,
+    ) -> Self::Cursor;
+    /// The colour at the cursor.
+    fn colour(cursor: &Self::Cursor) -> Rgb888;
+    /// Moves the cursor one pixel right.
+    fn advance(cursor: &mut Self::Cursor);
+}
+
+/// Colour linear in screen space: cheapest, and wrong by as much as the triangle's depth varies
+/// (the colour of a receding triangle drifts towards its far vertices).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Affine;
+
+/// Perspective-correct colour at every `N`-th pixel of a span (and its last), affine between
+/// (`N ≥ 2`; a power of two makes the per-segment step a shift).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PerSegment<const N: u32>;
+
+/// Perspective-correct colour at every pixel written.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PerPixel;
+
+impl sealed::Sealed for Affine {}
+impl<const N: u32> sealed::Sealed for PerSegment<N> {}
+impl sealed::Sealed for PerPixel {}
+
+/// I16F16 channels as a colour.
+#[inline]
+fn rgb(c: &[i32; 3]) -> Rgb888 {
+    Rgb888::new(channel(c[0]), channel(c[1]), channel(c[2]))
+}
+
+impl Interpolation for Affine {
+    type Planes = ColorPlanes;
+    /// Channels (I16F16) and their per-pixel steps.
+    type Cursor = ([i32; 3], [i32; 3]);
+    #[inline]
+    fn planes<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> ColorPlanes {
+        ColorPlanes::new(solver, v)
+    }
+    #[inline]
+    fn cursor(p: &ColorPlanes, origin: &PixelOrigin, x0: i32, y: i32, _: usize) -> Self::Cursor {
+        p.span_start(origin, x0, y)
+    }
+    #[inline]
+    fn colour((c, _): &Self::Cursor) -> Rgb888 {
+        rgb(c)
+    }
+    #[inline]
+    fn advance((c, dc): &mut Self::Cursor) {
+        for k in 0..3 {
+            c[k] = c[k].wrapping_add(dc[k]);
+        }
+    }
+}
+
+impl Interpolation for PerPixel {
+    type Planes = PerspectivePlanes;
+    /// `[c·r, r]` values and their per-pixel steps.
+    type Cursor = ([i32; 4], [i32; 4]);
+    #[inline]
+    fn planes<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> Self::Planes {
+        PerspectivePlanes::new(solver, v)
+    }
+    #[inline]
+    fn cursor(p: &Self::Planes, origin: &PixelOrigin, x0: i32, y: i32, _: usize) -> Self::Cursor {
+        p.span_start(origin, x0, y)
+    }
+    #[inline]
+    fn colour((v, _): &Self::Cursor) -> Rgb888 {
+        rgb(&PerspectivePlanes::colour(v))
+    }
+    #[inline]
+    fn advance((v, dv): &mut Self::Cursor) {
+        for k in 0..4 {
+            v[k] = v[k].wrapping_add(dv[k]);
+        }
+    }
+}
+
+/// Where a [`PerSegment`] interpolation is within a span.
+#[derive(Clone, Copy, Debug)]
+pub struct SegmentCursor {
+    /// `[c·r, r]` at the current segment's end pixel, and per-pixel steps.
+    at: [i32; 4],
+    dv: [i32; 4],
+    /// Channels (I16F16) at the cursor, their step, and their exact values at the segment end.
+    c: [i32; 3],
+    dc: [i32; 3],
+    end: [i32; 3],
+    /// Pixels from the cursor to the segment end; pixels of the span after the segment end.
+    left: u32,
+    rest: u32,
+}
+
+impl SegmentCursor {
+    /// Starts the segment at the cursor (whose channels are exact): at most `n` pixels long, to
+    /// the span's last pixel at the farthest.
+    #[inline]
+    fn next_segment(&mut self, n: u32) {
+        let len = n.min(self.rest);
+        if len == 0 {
+            // The span's last pixel: nothing beyond it to interpolate towards.
+            self.dc = [0; 3];
+            self.left = u32::MAX;
+            return;
+        }
+        for k in 0..4 {
+            let jump = if len == n {
+                self.dv[k].wrapping_mul(n as i32)
+            } else {
+                self.dv[k].wrapping_mul(len as i32)
+            };
+            self.at[k] = self.at[k].wrapping_add(jump);
+        }
+        self.end = PerspectivePlanes::colour(&self.at);
+        for k in 0..3 {
+            let d = self.end[k].wrapping_sub(self.c[k]);
+            self.dc[k] = if len == n {
+                d / n as i32
+            } else {
+                d / len as i32
+            };
+        }
+        self.left = len;
+        self.rest -= len;
+    }
+}
+
+impl<const N: u32> Interpolation for PerSegment<N> {
+    type Planes = PerspectivePlanes;
+    type Cursor = SegmentCursor;
+    #[inline]
+    fn planes<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> Self::Planes {
+        PerspectivePlanes::new(solver, v)
+    }
+    #[inline]
+    fn cursor(p: &Self::Planes, origin: &PixelOrigin, x0: i32, y: i32, len: usize) -> Self::Cursor {
+        const { assert!(N >= 2 && N <= 1 << 16, "a segment is 2 to 65536 pixels") };
+        let (at, dv) = p.span_start(origin, x0, y);
+        let mut cursor = SegmentCursor {
+            at,
+            dv,
+            c: PerspectivePlanes::colour(&at),
+            dc: [0; 3],
+            end: [0; 3],
+            left: 0,
+            rest: (len as u32).saturating_sub(1),
+        };
+        cursor.next_segment(N);
+        cursor
+    }
+    #[inline]
+    fn colour(cursor: &SegmentCursor) -> Rgb888 {
+        rgb(&cursor.c)
+    }
+    #[inline]
+    fn advance(cursor: &mut SegmentCursor) {
+        cursor.left = cursor.left.wrapping_sub(1);
+        if cursor.left == 0 {
+            cursor.c = cursor.end;
+            cursor.next_segment(N);
+        } else {
+            for k in 0..3 {
+                cursor.c[k] = cursor.c[k].wrapping_add(cursor.dc[k]);
+            }
+        }
+    }
+}
 
 impl sealed::Sealed for Flat {}
-impl sealed::Sealed for Gouraud {}
+impl<I: Interpolation> sealed::Sealed for Gouraud<I> {}
 
 impl Shading for Flat {
     type Payload<P: Copy> = P;
@@ -125,13 +327,13 @@ impl Shading for Flat {
 
 /// Per-triangle data for [`Gouraud`].
 #[derive(Clone, Copy, Debug)]
-pub struct GouraudPayload {
-    planes: ColorPlanes,
+pub struct GouraudPayload<T> {
+    planes: T,
     id: u32,
 }
 
-impl Shading for Gouraud {
-    type Payload<P: Copy> = GouraudPayload;
+impl<I: Interpolation> Shading for Gouraud<I> {
+    type Payload<P: Copy> = GouraudPayload<I::Planes>;
     const PER_VERTEX: bool = true;
 
     fn payload<P: RowPixel, const S: u32>(
@@ -139,54 +341,153 @@ impl Shading for Gouraud {
         id: u32,
         solver: &PlaneSolver,
         v: &[ScreenVertex<S>; 3],
-    ) -> GouraudPayload {
+    ) -> Self::Payload<P> {
         GouraudPayload {
-            planes: ColorPlanes::new(solver, v),
+            planes: I::planes(solver, v),
             id,
         }
     }
 
     #[inline]
     fn fill<P: RowPixel, Z: DepthFormat>(
-        payload: &GouraudPayload,
+        payload: &Self::Payload<P>,
         origin: &PixelOrigin,
         span: SpanDepth,
         depth: &mut [Z],
         pixels: &mut [P],
     ) -> u32 {
-        let (mut c, dc) = payload.planes.span_start(origin, span.x0, span.y);
+        let mut c = I::cursor(&payload.planes, origin, span.x0, span.y, depth.len());
         let mut q = span.q;
         let mut written = 0;
         for (z, p) in depth.iter_mut().zip(pixels.iter_mut()) {
             let stored = Z::store(q);
             if stored > *z {
                 *z = stored;
-                let rgb = Rgb888::new(channel(c[0]), channel(c[1]), channel(c[2]));
-                *p = P::from_shade(rgb, payload.id);
+                *p = P::from_shade(I::colour(&c), payload.id);
                 written += 1;
             }
             q = q.wrapping_add(span.dq);
-            for k in 0..3 {
-                c[k] = c[k].wrapping_add(dc[k]);
-            }
+            I::advance(&mut c);
         }
         written
     }
 
     #[inline]
     fn paint<P: RowPixel>(
-        payload: &GouraudPayload,
+        payload: &Self::Payload<P>,
         origin: &PixelOrigin,
         x0: i32,
         y: i32,
         pixels: &mut [P],
     ) {
-        let (mut c, dc) = payload.planes.span_start(origin, x0, y);
+        let mut c = I::cursor(&payload.planes, origin, x0, y, pixels.len());
         for p in pixels.iter_mut() {
-            let rgb = Rgb888::new(channel(c[0]), channel(c[1]), channel(c[2]));
-            *p = P::from_shade(rgb, payload.id);
-            for k in 0..3 {
-                c[k] = c[k].wrapping_add(dc[k]);
+            *p = P::from_shade(I::colour(&c), payload.id);
+            I::advance(&mut c);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::project::{Depth, SubPx};
+    use fixed::types::I16F16;
+    use std::vec::Vec;
+
+    /// A triangle receding steeply to the right: vertex depths `q` 1.0 on the left and 0.05 on
+    /// the right (20× farther), red left, blue right. Screen positions in pixels at 4 sub-bits.
+    fn receding() -> [ScreenVertex<4>; 3] {
+        let v = |x: i32, y: i32, q: f64, c: [u8; 3]| ScreenVertex::<4> {
+            x: SubPx(x << 4),
+            y: SubPx(y << 4),
+            q: Depth::from_num(q),
+            color: c.map(I16F16::from_num),
+        };
+        [
+            v(0, 0, 1.0, [255, 0, 0]),
+            v(0, 64, 1.0, [255, 0, 0]),
+            v(200, 32, 0.05, [0, 0, 255]),
+        ]
+    }
+
+    /// The perspective-correct red channel at pixel centre `(c, r)`: screen barycentrics
+    /// weighted by `q` (Heckbert and Moreton).
+    fn exact_red(v: &[ScreenVertex<4>; 3], c: i32, r: i32) -> f64 {
+        let p = |s: &ScreenVertex<4>| (s.x.0 as f64 / 16.0, s.y.0 as f64 / 16.0);
+        let (a, b, d) = (p(&v[0]), p(&v[1]), p(&v[2]));
+        let (x, y) = (c as f64 + 0.5, r as f64 + 0.5);
+        let area = (b.0 - a.0) * (d.1 - a.1) - (d.0 - a.0) * (b.1 - a.1);
+        let w1 = ((x - a.0) * (d.1 - a.1) - (d.0 - a.0) * (y - a.1)) / area;
+        let w2 = ((b.0 - a.0) * (y - a.1) - (x - a.0) * (b.1 - a.1)) / area;
+        let bary = [1.0 - w1 - w2, w1, w2];
+        let q: Vec<f64> = v.iter().map(|s| s.q.to_num::<f64>()).collect();
+        let red: Vec<f64> = v.iter().map(|s| s.color[0].to_num::<f64>()).collect();
+        let num: f64 = (0..3).map(|k| bary[k] * q[k] * red[k]).sum();
+        let den: f64 = (0..3).map(|k| bary[k] * q[k]).sum();
+        num / den
+    }
+
+    /// Red channel of row 32, columns 0..180, filled with Gouraud<I>; and its worst error
+    /// against the perspective-correct value.
+    fn worst_red_error<I: Interpolation>() -> f64 {
+        let v = receding();
+        let solver = PlaneSolver::new(&v).unwrap();
+        let payload = Gouraud::<I>::payload::<Rgb888, 4>(Rgb888::new(0, 0, 0), 0, &solver, &v);
+        let mut depth = [Depth::ZERO; 180];
+        let mut pixels = [Rgb888::new(0, 0, 0); 180];
+        let span = SpanDepth {
+            x0: 0,
+            y: 32,
+            q: 1,
+            dq: 0,
+        };
+        let written = Gouraud::<I>::fill(&payload, &solver.origin(), span, &mut depth, &mut pixels);
+        assert_eq!(written, 180);
+        let mut painted = [Rgb888::new(0, 0, 0); 180];
+        Gouraud::<I>::paint(&payload, &solver.origin(), 0, 32, &mut painted);
+        assert_eq!(pixels, painted, "fill and paint interpolate alike");
+        use embedded_graphics::pixelcolor::RgbColor;
+        (0..180)
+            .map(|c| (pixels[c].r() as f64 - exact_red(&v, c as i32, 32)).abs())
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn perspective_correct_interpolation_follows_depth_and_affine_does_not() {
+        let affine = worst_red_error::<Affine>();
+        let per_pixel = worst_red_error::<PerPixel>();
+        let per_8 = worst_red_error::<PerSegment<8>>();
+        let per_32 = worst_red_error::<PerSegment<32>>();
+        std::println!("worst red error: affine {affine}, per pixel {per_pixel}, segments of 8 {per_8}, of 32 {per_32}");
+        // Per pixel: the 8-bit channel's truncation and plane rounding only.
+        assert!(per_pixel <= 1.5, "per pixel {per_pixel}");
+        // Segments: exact at their ends, affine between, so error grows with their length.
+        assert!(per_pixel <= per_8 && per_8 <= per_32 && per_32 < affine);
+        assert!(per_8 < 6.0, "segments of 8: {per_8}");
+        // Affine is off by most of the channel's range where the triangle recedes.
+        assert!(affine > 100.0, "affine {affine}");
+    }
+
+    #[test]
+    fn segments_end_on_the_spans_last_pixel() {
+        // Spans of every length up to 40 pixels: segment arithmetic never steps past the end
+        // (the last pixel is exact) and fill and paint agree.
+        let v = receding();
+        let solver = PlaneSolver::new(&v).unwrap();
+        let payload =
+            Gouraud::<PerSegment<16>>::payload::<Rgb888, 4>(Rgb888::new(0, 0, 0), 0, &solver, &v);
+        let exact = Gouraud::<PerPixel>::payload::<Rgb888, 4>(Rgb888::new(0, 0, 0), 0, &solver, &v);
+        for len in 1..=40usize {
+            let mut seg = [Rgb888::new(0, 0, 0); 40];
+            let mut one = [Rgb888::new(0, 0, 0); 40];
+            let o = solver.origin();
+            Gouraud::<PerSegment<16>>::paint(&payload, &o, 10, 30, &mut seg[..len]);
+            Gouraud::<PerPixel>::paint(&exact, &o, 10, 30, &mut one[..len]);
+            assert_eq!(seg[0], one[0], "first pixel exact, length {len}");
+            assert_eq!(seg[len - 1], one[len - 1], "last pixel exact, length {len}");
+            if len > 16 {
+                assert_eq!(seg[16], one[16], "segment boundary exact, length {len}");
             }
         }
     }
