@@ -22,13 +22,22 @@ fn main() {
 
 #[cfg(target_os = "none")]
 mod firmware {
+    use embedded_graphics::pixelcolor::Rgb565;
     use scanline3d::demo::{self, PanelWorkspace};
+    use scanline3d::depth::Depth16;
     use scanline3d::preset::{Fast, Preset};
+    use scanline3d::shading::{Gouraud, PerPixel, PerSegment};
+    use scanline3d::{Depth, RenderOptions, Workspace};
+
+    /// The demo's capacities with another shading and depth format.
+    type Ws<Sh, Z> = Workspace<Rgb565, Sh, 240, 240, 640, 80, 3, Z>;
 
     #[cfg_attr(target_arch = "arm", cortex_m_rt::entry)]
     #[cfg_attr(target_arch = "riscv32", riscv_rt::entry)]
     fn main() -> ! {
         let mut ws = PanelWorkspace::new(demo::BACKGROUND.into());
+        let mut segments = Ws::<Gouraud<PerSegment<16>>, Depth16>::new(Rgb565::new(0, 0, 0));
+        let mut per_pixel = Ws::<Gouraud<PerPixel>, Depth>::new(Rgb565::new(0, 0, 0));
         let instances = demo::instances();
         let mut frame = 0;
         loop {
@@ -39,6 +48,11 @@ mod firmware {
                 let mut sink = scanline3d::sink::HashSink::new();
                 let quick = ws.render(&scene, &Fast::options(), &mut sink);
                 core::hint::black_box((&quick, sink.hash()));
+                // Perspective-correct Gouraud, per segment with 16-bit depth and per pixel.
+                let options = RenderOptions::default();
+                let a = segments.render(&scene, &options, &mut sink);
+                let b = per_pixel.render(&scene, &options, &mut sink);
+                core::hint::black_box((&a, &b, sink.hash()));
             }
             frame = frame.wrapping_add(1);
         }

@@ -21,12 +21,13 @@ use scanline3d::depth::{Depth16, DepthFormat};
 use scanline3d::math::MathBackend;
 use scanline3d::preset::{self, Arithmetic, Preset};
 use scanline3d::scene::{Camera, Scene, SceneError};
+use scanline3d::shading::{Affine, Gouraud, Interpolation, PerPixel, PerSegment};
 use scanline3d::sink::HashSink;
-use scanline3d::{demo, Depth, Flat, RenderOptions, Workspace};
+use scanline3d::{demo, Depth, Flat, RenderOptions, Shading, Workspace};
 
 /// The demo's panel workspace with room to spare: the approximate set-up of some variants moves
 /// the camera slightly, so the exact capacities `sim analyze --demo` measured may not cover it.
-type Ws<Z> = Workspace<Rgb565, Flat, 240, 240, 640, 80, 3, Z>;
+type Ws<Sh, Z> = Workspace<Rgb565, Sh, 240, 240, 640, 80, 3, Z>;
 
 /// A new workspace: boxed on the host (a debug build would need a large main stack), on the
 /// stack on targets (no allocator; the variant's frame holds it while it renders).
@@ -50,6 +51,7 @@ struct Frame {
 
 /// Renders one frame of `scene` into the panel model, counting its instructions.
 fn frame<
+    Sh: Shading,
     const S: u32,
     A: Arithmetic,
     const T: usize,
@@ -57,7 +59,7 @@ fn frame<
     const I: usize,
     Z: DepthFormat,
 >(
-    ws: &mut Workspace<Rgb565, Flat, 240, 240, T, ACT, I, Z>,
+    ws: &mut Workspace<Rgb565, Sh, 240, 240, T, ACT, I, Z>,
     scene: &Scene<'_>,
     options: &RenderOptions<S, FrustumClip, A>,
     count: &impl Fn() -> Counter,
@@ -83,8 +85,9 @@ fn camera<M: MathBackend>(
 
 /// What to render with each variant.
 trait Renders {
-    /// Renders with variant `name`: `options`, the camera computed with `M`, depth format `Z`.
-    fn variant<const S: u32, A: Arithmetic, M: MathBackend, Z: DepthFormat>(
+    /// Renders with variant `name`: `options`, the camera computed with `M`, depth format `Z`,
+    /// shading `Sh`.
+    fn variant<Sh: Shading, const S: u32, A: Arithmetic, M: MathBackend, Z: DepthFormat>(
         &mut self,
         name: &'static str,
         options: RenderOptions<S, FrustumClip, A>,
@@ -98,12 +101,12 @@ struct Orbit<'a, C, R> {
 }
 
 impl<C: Fn() -> Counter, R: FnMut(&str, u32, Frame)> Renders for Orbit<'_, C, R> {
-    fn variant<const S: u32, A: Arithmetic, M: MathBackend, Z: DepthFormat>(
+    fn variant<Sh: Shading, const S: u32, A: Arithmetic, M: MathBackend, Z: DepthFormat>(
         &mut self,
         name: &'static str,
         options: RenderOptions<S, FrustumClip, A>,
     ) -> Result<(), &'static str> {
-        let mut ws = fresh(|| Ws::<Z>::new(Rgb565::new(0, 0, 0)));
+        let mut ws = fresh(|| Ws::<Sh, Z>::new(Rgb565::new(0, 0, 0)));
         let instances = demo::instances();
         for f in 0..demo::ORBIT_FRAMES {
             let (eye, target, up, fovy, near, far) = demo::camera_parameters(f, demo::ORBIT_FRAMES);
@@ -140,6 +143,14 @@ const BUILD_VARIANT: &str = if cfg!(scanline3d_variant = "fast") {
     "narrow-normals"
 } else if cfg!(scanline3d_variant = "depth16") {
     "depth16"
+} else if cfg!(scanline3d_variant = "gouraudaffine") {
+    "gouraud-affine"
+} else if cfg!(scanline3d_variant = "gouraudsegments16") {
+    "gouraud-segments16"
+} else if cfg!(scanline3d_variant = "gouraudsegments8") {
+    "gouraud-segments8"
+} else if cfg!(scanline3d_variant = "gouraudperpixel") {
+    "gouraud-per-pixel"
 } else {
     "balanced"
 };
@@ -174,41 +185,57 @@ fn variants(r: &mut impl Renders) -> Result<(), &'static str> {
     type Arith<P> = <P as Preset>::Arithmetic;
     let default = RenderOptions::default();
     if renders(Fast::NAME) {
-        r.variant::<2, Arith<Fast>, Math<Fast>, Depth>(Fast::NAME, Fast::options())?;
+        r.variant::<Flat, 2, Arith<Fast>, Math<Fast>, Depth>(Fast::NAME, Fast::options())?;
     }
     if renders(Balanced::NAME) {
-        r.variant::<4, Arith<Balanced>, Math<Balanced>, Depth>(
+        r.variant::<Flat, 4, Arith<Balanced>, Math<Balanced>, Depth>(
             Balanced::NAME,
             Balanced::options(),
         )?;
     }
     if renders(Exact::NAME) {
-        r.variant::<8, Arith<Exact>, Math<Exact>, Depth>(Exact::NAME, Exact::options())?;
+        r.variant::<Flat, 8, Arith<Exact>, Math<Exact>, Depth>(Exact::NAME, Exact::options())?;
     }
     if renders("default") {
-        r.variant::<4, _, Libm, Depth>("default", default)?;
+        r.variant::<Flat, 4, _, Libm, Depth>("default", default)?;
     }
     if renders("bits:0") {
         let bits0 = default.with_sub_pixel_bits::<0>();
-        r.variant::<0, _, Libm, Depth>("bits:0", bits0)?;
+        r.variant::<Flat, 0, _, Libm, Depth>("bits:0", bits0)?;
     }
     if renders("micromath") {
-        r.variant::<4, _, Micromath, Depth>("micromath", default)?;
+        r.variant::<Flat, 4, _, Micromath, Depth>("micromath", default)?;
     }
     if renders("narrow-transform") {
         let a = Setup::<NarrowTransform, ExactDivision, WideNormals>::default();
-        r.variant::<4, _, Libm, Depth>("narrow-transform", default.with_arithmetic(a))?;
+        r.variant::<Flat, 4, _, Libm, Depth>("narrow-transform", default.with_arithmetic(a))?;
     }
     if renders("reciprocal") {
         let a = Setup::<WideTransform, Reciprocal, WideNormals>::default();
-        r.variant::<4, _, Libm, Depth>("reciprocal", default.with_arithmetic(a))?;
+        r.variant::<Flat, 4, _, Libm, Depth>("reciprocal", default.with_arithmetic(a))?;
     }
     if renders("narrow-normals") {
         let a = Setup::<WideTransform, ExactDivision, NarrowNormals>::default();
-        r.variant::<4, _, Libm, Depth>("narrow-normals", default.with_arithmetic(a))?;
+        r.variant::<Flat, 4, _, Libm, Depth>("narrow-normals", default.with_arithmetic(a))?;
     }
     if renders("depth16") {
-        r.variant::<4, _, Libm, Depth16>("depth16", default)?;
+        r.variant::<Flat, 4, _, Libm, Depth16>("depth16", default)?;
+    }
+    gouraud::<Affine>(r, "gouraud-affine")?;
+    gouraud::<PerSegment<16>>(r, "gouraud-segments16")?;
+    gouraud::<PerSegment<8>>(r, "gouraud-segments8")?;
+    gouraud::<PerPixel>(r, "gouraud-per-pixel")?;
+    Ok(())
+}
+
+/// The default with Gouraud shading interpolated by `I` (the demo only: the corpus carries no
+/// vertex colours on firmware), if this build renders `name`.
+fn gouraud<I: Interpolation>(r: &mut impl Renders, name: &'static str) -> Result<(), &'static str> {
+    if renders(name) {
+        r.variant::<Gouraud<I>, 4, _, scanline3d::math::Libm, Depth>(
+            name,
+            RenderOptions::default(),
+        )?;
     }
     Ok(())
 }
@@ -227,8 +254,8 @@ mod corpus_views {
     }
 
     /// A workspace for the largest corpus scene.
-    type CorpusWs<Z> =
-        Workspace<Rgb565, Flat, 240, 240, { corpus::MAX_TRIANGLES }, { corpus::MAX_ACTIVE }, 1, Z>;
+    type CorpusWs<Sh, Z> =
+        Workspace<Rgb565, Sh, 240, 240, { corpus::MAX_TRIANGLES }, { corpus::MAX_ACTIVE }, 1, Z>;
 
     pub struct Views<'a, C, R> {
         pub count: &'a C,
@@ -236,12 +263,12 @@ mod corpus_views {
     }
 
     impl<C: Fn() -> Counter, R: FnMut(&str, &str, usize, Frame)> Renders for Views<'_, C, R> {
-        fn variant<const S: u32, A: Arithmetic, M: MathBackend, Z: DepthFormat>(
+        fn variant<Sh: Shading, const S: u32, A: Arithmetic, M: MathBackend, Z: DepthFormat>(
             &mut self,
             name: &'static str,
             options: RenderOptions<S, FrustumClip, A>,
         ) -> Result<(), &'static str> {
-            let mut ws = fresh(|| CorpusWs::<Z>::new(Rgb565::new(0, 0, 0)));
+            let mut ws = fresh(|| CorpusWs::<Sh, Z>::new(Rgb565::new(0, 0, 0)));
             for s in &corpus::SCENES {
                 let instances = [Instance {
                     mesh: s.mesh,
@@ -355,9 +382,13 @@ mod firmware {
         }
         // The one variant this image renders: its demo workspace.
         let workspace = if renders("depth16") {
-            Ws::<Depth16>::BYTES
+            Ws::<Flat, Depth16>::BYTES
+        } else if renders("gouraud-affine") {
+            Ws::<Gouraud<Affine>, Depth>::BYTES
+        } else if BUILD_VARIANT.starts_with("gouraud") {
+            Ws::<Gouraud<PerPixel>, Depth>::BYTES
         } else {
-            Ws::<Depth>::BYTES
+            Ws::<Flat, Depth>::BYTES
         };
         println!("summary workspace {}", workspace);
         if complete {

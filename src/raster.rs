@@ -478,16 +478,16 @@ impl ColorPlanes {
 /// their quotient, exact up to rounding however steeply the triangle recedes.
 ///
 /// Bit budget: channels enter as I8F4 (`c·2^4 < 2^12`), `r` as an integer `1..=2^15`, so
-/// `c·r` with 4 more fractional bits in its plane stays below 2^31; the `r` plane carries 8
-/// fractional bits (below 2^24). A quotient divides `c·r·2^8` by `r·2^4` (the `r` plane's low
-/// 4 bits dropped): the channel with 4 fractional bits, relative error below `2^-4 / r`, which
-/// is under 2^-14 unless a triangle spans more than 2^10 in depth ratio.
+/// `c·r` with 4 more fractional bits in its plane stays below 2^31 inside the triangle; the `r`
+/// plane carries 8 fractional bits (below 2^24). Planes are stepped in `i64`: a sliver's
+/// gradient may be far larger than the values themselves. A quotient divides `c·r·2^8` by
+/// `r·2^4` (the `r` plane's low 4 bits dropped) in 32 bits: the channel with 4 fractional bits,
+/// relative error below `2^-4 / r`, under 2^-14 unless a triangle spans a depth ratio beyond
+/// 2^10.
 #[derive(Clone, Copy, Debug)]
 pub struct PerspectivePlanes {
-    /// `[c₀·r, c₁·r, c₂·r, r]` at the reference pixel and per-pixel steps.
-    value: [i32; 4],
-    dx: [i32; 4],
-    dy: [i32; 4],
+    /// `[c₀·r, c₁·r, c₂·r, r]`.
+    planes: [Plane; 4],
 }
 
 /// Bits of the vertex weight `r = q / q_max`.
@@ -499,51 +499,37 @@ impl PerspectivePlanes {
         let q = v.each_ref().map(|s| s.q.to_bits().max(0) as i64);
         let q_max = q[0].max(q[1]).max(q[2]).max(1);
         let r = q.map(|q| ((q << WEIGHT_BITS) / q_max).max(1));
-        let mut out = PerspectivePlanes {
-            value: [0; 4],
-            dx: [0; 4],
-            dy: [0; 4],
+        let weighted = |k: usize| {
+            core::array::from_fn(|j| {
+                let c = (v[j].color[k].to_bits() >> 12).clamp(0, 255 << 4) as i64;
+                c * r[j]
+            })
         };
-        let sat = |x: i64| x.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
-        for k in 0..4 {
-            let f = if k < 3 {
-                core::array::from_fn(|j| {
-                    let c = (v[j].color[k].to_bits() >> 12).clamp(0, 255 << 4) as i64;
-                    c * r[j]
-                })
-            } else {
-                r
-            };
-            let p = solver.plane(f, if k < 3 { 4 } else { 8 });
-            // As for `ColorPlanes`: a gradient beyond i32 belongs to a triangle too thin to
-            // hold two centres in a row.
-            out.value[k] = sat(p.value);
-            out.dx[k] = sat(p.dx);
-            out.dy[k] = sat(p.dy);
+        PerspectivePlanes {
+            planes: [
+                solver.plane(weighted(0), 4),
+                solver.plane(weighted(1), 4),
+                solver.plane(weighted(2), 4),
+                solver.plane(r, 8),
+            ],
         }
-        out
     }
 
     /// `[c₀·r, c₁·r, c₂·r, r]` at pixel centre `(c, r)` and their per-pixel steps.
     #[inline]
-    pub fn span_start(&self, origin: &PixelOrigin, c: i32, r: i32) -> ([i32; 4], [i32; 4]) {
-        let v = core::array::from_fn(|k| {
-            let p = Plane {
-                value: self.value[k] as i64,
-                dx: self.dx[k] as i64,
-                dy: self.dy[k] as i64,
-            };
-            origin.at(&p, c, r) as i32
-        });
-        (v, self.dx)
+    pub fn span_start(&self, origin: &PixelOrigin, c: i32, r: i32) -> ([i64; 4], [i64; 4]) {
+        (
+            self.planes.each_ref().map(|p| origin.at(p, c, r)),
+            self.planes.each_ref().map(|p| p.dx),
+        )
     }
 
     /// The channels (I16F16 bits, clamped to 0..=255) of stepped values `v`.
     #[inline]
-    pub fn colour(v: &[i32; 4]) -> [i32; 3] {
-        let den = ((v[3] >> 4).max(1)) as u32;
+    pub fn colour(v: &[i64; 4]) -> [i32; 3] {
+        let den = (v[3] >> 4).clamp(1, u32::MAX as i64) as u32;
         core::array::from_fn(|k| {
-            let c = v[k].max(0) as u32 / den;
+            let c = v[k].clamp(0, u32::MAX as i64) as u32 / den;
             (c.min(255 << 4) as i32) << 12
         })
     }

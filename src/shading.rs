@@ -168,7 +168,7 @@ impl Interpolation for Affine {
 impl Interpolation for PerPixel {
     type Planes = PerspectivePlanes;
     /// `[c·r, r]` values and their per-pixel steps.
-    type Cursor = ([i32; 4], [i32; 4]);
+    type Cursor = ([i64; 4], [i64; 4]);
     #[inline]
     fn planes<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> Self::Planes {
         PerspectivePlanes::new(solver, v)
@@ -193,8 +193,8 @@ impl Interpolation for PerPixel {
 #[derive(Clone, Copy, Debug)]
 pub struct SegmentCursor {
     /// `[c·r, r]` at the current segment's end pixel, and per-pixel steps.
-    at: [i32; 4],
-    dv: [i32; 4],
+    at: [i64; 4],
+    dv: [i64; 4],
     /// Channels (I16F16) at the cursor, their step, and their exact values at the segment end.
     c: [i32; 3],
     dc: [i32; 3],
@@ -218,9 +218,9 @@ impl SegmentCursor {
         }
         for k in 0..4 {
             let jump = if len == n {
-                self.dv[k].wrapping_mul(n as i32)
+                self.dv[k].wrapping_mul(n as i64)
             } else {
-                self.dv[k].wrapping_mul(len as i32)
+                self.dv[k].wrapping_mul(len as i64)
             };
             self.at[k] = self.at[k].wrapping_add(jump);
         }

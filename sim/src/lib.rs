@@ -18,6 +18,8 @@ pub mod fuzz;
 #[cfg(not(target_os = "none"))]
 pub mod hsr;
 #[cfg(not(target_os = "none"))]
+pub mod interpolation;
+#[cfg(not(target_os = "none"))]
 pub mod meshgen;
 #[cfg(not(target_os = "none"))]
 pub mod metrics;

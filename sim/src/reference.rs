@@ -310,6 +310,9 @@ pub struct Scene {
     pub camera: Camera,
     /// Skip triangles whose back faces the ray.
     pub cull_back_faces: bool,
+    /// Per triangle, the base colours of its three vertices (Gouraud); empty: flat, each
+    /// triangle's `color`.
+    pub vertex_colors: Vec<[[f64; 3]; 3]>,
     bvh: Bvh,
 }
 
@@ -344,8 +347,28 @@ impl Scene {
             light,
             camera,
             cull_back_faces,
+            vertex_colors: Vec::new(),
             bvh,
         }
+    }
+
+    /// The same scene Gouraud-shaded: triangle `i`'s colour at a point is its vertex colours
+    /// `colors[i]` blended by the point's barycentric coordinates on the triangle in space, then
+    /// lit with the face normal. Blending in space is what perspective-correct interpolation
+    /// approximates on screen; since the light is the same at the three vertices, this equals
+    /// blending the lit vertex colours.
+    pub fn with_vertex_colors(self, colors: Vec<[[f64; 3]; 3]>) -> Result<Scene, String> {
+        if colors.len() != self.triangles.len() {
+            return Err(format!(
+                "{} vertex colour triples for {} triangles",
+                colors.len(),
+                self.triangles.len()
+            ));
+        }
+        Ok(Scene {
+            vertex_colors: colors,
+            ..self
+        })
     }
 
     fn shade(&self, base: [f64; 3], normal: V3) -> [u8; 3] {
@@ -553,8 +576,21 @@ impl Scene {
         let ns = self.spheres.len() as i32;
         if id < nt {
             let t = &self.triangles[id as usize];
-            let n = normalize(cross(sub(t.v[1], t.v[0]), sub(t.v[2], t.v[0]))).unwrap_or([0.0; 3]);
-            (t.color, n)
+            let m = cross(sub(t.v[1], t.v[0]), sub(t.v[2], t.v[0]));
+            let n = normalize(m).unwrap_or([0.0; 3]);
+            let color = match self.vertex_colors.get(id as usize) {
+                Some(c) => {
+                    // Barycentric coordinates from the sub-triangles' areas along the normal.
+                    let area = dot(m, m);
+                    let b = [1, 2, 0].map(|k| {
+                        let (a, b) = (t.v[k], t.v[(k + 1) % 3]);
+                        dot(cross(sub(a, point), sub(b, point)), m) / area
+                    });
+                    [0, 1, 2].map(|ch| (0..3).map(|k| b[k] * c[k][ch]).sum())
+                }
+                None => t.color,
+            };
+            (color, n)
         } else if id < nt + ns {
             let s = &self.spheres[(id - nt) as usize];
             (s.color, normalize(sub(point, s.centre)).unwrap_or([0.0; 3]))

@@ -424,6 +424,21 @@ impl SceneSpec {
         Ok(f(&scene))
     }
 
+    /// Calls `f` with `instances` (this scene's meshes with other colours, say) under this
+    /// scene's camera and light, as the library sees them.
+    pub fn with_library_scene<R>(
+        &self,
+        instances: &[Instance<'_>],
+        f: impl FnOnce(&Scene<'_>) -> R,
+    ) -> Result<R, String> {
+        let scene = Scene {
+            instances,
+            camera: self.camera.fixed()?,
+            light: self.light.fixed()?,
+        };
+        Ok(f(&scene))
+    }
+
     /// Largest |model coordinate| over all meshes.
     pub fn max_model_coord(&self) -> f64 {
         self.instances
