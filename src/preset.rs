@@ -1,15 +1,18 @@
 //! Named precision presets: each choice that trades accuracy for speed or size, bundled and
 //! fixed at compile time so a build pays only for the one it uses.
 //!
-//! | preset | sub-pixel bits | set-up arithmetic | set-up math |
-//! |---|---|---|---|
-//! | [`Fast`] | 2 | [`Quick`]: narrow transform, reciprocal projection, 15-bit normals | [`Libm`] |
-//! | [`Balanced`] | 4 | [`Frugal`]: wide transform, reciprocal projection, 15-bit normals | [`Libm`] |
-//! | [`Exact`] | 8 | [`Precise`]: wide transform, exact division, 30-bit normals | [`Libm`] |
+//! | preset | sub-pixel bits | set-up arithmetic | set-up math | Gouraud interpolation |
+//! |---|---|---|---|---|
+//! | [`Fast`] | 2 | [`Quick`]: narrow transform, reciprocal projection, 15-bit normals | [`Libm`] | [`Affine`] |
+//! | [`Balanced`] | 4 | [`Frugal`]: wide transform, reciprocal projection, 15-bit normals | [`Libm`] | [`PerSegment<16>`](PerSegment) |
+//! | [`Exact`] | 8 | [`Precise`]: wide transform, exact division, 30-bit normals | [`Libm`] | [`PerPixel`] |
 //!
 //! Sub-pixel bits set how finely vertices snap (`2^-S` pixel); the set-up [`Arithmetic`] how
 //! vertices are transformed, projected and lit; the math backend how per-frame camera and model
-//! matrices are computed. Everything per pixel is exact integer arithmetic in every preset.
+//! matrices are computed; the interpolation how [`Gouraud`](crate::Gouraud) colour follows
+//! perspective (`Gouraud<<Exact as Preset>::Interpolation>`). Edge walking and depth are exact
+//! integer arithmetic in every preset. The depth format ([`crate::depth`]) is in no preset: the
+//! 16-bit one saves RAM (2 bytes per column of the span z-buffer), not time.
 //! [`RenderOptions::default`] (4 sub-pixel bits, [`Precise`] arithmetic) is not a preset: it is
 //! the exactly rounded reference the conformance tests and tools are built on, and what a
 //! build gets without choosing.
@@ -40,6 +43,7 @@ use crate::math::{Libm, MathBackend, NarrowNormals, NormalPrecision, WideNormals
 use crate::project::{ExactDivision, ProjectionPrecision, Reciprocal};
 use crate::render::RenderOptions;
 use crate::scene::{Camera, SceneError};
+use crate::shading::{Affine, Interpolation, PerPixel, PerSegment};
 use crate::vertex::{NarrowTransform, TransformPrecision, WideTransform};
 use core::marker::PhantomData;
 
@@ -99,6 +103,8 @@ pub trait Preset {
     type Math: MathBackend;
     /// Integer arithmetic of the per-vertex and per-triangle set-up.
     type Arithmetic: Arithmetic;
+    /// How [`Gouraud`](crate::Gouraud) shading interpolates colour.
+    type Interpolation: Interpolation;
 
     /// The preset's render options (back-face culling on, as [`RenderOptions::default`]).
     fn options() -> Self::Options;
@@ -120,16 +126,18 @@ pub trait Preset {
     }
 }
 
-/// Coarse and cheap: 2 sub-pixel bits, [`Quick`] arithmetic, [`Libm`] set-up.
+/// Coarse and cheap: 2 sub-pixel bits, [`Quick`] arithmetic, [`Libm`] set-up, [`Affine`]
+/// Gouraud colour.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Fast;
 
 /// Middle: 4 sub-pixel bits (as [`RenderOptions::default`]), [`Frugal`] arithmetic, [`Libm`]
-/// set-up.
+/// set-up, Gouraud colour perspective-correct every 16 pixels ([`PerSegment<16>`](PerSegment)).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Balanced;
 
-/// Finest: 8 sub-pixel bits, [`Precise`] arithmetic, [`Libm`] set-up.
+/// Finest: 8 sub-pixel bits, [`Precise`] arithmetic, [`Libm`] set-up, [`PerPixel`] Gouraud
+/// colour.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Exact;
 
@@ -139,6 +147,7 @@ impl Preset for Fast {
     type Options = RenderOptions<2, FrustumClip, Quick>;
     type Math = Libm;
     type Arithmetic = Quick;
+    type Interpolation = Affine;
     fn options() -> Self::Options {
         RenderOptions::default()
             .with_sub_pixel_bits::<2>()
@@ -152,6 +161,7 @@ impl Preset for Balanced {
     type Options = RenderOptions<4, FrustumClip, Frugal>;
     type Math = Libm;
     type Arithmetic = Frugal;
+    type Interpolation = PerSegment<16>;
     fn options() -> Self::Options {
         RenderOptions::default().with_arithmetic(Frugal::default())
     }
@@ -163,6 +173,7 @@ impl Preset for Exact {
     type Options = RenderOptions<8, FrustumClip>;
     type Math = Libm;
     type Arithmetic = Precise;
+    type Interpolation = PerPixel;
     fn options() -> Self::Options {
         RenderOptions::default().with_sub_pixel_bits::<8>()
     }

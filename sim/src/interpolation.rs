@@ -14,7 +14,7 @@ use scanline3d::{RenderOptions, Workspace};
 use std::convert::Infallible;
 
 /// An interpolation, chosen at run time.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Mode {
     /// `shading::Affine`.
     Affine,

@@ -13,6 +13,7 @@ use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use embedded_graphics::prelude::*;
 use embedded_graphics::primitives::{Circle, Line, PrimitiveStyle, Rectangle};
 use embedded_graphics::text::Text;
+use scanline3d_sim::interpolation::{self, Mode, ModeError};
 use scanline3d_sim::tradeoff::{self, Accuracy, VARIANTS};
 use std::collections::HashMap;
 use std::process::Command;
@@ -133,6 +134,7 @@ struct Row {
     sub_bits: u32,
     math: &'static str,
     arith: &'static str,
+    depth: &'static str,
     preset: bool,
     mean_id: f64,
     worst_id: f64,
@@ -143,6 +145,116 @@ struct Row {
     instructions: Vec<f64>,
     host_ns: Option<f64>,
     flash: Vec<Option<u64>>,
+    workspace: Option<u64>,
+}
+
+/// "Gouraud attribute interpolation": each mode's colour error on the corpus and its cost on
+/// the demo orbit.
+fn gouraud_section(
+    line: &mut impl FnMut(String),
+    errors: &[ModeError],
+    cost: &HashMap<(Mode, &'static str), Demo>,
+) {
+    line("## Gouraud attribute interpolation".into());
+    line(String::new());
+    line(format!("`Gouraud<I>` with `I` one of `shading::Affine` (the default), `PerSegment<16>`, `PerSegment<8>` and `PerPixel`; everything else as `RenderOptions::default()`. **Colour error:** every corpus scene from every camera ({} views) at {SIZE}×{SIZE}, each vertex a different colour (`interpolation::vertex_color`), against the f64 reference, which blends the vertex colours by the hit point's barycentric coordinates in space (`reference::Scene::with_vertex_colors`); channel differences over the pixels where both show the same triangle. **Cost:** the demo orbit with Gouraud shading on QEMU, as above (its sphere has vertex normals, so its colours vary across triangles; the corpus carries no vertex colours on firmware); every frame hash equals the host's.", errors.len() / Mode::ALL.len().max(1)));
+    line(String::new());
+    line("| interpolation | mean channel error | worst view, mean | worst pixel | worst view PSNR | thumbv7em instr./frame | thumbv6m instr./frame | thumbv6m vs affine | flash thumbv7em / thumbv6m | RAM (workspace) |".into());
+    line("|---|---|---|---|---|---|---|---|---|---|".into());
+    let affine_v6m = cost
+        .get(&(Mode::Affine, TARGETS[1]))
+        .map_or(1.0, |d| d.instructions);
+    for mode in Mode::ALL {
+        let mine: Vec<&ModeError> = errors.iter().filter(|e| e.mode == mode).collect();
+        let mean = mine.iter().map(|e| e.error.mean).sum::<f64>() / mine.len().max(1) as f64;
+        let worst_view = mine.iter().map(|e| e.error.mean).fold(0.0, f64::max);
+        let worst_pixel = mine.iter().map(|e| e.error.max).max().unwrap_or(0);
+        let psnr = mine
+            .iter()
+            .map(|e| e.error.psnr)
+            .fold(f64::INFINITY, f64::min);
+        let at = |t: &'static str| cost.get(&(mode, t));
+        let instr =
+            |t: &'static str| at(t).map_or("n/a".into(), |d| thousands(d.instructions as u64));
+        line(format!(
+            "| {} | {mean:.3} | {worst_view:.3} | {worst_pixel} | {psnr:.1} dB | {} | {} | {} | {} | {} |",
+            mode.name(),
+            instr(TARGETS[0]),
+            instr(TARGETS[1]),
+            at(TARGETS[1]).map_or("n/a".into(), |d| format!("{:.2}×", d.instructions / affine_v6m)),
+            match (at(TARGETS[0]), at(TARGETS[1])) {
+                (Some(a), Some(b)) => format!("{} / {} B", thousands(a.flash), thousands(b.flash)),
+                _ => "n/a".into(),
+            },
+            at(TARGETS[1]).map_or("n/a".into(), |d| format!("{} B", thousands(d.workspace))),
+        ));
+    }
+}
+
+/// The trade-off example's name for Gouraud shading interpolated by `mode`.
+fn gouraud_variant(mode: Mode) -> String {
+    format!("gouraud-{}", mode.name())
+}
+
+/// The `scanline3d_variant` cfg that builds variant `name` alone.
+fn cfg_of(name: &str) -> String {
+    format!("scanline3d_variant=\"{}\"", name.replace([':', '-'], ""))
+}
+
+/// One variant's demo firmware on one target.
+struct Demo {
+    /// Mean instructions per frame.
+    instructions: f64,
+    flash: u64,
+    /// Its workspace in bytes.
+    workspace: u64,
+}
+
+/// Builds the trade-off example with variant `name` alone for `target`, runs it on QEMU and
+/// checks its frame hashes against `host_hashes` (the host's for every variant).
+fn demo_on_target(
+    target: &str,
+    name: &str,
+    host_hashes: &[(String, u32, u32)],
+) -> Result<Demo, String> {
+    step(&format!(
+        "trade-off firmware, {name} alone, on QEMU: {target}"
+    ));
+    // The cfg goes to the example alone (the final compilation unit).
+    let elf = build_tradeoff(Some(target), &[cfg_of(name)], None)?;
+    let flash = flash_bytes(&elf)?;
+    let out = run_on_qemu(target, &elf)?;
+    let f = frames(&out);
+    let hashes: Vec<_> = f.iter().map(|f| (f.0.clone(), f.1, f.2)).collect();
+    let host: Vec<_> = host_hashes
+        .iter()
+        .filter(|h| h.0 == name)
+        .cloned()
+        .collect();
+    if hashes != host {
+        return Err(format!(
+            "{target}, {name}: frame hashes differ from the host's"
+        ));
+    }
+    let counts: Vec<u64> = f.iter().filter_map(|x| x.3).collect();
+    if counts.len() != host.len() || counts.is_empty() {
+        return Err(format!("{target}: no counts for {name}"));
+    }
+    let mean = counts.iter().sum::<u64>() as f64 / counts.len() as f64;
+    println!(
+        "{} frames, hashes equal the host's, {mean:.0} instructions per frame",
+        f.len()
+    );
+    let workspace = out
+        .lines()
+        .find_map(|l| l.strip_prefix("summary workspace "))
+        .and_then(|v| v.trim().parse().ok())
+        .ok_or_else(|| format!("{target}, {name}: no workspace size"))?;
+    Ok(Demo {
+        instructions: mean,
+        flash,
+        workspace,
+    })
 }
 
 pub fn tradeoff() -> Result<(), String> {
@@ -153,6 +265,18 @@ pub fn tradeoff() -> Result<(), String> {
             .map_err(|e| e.to_string())?,
     );
     let accuracy = tradeoff::corpus_accuracy(SIZE, SIZE, |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })?;
+    bar.finish();
+
+    step("Gouraud interpolation against the f64 reference (every corpus scene and camera)");
+    let bar = indicatif::ProgressBar::new(0);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} cameras, {elapsed}")
+            .map_err(|e| e.to_string())?,
+    );
+    let interpolation = interpolation::corpus_errors(SIZE, SIZE, |done, total| {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
     })?;
@@ -186,47 +310,15 @@ pub fn tradeoff() -> Result<(), String> {
 
     let mut instructions: HashMap<(&str, &str), f64> = HashMap::new();
     let mut flash: HashMap<(&str, &str), u64> = HashMap::new();
-    let mut workspace = 0u64;
+    let mut workspace: HashMap<&str, u64> = HashMap::new();
     let mut corpus_instructions: HashMap<(&str, &str, String), f64> = HashMap::new();
     for target in TARGETS {
         for v in VARIANTS {
-            step(&format!(
-                "trade-off firmware, {} alone, on QEMU: {target}",
-                v.name
-            ));
-            // The cfg goes to the example alone (the final compilation unit).
-            let variant = format!("scanline3d_variant=\"{}\"", v.name.replace([':', '-'], ""));
-            let elf = build_tradeoff(Some(target), std::slice::from_ref(&variant), None)?;
-            flash.insert((v.name, target), flash_bytes(&elf)?);
-            let out = run_on_qemu(target, &elf)?;
-            let f = frames(&out);
-            let hashes: Vec<_> = f.iter().map(|f| (f.0.clone(), f.1, f.2)).collect();
-            let host: Vec<_> = host_hashes
-                .iter()
-                .filter(|h| h.0 == v.name)
-                .cloned()
-                .collect();
-            if hashes != host {
-                return Err(format!(
-                    "{target}, {}: frame hashes differ from the host's",
-                    v.name
-                ));
-            }
-            let counts: Vec<u64> = f.iter().filter_map(|x| x.3).collect();
-            if counts.len() != host.len() || counts.is_empty() {
-                return Err(format!("{target}: no counts for {}", v.name));
-            }
-            let mean = counts.iter().sum::<u64>() as f64 / counts.len() as f64;
-            println!(
-                "{} frames, hashes equal the host's, {mean:.0} instructions per frame",
-                f.len()
-            );
-            instructions.insert((v.name, target), mean);
-            workspace = out
-                .lines()
-                .find_map(|l| l.strip_prefix("summary workspace "))
-                .and_then(|v| v.trim().parse().ok())
-                .unwrap_or(0);
+            let demo = demo_on_target(target, v.name, &host_hashes)?;
+            instructions.insert((v.name, target), demo.instructions);
+            flash.insert((v.name, target), demo.flash);
+            workspace.insert(v.name, demo.workspace);
+            let variant = cfg_of(v.name);
 
             // The same variant over every corpus view (a separate image: the corpus data would
             // swamp the flash figure).
@@ -262,6 +354,16 @@ pub fn tradeoff() -> Result<(), String> {
         }
     }
 
+    // Gouraud interpolation: the demo orbit only (the corpus carries no vertex colours on
+    // firmware).
+    let mut gouraud: HashMap<(Mode, &str), Demo> = HashMap::new();
+    for target in TARGETS {
+        for mode in Mode::ALL {
+            let name = gouraud_variant(mode);
+            gouraud.insert((mode, target), demo_on_target(target, &name, &host_hashes)?);
+        }
+    }
+
     let scenes: Vec<&'static str> = scanline3d_sim::corpus::all()
         .iter()
         .map(|s| s.name)
@@ -282,6 +384,7 @@ pub fn tradeoff() -> Result<(), String> {
                 name: v.name,
                 sub_bits: v.precision.sub_bits,
                 arith: v.precision.arith.name(),
+                depth: v.precision.depth.name(),
                 math: match v.precision.math {
                     scanline3d_sim::scene::SetupMath::Libm => "libm",
                     scanline3d_sim::scene::SetupMath::Micromath => "micromath",
@@ -309,6 +412,7 @@ pub fn tradeoff() -> Result<(), String> {
                     .iter()
                     .map(|t| flash.get(&(v.name, *t)).copied())
                     .collect(),
+                workspace: workspace.get(v.name).copied(),
             }
         })
         .collect();
@@ -340,28 +444,29 @@ pub fn tradeoff() -> Result<(), String> {
     line(String::new());
     line("Written by `cargo xtask tradeoff`; do not edit by hand. The presets of `scanline3d::preset` (fast, balanced, exact), the library default (`RenderOptions::default()`: 4 sub-pixel bits, precise arithmetic, libm; not a preset) and the default with one knob changed, so that each knob's own effect shows.".into());
     line(String::new());
-    line("Set-up arithmetic (`scanline3d::preset::Arithmetic`): *precise* transforms with 64-bit products, divides each coordinate exactly and normalizes normals to 30 bits; *quick* uses 32-bit transform products (`vertex::NarrowTransform`), one reciprocal per vertex (`project::Reciprocal`) and 15-bit normals (`math::NarrowNormals`). The three knob rows change one of these alone. Each variant is judged under its own documented error bound: sub-pixel snapping plus what its arithmetic adds (`SetupArith::documented_error`).".into());
+    line("Set-up arithmetic (`scanline3d::preset::Arithmetic`): *precise* transforms with 64-bit products, divides each coordinate exactly and normalizes normals to 30 bits; *quick* uses 32-bit transform products (`vertex::NarrowTransform`), one reciprocal per vertex (`project::Reciprocal`) and 15-bit normals (`math::NarrowNormals`). The three knob rows change one of these alone. Depth format (`scanline3d::depth`): 32-bit `q = near/w` (I2F30) or 16-bit (`Depth16`, U0F16). Each variant is judged under its own documented error bound: sub-pixel snapping plus what its arithmetic and depth format add (`Precision::documented_error`).".into());
     line(String::new());
     line(format!("* **Accuracy:** every corpus scene from every camera ({} views) at {SIZE}×{SIZE} against the f64 reference, each variant judged under its own sub-pixel error bound (`metrics::compare`). Id mismatches: pixels showing another triangle than the reference (mean and worst view); real: mismatches the bound does not explain, summed over all views; depth: pixels beyond their depth bound, summed.", accuracy.len() / VARIANTS.len()));
     line(format!("* **Instructions** (main table): the demo orbit (1420 triangles, 8 frames, mean per frame) on QEMU ({}, `-icount shift=0`): mps2-an386 for thumbv7em (Cortex-M4F), mps2-an385 for thumbv6m. `examples/tradeoff.rs` is built once per variant, so each image carries only its own code (in one image holding every variant, LLVM inlined each variant differently, and the counts no longer compared like with like); every frame hash equals the host's.", first_line(Command::new("qemu-system-arm").arg("--version"))));
     line(format!("* **Host time:** criterion (`cargo bench --bench tradeoff`), the sum over the corpus scenes (first camera each) of the mean time per frame, on {} ({}).", host_cpu(), first_line(Command::new("rustc").arg("--version"))));
-    line(format!("* **Flash:** that variant's trade-off firmware (release profile, demo mesh data included). **RAM:** the workspace is the same for every variant, {} B; no knob changes memory yet.", thousands(workspace)));
+    line("* **Flash:** that variant's trade-off firmware (release profile, demo mesh data included). **RAM:** its demo workspace (`Workspace::BYTES`, 240×240, capacities 640 triangles and 80 active, as the firmware reports it); the render's stack comes on top and is the same for every variant.".into());
     line("* **Pareto front:** variants without real mismatches that no other such variant beats on both thumbv6m instructions and mean id mismatches.".into());
     line(String::new());
-    line("| variant | sub-pixel bits | set-up math | set-up arithmetic | id mismatches, mean / worst (scene) | real | depth beyond bound | worst colour PSNR | thumbv7em instr./frame | thumbv6m instr./frame | thumbv6m vs exact | host time, corpus | flash thumbv7em / thumbv6m | Pareto |".into());
-    line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|".into());
+    line("| variant | sub-pixel bits | set-up math | set-up arithmetic | depth | id mismatches, mean / worst (scene) | real | depth beyond bound | worst colour PSNR | thumbv7em instr./frame | thumbv6m instr./frame | thumbv6m vs exact | host time, corpus | flash thumbv7em / thumbv6m | RAM (workspace) | Pareto |".into());
+    line("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|".into());
     for (r, on_front) in rows.iter().zip(&front) {
         let flash = match (r.flash[0], r.flash[1]) {
             (Some(a), Some(b)) => format!("{} / {} B", thousands(a), thousands(b)),
             _ => "n/a".into(),
         };
         line(format!(
-            "| {}{} | {} | {} | {} | {:.3} % / {:.3} % ({}) | {} | {} | {:.1} dB | {} | {} | {:.2}× | {} | {} | {} |",
+            "| {}{} | {} | {} | {} | {} | {:.3} % / {:.3} % ({}) | {} | {} | {:.1} dB | {} | {} | {:.2}× | {} | {} | {} | {} |",
             if r.preset { "**" } else { "" },
             if r.preset { format!("{}**", r.name) } else { r.name.to_string() },
             r.sub_bits,
             r.math,
             r.arith,
+            r.depth,
             r.mean_id,
             r.worst_id,
             r.worst_scene,
@@ -373,11 +478,14 @@ pub fn tradeoff() -> Result<(), String> {
             exact_v6m / v6m(r),
             r.host_ns.map_or("n/a".into(), |ns| format!("{:.1} µs", ns / 1000.0)),
             flash,
+            r.workspace.map_or("n/a".into(), |b| format!("{} B", thousands(b))),
             if *on_front { "on the front" } else if r.real > 0 { "has real mismatches" } else { "dominated" },
         ));
     }
     line(String::new());
     line("![instructions against id mismatches](tradeoff.png)".into());
+    line(String::new());
+    gouraud_section(&mut line, &interpolation, &gouraud);
     line(String::new());
     line("## Instructions per frame on each corpus scene".into());
     line(String::new());
