@@ -118,11 +118,11 @@ mod sealed {
     impl Sealed for super::NarrowNormals {}
 }
 
-/// Normals normalized in 64-bit integers to 30 bits ([`normalize_i64`]): the default.
+/// Normals normalized in 64-bit integers to 30 bits (`normalize_i64`): the default.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct WideNormals;
 
-/// Normals normalized in 32-bit integers to 15 bits ([`normalize_i32`]): a direction error
+/// Normals normalized in 32-bit integers to 15 bits (`normalize_i32`): a direction error
 /// below 2^-13 rad, far below one 8-bit colour step, for a fraction of the cost on cores
 /// without a 64-bit divider.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

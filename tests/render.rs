@@ -220,6 +220,15 @@ fn one_triangle() -> MeshData {
     )
 }
 
+/// `instances` seen by [`front_camera`].
+fn front_scene<'a>(instances: &'a [Instance<'a>]) -> Scene<'a> {
+    Scene {
+        instances,
+        camera: front_camera().fixed().unwrap(),
+        light: light(),
+    }
+}
+
 fn front_camera() -> CameraSpec {
     CameraSpec::looking_at([0.0, 0.0, 3.0], [0.0; 3], 60.0, 0.5, 10.0)
 }
@@ -229,11 +238,7 @@ fn sink_error_stops_the_frame_at_that_row() {
     let data = one_triangle();
     let mesh = data.mesh().unwrap();
     let instances = [instance(&mesh)];
-    let scene = Scene {
-        instances: &instances,
-        camera: front_camera().fixed().unwrap(),
-        light: light(),
-    };
+    let scene = front_scene(&instances);
     let mut ws: Workspace<Rgb565, Flat, 16, 16, 4, 4> = Workspace::new(Rgb565::BLACK);
     let mut seen = Vec::new();
     let mut sink = FnSink(|row: Row<'_, Rgb565>| {
@@ -262,11 +267,7 @@ fn too_many_triangles_fails_before_any_row() {
     let sphere = icosphere(1, 1.0);
     let mesh = sphere.mesh().unwrap();
     let instances = [instance(&mesh)];
-    let scene = Scene {
-        instances: &instances,
-        camera: front_camera().fixed().unwrap(),
-        light: light(),
-    };
+    let scene = front_scene(&instances);
     let mut ws: Workspace<Rgb565, Flat, 32, 32, 8, 8> = Workspace::new(Rgb565::BLACK);
     let mut rows = 0;
     let err = ws
@@ -362,11 +363,7 @@ fn full_active_list_degrades_deterministically_and_reports_what_was_lost() {
     let sphere = icosphere(2, 1.0);
     let mesh = sphere.mesh().unwrap();
     let instances = [instance(&mesh)];
-    let scene = Scene {
-        instances: &instances,
-        camera: front_camera().fixed().unwrap(),
-        light: light(),
-    };
+    let scene = front_scene(&instances);
     let (full, full_complete, full_stats) = render_with_active::<64>(&scene);
     assert!(full_stats.is_complete() && full_complete.iter().all(|c| *c));
     assert_eq!(full_stats.incomplete_rows, 0);
@@ -586,11 +583,7 @@ fn instance_capacity_is_a_workspace_parameter() {
     let data = one_triangle();
     let mesh = data.mesh().unwrap();
     let instances = [instance(&mesh), instance(&mesh)];
-    let scene = Scene {
-        instances: &instances,
-        camera: front_camera().fixed().unwrap(),
-        light: light(),
-    };
+    let scene = front_scene(&instances);
     let mut one: Box<Workspace<TriangleId, Flat, 16, 16, 8, 4, 1>> =
         Box::new(Workspace::new(TriangleId::NONE));
     let rows = std::cell::Cell::new(0);
@@ -684,11 +677,7 @@ fn sixteen_bit_depth_gives_surfaces_closer_than_its_resolution_to_the_first_draw
     let data = mesh_data(&positions, &[[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]]);
     let mesh = data.mesh().unwrap();
     let instances = [instance(&mesh)];
-    let scene = Scene {
-        instances: &instances,
-        camera: front_camera().fixed().unwrap(),
-        light: light(),
-    };
+    let scene = front_scene(&instances);
     let count = |ids: &[i32], which: [i32; 2]| ids.iter().filter(|i| which.contains(i)).count();
     let (ids32, _) = ids_and_depth::<Depth>(&scene, false);
     let (ids16, _) = ids_and_depth::<Depth16>(&scene, false);

@@ -4,7 +4,7 @@
 //! under `sim/corpus/` are checked against this generator by a test.
 
 use crate::meshgen;
-use crate::scene::{CameraSpec, MeshData};
+use crate::scene::{CameraSpec, LightSpec, MeshData, SceneSpec};
 use embedded_graphics::pixelcolor::Rgb888;
 use std::f64::consts::TAU;
 
@@ -111,6 +111,31 @@ fn pawn() -> MeshData {
 }
 
 /// Every corpus scene with its cameras.
+/// Calls `f(scene name, camera index, scene)` for every corpus scene from every camera, with
+/// the default light, then `progress(done, total)` (in cameras).
+pub fn for_each_view(
+    mut f: impl FnMut(&'static str, usize, SceneSpec) -> Result<(), String>,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<(), String> {
+    let scenes = all();
+    let total: usize = scenes.iter().map(|s| s.cameras.len()).sum();
+    let mut done = 0;
+    for scene in &scenes {
+        for (k, camera) in scene.cameras.iter().enumerate() {
+            let spec = SceneSpec::single(
+                scene.mesh.clone(),
+                *camera,
+                LightSpec::default(),
+                scene.cull_back_faces,
+            );
+            f(scene.name, k, spec)?;
+            done += 1;
+            progress(done, total);
+        }
+    }
+    Ok(())
+}
+
 pub fn all() -> Vec<CorpusScene> {
     let orbit = |r: f64, y: f64, n: usize, fovy: f64| -> Vec<CameraSpec> {
         (0..n)

@@ -7,7 +7,7 @@
 //! into 100, 2,500 and 60,000 triangles, seen at 240×240 with flat shading, 4 sub-pixel bits
 //! and back-face culling, into RGB565 on black.
 //!
-//! Adding a method takes two lines here: a [`method!`] declaration and a line in
+//! Adding a method takes two lines here: a `method!` declaration and a line in
 //! [`for_each`].
 
 use scanline3d::render::{FrameStats, RenderError, RenderOptions};

@@ -4,7 +4,7 @@
 
 use crate::corpus;
 use crate::reference::Image;
-use crate::scene::{LightSpec, SceneSpec};
+use crate::scene::SceneSpec;
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use scanline3d::clip::FrustumClip;
 use scanline3d::scene::{Instance, Mesh, MeshColors, Scene};
@@ -217,33 +217,22 @@ pub struct ModeError {
 pub fn corpus_errors(
     w: usize,
     h: usize,
-    mut progress: impl FnMut(usize, usize),
+    progress: impl FnMut(usize, usize),
 ) -> Result<Vec<ModeError>, String> {
-    let scenes = corpus::all();
-    let total: usize = scenes.iter().map(|s| s.cameras.len()).sum();
     let mut out = Vec::new();
-    let mut done = 0;
-    for scene in &scenes {
-        for (k, camera) in scene.cameras.iter().enumerate() {
-            let spec = SceneSpec::single(
-                scene.mesh.clone(),
-                *camera,
-                LightSpec::default(),
-                scene.cull_back_faces,
-            );
-            let reference = render_reference(&spec, w, h)?;
-            for mode in Mode::ALL {
-                let fixed = render_fixed(&spec, mode, w, h)?;
-                out.push(ModeError {
-                    mode,
-                    scene: scene.name,
-                    camera: k,
-                    error: colour_error(&fixed, &reference),
-                });
-            }
-            done += 1;
-            progress(done, total);
+    let each = |scene, camera, spec: SceneSpec| {
+        let reference = render_reference(&spec, w, h)?;
+        for mode in Mode::ALL {
+            let fixed = render_fixed(&spec, mode, w, h)?;
+            out.push(ModeError {
+                mode,
+                scene,
+                camera,
+                error: colour_error(&fixed, &reference),
+            });
         }
-    }
+        Ok(())
+    };
+    corpus::for_each_view(each, progress)?;
     Ok(out)
 }

@@ -101,7 +101,7 @@ pub fn cube() -> Shape {
     (v, f)
 }
 
-/// An `n[0] × n[1]` grid of quads over [−half[0], half[0]] × [−half[1], half[1]] in the x-z
+/// An `n[0] × n[1]` grid of quads over `[−half[0], half[0]] × [−half[1], half[1]]` in the x-z
 /// plane, facing +y, with heights `height(x, z)`; two triangles per quad, row by row.
 pub fn grid(n: [usize; 2], half: [f64; 2], height: impl Fn(f64, f64) -> f64) -> Shape {
     let s = |k: usize, axis: usize| -half[axis] + 2.0 * half[axis] * k as f64 / n[axis] as f64;

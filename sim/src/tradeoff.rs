@@ -3,9 +3,7 @@
 
 use crate::corpus;
 use crate::metrics::{self, ErrorBound, Metrics};
-use crate::scene::{
-    DepthChoice, LightSpec, Precision, PresetChoice, SceneSpec, SetupArith, SetupMath,
-};
+use crate::scene::{DepthChoice, Precision, PresetChoice, SceneSpec, SetupArith, SetupMath};
 
 /// One set of precision choices.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -101,46 +99,35 @@ pub struct Accuracy {
 pub fn corpus_accuracy(
     w: usize,
     h: usize,
-    mut progress: impl FnMut(usize, usize),
+    progress: impl FnMut(usize, usize),
 ) -> Result<Vec<Accuracy>, String> {
-    let scenes = corpus::all();
-    let total: usize = scenes.iter().map(|s| s.cameras.len()).sum();
-    let mut done = 0;
     let mut out = Vec::new();
-    for scene in &scenes {
-        for (k, camera) in scene.cameras.iter().enumerate() {
-            let spec = SceneSpec::single(
-                scene.mesh.clone(),
-                *camera,
-                LightSpec::default(),
-                scene.cull_back_faces,
-            );
-            let reference = spec.reference()?;
-            let ref_image = reference.render(w, h);
-            for v in VARIANTS {
-                let fixed = spec.render_fixed_settings(
-                    w,
-                    h,
-                    v.precision,
-                    crate::scene::Algorithm::SpanZBuffer,
-                )?;
-                let bound = ErrorBound {
-                    sub_bits: v.precision.sub_bits,
-                    max_model_coord: spec.max_model_coord(),
-                    focal_px: reference.camera.focal_px(h),
-                    arithmetic: v.precision.documented_error(w, h, spec.max_model_coord()),
-                };
-                out.push(Accuracy {
-                    variant: v.name,
-                    scene: scene.name,
-                    camera: k,
-                    metrics: metrics::compare(&fixed.image, &ref_image, &reference, &bound),
-                });
-            }
-            done += 1;
-            progress(done, total);
+    let each = |scene, camera, spec: SceneSpec| {
+        let reference = spec.reference()?;
+        let ref_image = reference.render(w, h);
+        for v in VARIANTS {
+            let fixed = spec.render_fixed_settings(
+                w,
+                h,
+                v.precision,
+                crate::scene::Algorithm::SpanZBuffer,
+            )?;
+            let bound = ErrorBound {
+                sub_bits: v.precision.sub_bits,
+                max_model_coord: spec.max_model_coord(),
+                focal_px: reference.camera.focal_px(h),
+                arithmetic: v.precision.documented_error(w, h, spec.max_model_coord()),
+            };
+            out.push(Accuracy {
+                variant: v.name,
+                scene,
+                camera,
+                metrics: metrics::compare(&fixed.image, &ref_image, &reference, &bound),
+            });
         }
-    }
+        Ok(())
+    };
+    corpus::for_each_view(each, progress)?;
     Ok(out)
 }
 

@@ -257,13 +257,19 @@ fn demo_on_target(
     })
 }
 
-pub fn tradeoff() -> Result<(), String> {
-    step("the variants against the f64 reference (every corpus scene and camera)");
+/// A progress bar counting corpus cameras.
+fn cameras_bar() -> Result<indicatif::ProgressBar, String> {
     let bar = indicatif::ProgressBar::new(0);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} cameras, {elapsed}")
             .map_err(|e| e.to_string())?,
     );
+    Ok(bar)
+}
+
+pub fn tradeoff() -> Result<(), String> {
+    step("the variants against the f64 reference (every corpus scene and camera)");
+    let bar = cameras_bar()?;
     let accuracy = tradeoff::corpus_accuracy(SIZE, SIZE, |done, total| {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
@@ -271,11 +277,7 @@ pub fn tradeoff() -> Result<(), String> {
     bar.finish();
 
     step("Gouraud interpolation against the f64 reference (every corpus scene and camera)");
-    let bar = indicatif::ProgressBar::new(0);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} cameras, {elapsed}")
-            .map_err(|e| e.to_string())?,
-    );
+    let bar = cameras_bar()?;
     let interpolation = interpolation::corpus_errors(SIZE, SIZE, |done, total| {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
