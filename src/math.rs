@@ -84,12 +84,55 @@ impl MathBackend for Micromath {
 pub(crate) fn normalize_i64(v: [i64; 3]) -> Option<[i32; 3]> {
     let s = fit_bits(v, 30)?;
     let len_sq: u64 = s.iter().map(|&c| (c * c) as u64).sum();
-    let len = len_sq.isqrt() as i64;
+    let len = isqrt_u64(len_sq);
     if len == 0 {
         return None;
     }
-    // |s_i| <= len, so each quotient is within +-2^30 and fits i32.
-    Some(s.map(|c| ((c << 30) / len) as i32))
+    // One division for the three components: each quotient is exactly `(c << 30) / len`
+    // (truncated towards zero), as three divisions would give. |s_i| <= len, so each is within
+    // ±2^30 and fits i32.
+    let inv = u64::MAX / len;
+    Some(s.map(|c| {
+        let q = div_with_inverse(c.unsigned_abs() << 30, len, inv) as i64;
+        (if c < 0 { -q } else { q }) as i32
+    }))
+}
+
+/// `floor(n / d)` for `1 <= d` and `n < 2^62`, given `inv = floor((2^64 − 1) / d)`: the
+/// product estimate `n · inv / 2^64` is at most 2 below the quotient (`d · inv > 2^64 − 1 − d`
+/// and `n / d < 2^62`), and the remainder corrects it exactly.
+#[inline]
+fn div_with_inverse(n: u64, d: u64, inv: u64) -> u64 {
+    let mut q = ((n as u128 * inv as u128) >> 64) as u64;
+    let mut r = n.wrapping_sub(q.wrapping_mul(d));
+    while r >= d {
+        q = q.wrapping_add(1);
+        r -= d;
+    }
+    q
+}
+
+/// `floor(sqrt(n))`, exactly `n.isqrt()`. Where the core has a double-precision square root
+/// (x86-64, AArch64) its correctly rounded estimate is within one of the answer and one
+/// integer step on each side makes it exact; elsewhere the integer algorithm of `core`.
+#[inline]
+fn isqrt_u64(n: u64) -> u64 {
+    #[cfg(any(target_feature = "sse2", target_arch = "aarch64"))]
+    {
+        // n < 2^63, so the estimate is below 2^32 and its square cannot overflow.
+        let mut r = libm::sqrt(n as f64) as u64;
+        while r * r > n {
+            r -= 1;
+        }
+        while (r + 1) * (r + 1) <= n {
+            r += 1;
+        }
+        r
+    }
+    #[cfg(not(any(target_feature = "sse2", target_arch = "aarch64")))]
+    {
+        n.isqrt()
+    }
 }
 
 /// `v` shifted right (the same for every component) until each fits `bits` bits (`|c| <=
@@ -167,6 +210,34 @@ pub(crate) fn dot_q30(a: [i32; 3], b: [i32; 3]) -> i32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn square_root_and_division_are_exact() {
+        // Perfect squares and their neighbours at every size, and pseudo-random values.
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        for k in 0..200_000u64 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let root = (k * 20_000 + (x >> 44)) % (1 << 31);
+            for n in [
+                root * root,
+                (root * root).saturating_sub(1),
+                root * root + 1,
+                x >> 2,
+            ] {
+                assert_eq!(isqrt_u64(n), n.isqrt(), "sqrt {n}");
+            }
+            let d = (x >> (x % 33)).max(1) % (1 << 31) + 1;
+            let n = (x >> 2) ^ k;
+            assert_eq!(div_with_inverse(n, d, u64::MAX / d), n / d, "{n} / {d}");
+        }
+        for d in [1u64, 2, 3, (1 << 31) - 1, 1 << 31] {
+            for n in [0u64, 1, d - 1, d, d + 1, (1 << 62) - 1] {
+                assert_eq!(div_with_inverse(n, d, u64::MAX / d), n / d, "{n} / {d}");
+            }
+        }
+    }
 
     #[test]
     fn normalize_gives_unit_length_at_every_scale() {

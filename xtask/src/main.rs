@@ -526,7 +526,7 @@ fn peers() -> Result<(), String> {
     };
     line("# Ours against the peer renderers".into());
     line(String::new());
-    line("Written by `cargo xtask peers`; do not edit by hand. Every corpus scene at 240×240, rendered by".into());
+    line("Written by `cargo xtask peers` (also run by `cargo xtask tradeoff`); do not edit by hand. Every corpus scene at 240×240, rendered by".into());
     line(format!(
         "scanline3d's default (`Workspace`: span z-buffer, flat shading, 4 sub-pixel bits) and by the peers a user would otherwise pick: [`euc`](https://crates.io/crates/euc) {} and [`embedded-3dgfx`](https://crates.io/crates/embedded-3dgfx) {}. How the peers are driven (id images through per-triangle colours, cameras, what is set up once) is in `sim/src/peers.rs`.",
         peers::EUC_VERSION,
@@ -1173,7 +1173,10 @@ fn main() -> ExitCode {
         "firmware" => install().and_then(|_| firmware()),
         "lean" => install().and_then(|_| lean()),
         "peers" => peers(),
-        "tradeoff" => install().and_then(|_| tradeoff::tradeoff()),
+        // The trade table and, in the same command, the peers (`docs/peers.md`).
+        "tradeoff" => install()
+            .and_then(|_| tradeoff::tradeoff())
+            .and_then(|_| peers()),
         "profile" => {
             let variant = std::env::args().nth(2).unwrap_or_else(|| "balanced".into());
             install().and_then(|_| profile::profile(&variant))

@@ -489,6 +489,8 @@ pub fn tradeoff() -> Result<(), String> {
     line(String::new());
     gouraud_section(&mut line, &interpolation, &gouraud);
     line(String::new());
+    line("Against other renderers (`euc`, `embedded-3dgfx`) on the same scenes and size: [peers.md](peers.md), written by the same command.".into());
+    line(String::new());
     line("## Instructions per frame on each corpus scene".into());
     line(String::new());
     line(format!("Every view of every corpus scene rendered by the trade-off firmware built with that scene data (`scanline3d_sim::export::corpus_source`, capacities with a {CORPUS_MARGIN_PERCENT} % margin), one image per variant; mean per view, thumbv6m / thumbv7em, in millions of instructions. Every hash equals the host's."));
