@@ -239,7 +239,7 @@ impl<P: Copy> RowSink<P> for FrameBuffer<'_, P> {
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
-/// use scanline3d::sink::{FnSink, Row, RowSink};
+/// use scanline3d::{depth::DepthRow, sink::{FnSink, Row, RowSink}};
 /// let mut rows = 0;
 /// let mut sink = FnSink(|row: Row<'_, Rgb565>| -> Result<(), ()> { rows += row.y as usize; Ok(()) });
 /// sink.write_row(Row { y: 2, pixels: &[], depth: DepthRow::NONE, complete: true }).unwrap();
