@@ -75,41 +75,25 @@ impl MathBackend for Micromath {
     }
 }
 
-/// Unit vector in I2F30 (components as raw bits, `1.0 = 1 << 30`) pointing along an integer
-/// vector of any scale. `None` for the zero vector.
+/// Cosine of the angle between an integer vector `v` of any scale and a unit vector `unit`
+/// (I2F30 bits), in I2F30 bits truncated towards zero; `None` for the zero vector.
 ///
-/// Integer only (exact `isqrt`), so normals are identical on every target. The input is first
-/// shifted right until every component fits in 30 bits, which keeps the squared length below
-/// `3 * 2^60` (fits `u64`) while losing at most 2^-29 of relative precision.
-pub(crate) fn normalize_i64(v: [i64; 3]) -> Option<[i32; 3]> {
+/// One square root and one division: `v · unit / |v|`, with `v` first scaled so that its
+/// largest component has 30 bits, which keeps `|v|²` below `3 · 2^60` (fits `u64`) and every
+/// truncation (of `v`, of the root, of the quotient) within a few 2^-30. Integer only (exact `isqrt`), so lighting is identical on
+/// every target.
+pub(crate) fn cosine_i64(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
     let s = fit_bits(v, 30)?;
-    let len_sq: u64 = s.iter().map(|&c| (c * c) as u64).sum();
-    let len = isqrt_u64(len_sq);
+    let len = isqrt_u64(s.iter().map(|&c| (c * c) as u64).sum());
     if len == 0 {
         return None;
     }
-    // One division for the three components: each quotient is exactly `(c << 30) / len`
-    // (truncated towards zero), as three divisions would give. |s_i| <= len, so each is within
-    // ±2^30 and fits i32.
-    let inv = u64::MAX / len;
-    Some(s.map(|c| {
-        let q = div_with_inverse(c.unsigned_abs() << 30, len, inv) as i64;
-        (if c < 0 { -q } else { q }) as i32
-    }))
-}
-
-/// `floor(n / d)` for `1 <= d` and `n < 2^62`, given `inv = floor((2^64 − 1) / d)`: the
-/// product estimate `n · inv / 2^64` is at most 2 below the quotient (`d · inv > 2^64 − 1 − d`
-/// and `n / d < 2^62`), and the remainder corrects it exactly.
-#[inline]
-fn div_with_inverse(n: u64, d: u64, inv: u64) -> u64 {
-    let mut q = ((n as u128 * inv as u128) >> 64) as u64;
-    let mut r = n.wrapping_sub(q.wrapping_mul(d));
-    while r >= d {
-        q = q.wrapping_add(1);
-        r -= d;
-    }
-    q
+    // |s_i · unit_i| < 2^60 and, by Cauchy–Schwarz, every partial sum is at most
+    // |s| · |unit| < 2^61: no overflow, and the quotient is within about ±2^30.
+    let dot: i64 = (0..3).map(|k| s[k] * unit[k] as i64).sum();
+    // Unsigned division: `len` is known non-zero here, so no panic branch is emitted.
+    let q = (dot.unsigned_abs() / len) as i32;
+    Some(if dot < 0 { -q } else { q })
 }
 
 /// `floor(sqrt(n))`, exactly `n.isqrt()`. Where the core has a double-precision square root
@@ -135,24 +119,31 @@ fn isqrt_u64(n: u64) -> u64 {
     }
 }
 
-/// `v` shifted right (the same for every component) until each fits `bits` bits (`|c| <=
-/// 2^bits`); `None` for the zero vector.
-fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i64; 3]> {
+/// `v` shifted (left or right, the same for every component) so that its largest component
+/// has exactly `bits` significant bits (`2^(bits-1) <= max |c| <= 2^bits`); `None` for the zero
+/// vector. Scaling small vectors up keeps the integer square root of `|v|²`, which truncates,
+/// within a relative 2^(1-bits) of the true length.
+pub(crate) fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i64; 3]> {
     let max = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
     if max == 0 {
         return None;
     }
-    let shift = (64 - max.leading_zeros()).saturating_sub(bits);
-    Some(v.map(|c| c >> shift))
+    let len = 64 - max.leading_zeros();
+    Some(if len > bits {
+        v.map(|c| c >> (len - bits))
+    } else {
+        v.map(|c| c << (bits - len))
+    })
 }
 
-/// How precisely lighting normalizes normals, chosen at compile time (see
-/// [`crate::preset::Arithmetic`]).
+/// How precisely lighting takes the cosine between a normal and the light, chosen at compile
+/// time (see [`crate::preset::Arithmetic`]).
 pub trait NormalPrecision:
     Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed + 'static
 {
-    /// Unit vector in I2F30 bits along `v`; `None` for the zero vector.
-    fn normalize(v: [i64; 3]) -> Option<[i32; 3]>;
+    /// Cosine between `v` (any non-zero scale) and the unit vector `unit` (I2F30 bits), in
+    /// I2F30 bits; `None` for the zero vector.
+    fn cosine(v: [i64; 3], unit: [i32; 3]) -> Option<i32>;
 }
 
 mod sealed {
@@ -161,50 +152,45 @@ mod sealed {
     impl Sealed for super::NarrowNormals {}
 }
 
-/// Normals normalized in 64-bit integers to 30 bits (`normalize_i64`): the default.
+/// Cosines in 64-bit integers to 30 bits (`cosine_i64`): the default.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct WideNormals;
 
-/// Normals normalized in 32-bit integers to 15 bits (`normalize_i32`): a direction error
-/// below 2^-13 rad, far below one 8-bit colour step, for a fraction of the cost on cores
-/// without a 64-bit divider.
+/// Cosines in 32-bit integers to 15 bits (`cosine_i32`): an error of a few 2^-15, far below
+/// one 8-bit colour step, for a fraction of the cost on cores without a 64-bit divider.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct NarrowNormals;
 
 impl NormalPrecision for WideNormals {
     #[inline]
-    fn normalize(v: [i64; 3]) -> Option<[i32; 3]> {
-        normalize_i64(v)
+    fn cosine(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
+        cosine_i64(v, unit)
     }
 }
 
 impl NormalPrecision for NarrowNormals {
     #[inline]
-    fn normalize(v: [i64; 3]) -> Option<[i32; 3]> {
-        normalize_i32(v)
+    fn cosine(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
+        cosine_i32(v, unit)
     }
 }
 
-/// [`normalize_i64`] to 15 bits in 32-bit arithmetic: the input is shifted until every
-/// component fits 15 bits (so the squared length is below `3 * 2^30`, a `u32`), and each
-/// component is divided in `i32` (`|c| << 15 <= 2^30`). The result is in I2F30 bits with its
-/// low 15 bits zero.
-pub(crate) fn normalize_i32(v: [i64; 3]) -> Option<[i32; 3]> {
-    // Each component is now within ±2^15.
+/// [`cosine_i64`] to 15 bits in 32-bit arithmetic: `v` is scaled until its largest component
+/// has 15 bits (so `|v|²` is below `3 · 2^30`, a `u32`) and `unit` is taken to 15 bits. The result
+/// is in I2F30 bits with its low 15 bits zero.
+pub(crate) fn cosine_i32(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
     let s = fit_bits(v, 15)?.map(|c| c as i32);
-    let len_sq: u32 = s.iter().map(|&c| (c * c) as u32).sum();
-    let len = len_sq.isqrt() as i32;
+    let len = s.iter().map(|&c| (c * c) as u32).sum::<u32>().isqrt();
     if len == 0 {
         return None;
     }
-    Some(s.map(|c| (c << 15).wrapping_div(len) << 15))
-}
-
-/// Dot product of two I2F30 vectors, result in I2F30 bits (each product is below 2^61).
-#[inline]
-pub(crate) fn dot_q30(a: [i32; 3], b: [i32; 3]) -> i32 {
-    let sum: i64 = (0..3).map(|i| a[i] as i64 * b[i] as i64).sum();
-    (sum >> 30) as i32
+    // |s| < 2^15.8 and |unit >> 15| <= 2^15, so by Cauchy–Schwarz every partial sum of the
+    // dot product is below 2^31 (wrapping operations only keep the panic branch out).
+    let dot = (0..3).fold(0i32, |acc, k| {
+        acc.wrapping_add(s[k].wrapping_mul(unit[k] >> 15))
+    });
+    let q = (dot.unsigned_abs() / len) as i32;
+    Some((if dot < 0 { -q } else { q }) << 15)
 }
 
 #[cfg(test)]
@@ -212,7 +198,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn square_root_and_division_are_exact() {
+    fn square_root_is_exact() {
         // Perfect squares and their neighbours at every size, and pseudo-random values.
         let mut x = 0x9e37_79b9_7f4a_7c15u64;
         for k in 0..200_000u64 {
@@ -228,55 +214,61 @@ mod tests {
             ] {
                 assert_eq!(isqrt_u64(n), n.isqrt(), "sqrt {n}");
             }
-            let d = (x >> (x % 33)).max(1) % (1 << 31) + 1;
-            let n = (x >> 2) ^ k;
-            assert_eq!(div_with_inverse(n, d, u64::MAX / d), n / d, "{n} / {d}");
-        }
-        for d in [1u64, 2, 3, (1 << 31) - 1, 1 << 31] {
-            for n in [0u64, 1, d - 1, d, d + 1, (1 << 62) - 1] {
-                assert_eq!(div_with_inverse(n, d, u64::MAX / d), n / d, "{n} / {d}");
-            }
         }
     }
 
-    #[test]
-    fn normalize_gives_unit_length_at_every_scale() {
-        for scale in [1i64, 3, 1 << 20, 1 << 40, (1 << 55) + 12345] {
-            let n = normalize_i64([3 * scale, -4 * scale, 0]).unwrap();
-            let len_sq: i64 = n.iter().map(|&c| c as i64 * c as i64).sum();
-            let one = 1i64 << 60;
-            assert!((len_sq - one).abs() < one >> 26, "scale {scale}: {n:?}");
-            assert!((n[0] as i64 - (3 << 30) / 5).abs() <= 2);
-        }
-        assert_eq!(normalize_i64([0, 0, 0]), None);
-    }
-
-    #[test]
-    fn narrow_normals_are_unit_to_15_bits_and_agree_with_wide() {
+    /// Pseudo-random integer vectors at every scale from a few units to 2^62.
+    fn vectors(count: usize) -> impl Iterator<Item = [i64; 3]> {
         let mut x = 0x9e37_79b9u64;
-        let mut next = || {
+        let mut next = move || {
             x ^= x << 13;
             x ^= x >> 7;
             x ^= x << 17;
-            (x as i64) >> (x % 40) as u32
+            (x as i64) >> (x % 62) as u32
         };
-        for _ in 0..2000 {
-            let v = [next(), next(), next()];
-            let (Some(wide), Some(narrow)) = (normalize_i64(v), normalize_i32(v)) else {
-                assert_eq!(normalize_i32(v), None, "{v:?}");
+        (0..count).map(move |_| [next(), next(), next()])
+    }
+
+    /// `unit` as an I2F30 vector of length 1 (rounded), and the exact cosine in f64.
+    fn exact(v: [i64; 3], d: [f64; 3]) -> ([i32; 3], f64) {
+        let len = d.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let unit = d.map(|c| (c / len * (1u64 << 30) as f64).round() as i32);
+        let u = unit.map(|c| c as f64 / (1u64 << 30) as f64);
+        let vf = v.map(|c| c as f64);
+        let vlen = vf.iter().map(|c| c * c).sum::<f64>().sqrt();
+        (unit, (0..3).map(|k| vf[k] * u[k]).sum::<f64>() / vlen)
+    }
+
+    #[test]
+    fn cosines_match_f64_at_every_scale() {
+        let dirs = [[0.3, -0.5, 0.8], [1.0, 0.0, 0.0], [-0.2, -0.9, -0.1]];
+        for (i, v) in vectors(20_000).enumerate() {
+            let (unit, want) = exact(v, dirs[i % 3]);
+            let one = (1u64 << 30) as f64;
+            let (Some(wide), Some(narrow)) = (cosine_i64(v, unit), cosine_i32(v, unit)) else {
+                assert_eq!(v, [0; 3]);
                 continue;
             };
-            for k in 0..3 {
-                // 15-bit truncation of the input and of the quotient: a few 2^-15 at most.
-                let diff = (wide[k] as i64 - narrow[k] as i64).abs();
-                assert!(diff <= 4 << 15, "{v:?}: {wide:?} {narrow:?}");
-            }
+            // Wide: truncating `v` to 30 bits, its root and the quotient; the worst seen here
+            // is 3.0 units of 2^-30.
+            let wide_err = (wide as f64 / one - want).abs();
+            assert!(wide_err < 4.0 / one, "{v:?}: {wide} vs {want}");
+            // Narrow: the same at 15 bits, plus `unit >> 15`; the worst seen is 3.3 units of
+            // 2^-15.
+            let narrow_err = (narrow as f64 / one - want).abs();
+            assert!(narrow_err < 4.0 / 32768.0, "{v:?}: {narrow} vs {want}");
+            assert_eq!(narrow & 0x7fff, 0);
         }
-        assert_eq!(normalize_i32([0, 0, 0]), None);
-        assert_eq!(normalize_i32([0, -7, 0]), Some([0, -(1 << 30), 0]));
+        assert_eq!(cosine_i64([0; 3], [1 << 30, 0, 0]), None);
+        assert_eq!(cosine_i32([0; 3], [1 << 30, 0, 0]), None);
+        assert_eq!(cosine_i32([0, -7, 0], [0, -(1 << 30), 0]), Some(1 << 30));
         assert_eq!(
-            normalize_i32([i64::MIN + 1, 0, 0]),
-            Some([-(1 << 30), 0, 0])
+            cosine_i64([i64::MIN + 1, 0, 0], [1 << 30, 0, 0]),
+            Some(-(1 << 30))
+        );
+        assert_eq!(
+            cosine_i32([i64::MIN + 1, 0, 0], [1 << 30, 0, 0]),
+            Some(-(1 << 30))
         );
     }
 

@@ -13,7 +13,7 @@
 //!
 //! [`MAX_MODEL_COORD`]: crate::scene::MAX_MODEL_COORD
 
-use crate::math::{dot_q30, NormalPrecision};
+use crate::math::{fit_bits, NormalPrecision};
 use crate::scene::{Light, Transform, Vertex};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::{I16F16, I2F30};
@@ -280,23 +280,27 @@ impl Lighting {
         }
     }
 
+    /// Intensity of a world-space normal `n` (any non-zero scale).
     fn intensity_of_world_normal<N: NormalPrecision>(&self, n: [i64; 3]) -> I2F30 {
-        let lambert = match N::normalize(n) {
-            Some(unit) => dot_q30(unit, self.direction).max(0),
-            None => 0,
-        };
+        let lambert = N::cosine(n, self.direction).unwrap_or(0).max(0);
         let i = self.ambient.to_bits() as i64
             + ((self.diffuse.to_bits() as i64 * lambert as i64) >> 30);
         I2F30::from_bits(i.clamp(0, 1 << 30) as i32)
     }
 
-    fn normal_to_world(&self, n: [i32; 3]) -> [i64; 3] {
-        self.normal_matrix
-            .map(|row| (0..3).map(|k| row[k] as i64 * n[k] as i64).sum())
+    /// Model-space normal `n` (any scale) in world space, up to scale: `n` is first brought to
+    /// 30 bits, so with the matrix's entries within ±2^30 each product is below 2^60 and each
+    /// sum below 3 · 2^60. No normalization here: the cosine divides by the length once.
+    fn normal_to_world(&self, n: [i64; 3]) -> Option<[i64; 3]> {
+        let n = fit_bits(n, 30)?;
+        Some(
+            self.normal_matrix
+                .map(|row| (0..3).map(|k| row[k] as i64 * n[k]).sum()),
+        )
     }
 
     /// Intensity of a face with model-space vertices `v` (counter-clockwise = front), with
-    /// normals normalized at precision `N`.
+    /// the cosine taken at precision `N`.
     pub fn face<N: NormalPrecision>(&self, v: [&Vertex; 3]) -> I2F30 {
         let d = |a: &Vertex, b: &Vertex, k: usize| b[k].to_bits() as i64 - a[k].to_bits() as i64;
         let e1 = [0, 1, 2].map(|k| d(v[0], v[1], k));
@@ -307,18 +311,17 @@ impl Lighting {
             e1[2] * e2[0] - e1[0] * e2[2],
             e1[0] * e2[1] - e1[1] * e2[0],
         ];
-        match N::normalize(n) {
-            Some(unit) => self.intensity_of_world_normal::<N>(self.normal_to_world(unit)),
+        match self.normal_to_world(n) {
+            Some(w) => self.intensity_of_world_normal::<N>(w),
             None => self.ambient,
         }
     }
 
-    /// Intensity at a vertex with model-space normal `n` (any non-zero length), normalized at
-    /// precision `N`.
+    /// Intensity at a vertex with model-space normal `n` (any non-zero length), with the
+    /// cosine taken at precision `N`.
     pub fn vertex<N: NormalPrecision>(&self, n: &Vertex) -> I2F30 {
-        match N::normalize(n.map(|c| c.to_bits() as i64)) {
-            Some(unit) => {
-                let w = self.normal_to_world(unit);
+        match self.normal_to_world(n.map(|c| c.to_bits() as i64)) {
+            Some(w) => {
                 let w = if self.flip { w.map(|c| -c) } else { w };
                 self.intensity_of_world_normal::<N>(w)
             }
