@@ -5,6 +5,8 @@
 //!
 //! * `ours`: the default `Workspace` (span z-buffer, flat shading with Lambert lighting, 4
 //!   sub-pixel bits) into a `FrameBuffer` of the whole frame (every row is written).
+//! * `ours-cached`: the same with a vertex cache (`VERTS` = 16384): each vertex transformed
+//!   and projected once per frame instead of once per triangle and pass; the same pixels.
 //! * `euc`: clear colour and depth buffers, draw the triangle list with per-vertex colours.
 //! * `embedded-3dgfx`: clear the frame, record + execute one solid mesh per triangle (its solid
 //!   mode has one colour per mesh, so per-face colours, as ours draws them, need that).
@@ -18,7 +20,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
 use scanline3d::sink::FrameBuffer;
-use scanline3d::{Flat, RenderOptions, Workspace};
+use scanline3d::{Depth, Flat, RenderOptions, Workspace};
 use scanline3d_sim::corpus;
 use scanline3d_sim::peers::{E3dScene, EucScene};
 use scanline3d_sim::scene::{LightSpec, SceneSpec};
@@ -30,6 +32,8 @@ const H: usize = 240;
 
 /// Room for the largest corpus scene (10,082 triangles) and 240 slivers crossing one row.
 type Ours = Workspace<Rgb565, Flat, W, H, 16384, 1024>;
+/// The same with a vertex cache for every corpus scene's vertices (`scanline3d::cache`).
+type OursCached = Workspace<Rgb565, Flat, W, H, 16384, 1024, 8, Depth, 16384>;
 
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("peers");
@@ -38,6 +42,7 @@ fn bench(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_millis(1500));
     let mut ours: Box<Ours> = Box::new(Workspace::new(Rgb565::BLACK));
+    let mut cached: Box<OursCached> = Box::new(Workspace::new(Rgb565::BLACK));
     let mut frame = vec![Rgb565::BLACK; W * H];
     for scene in corpus::all() {
         let spec = SceneSpec::single(
@@ -57,6 +62,16 @@ fn bench(c: &mut Criterion) {
             group.bench_function(BenchmarkId::new("ours", name), |b| {
                 b.iter(|| {
                     let stats = ours.render(s, &options, &mut FrameBuffer::new(&mut frame, W));
+                    black_box(stats.ok());
+                })
+            });
+            let stats = cached
+                .render(s, &options, &mut FrameBuffer::new(&mut frame, W))
+                .expect("ours renders the corpus");
+            assert!(stats.cached_vertices > 0, "{name}: the cache is too small");
+            group.bench_function(BenchmarkId::new("ours-cached", name), |b| {
+                b.iter(|| {
+                    let stats = cached.render(s, &options, &mut FrameBuffer::new(&mut frame, W));
                     black_box(stats.ok());
                 })
             });

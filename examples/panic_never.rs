@@ -27,7 +27,7 @@ mod firmware {
     use scanline3d::depth::Depth16;
     use scanline3d::preset::{Fast, Preset};
     use scanline3d::shading::{Gouraud, PerPixel, PerSegment};
-    use scanline3d::{Depth, RenderOptions, Workspace};
+    use scanline3d::{Depth, Flat, RenderOptions, Workspace};
 
     /// The demo's capacities with another shading and depth format.
     type Ws<Sh, Z> = Workspace<Rgb565, Sh, 240, 240, 640, 80, 3, Z>;
@@ -38,6 +38,8 @@ mod firmware {
         let mut ws = PanelWorkspace::new(demo::BACKGROUND.into());
         let mut segments = Ws::<Gouraud<PerSegment<16>>, Depth16>::new(Rgb565::new(0, 0, 0));
         let mut per_pixel = Ws::<Gouraud<PerPixel>, Depth>::new(Rgb565::new(0, 0, 0));
+        let mut cached =
+            Workspace::<Rgb565, Flat, 240, 240, 640, 80, 3, Depth, 1024>::new(Rgb565::new(0, 0, 0));
         let instances = demo::instances();
         let mut frame = 0;
         loop {
@@ -53,6 +55,9 @@ mod firmware {
                 let a = segments.render(&scene, &options, &mut sink);
                 let b = per_pixel.render(&scene, &options, &mut sink);
                 core::hint::black_box((&a, &b, sink.hash()));
+                // With a vertex cache.
+                let c = cached.render(&scene, &options, &mut sink);
+                core::hint::black_box((&c, sink.hash()));
             }
             frame = frame.wrapping_add(1);
         }

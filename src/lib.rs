@@ -84,6 +84,7 @@
 #[cfg(test)]
 extern crate std;
 
+pub mod cache;
 pub mod clip;
 pub mod demo;
 pub mod depth;

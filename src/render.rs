@@ -2,21 +2,24 @@
 //! visibility with a one-row depth buffer (the span z-buffer) and handing each finished row to
 //! the sink.
 //!
-//! # Two passes, no per-vertex memory
+//! # Two passes, per-vertex memory optional
 //!
 //! Pass 1 transforms, clips, projects and culls every triangle just far enough to know its
 //! first row, and files its id in that row's bucket (a linked list threaded through two
 //! `u16` arrays: 4 bytes per triangle). Pass 2 walks the rows; when a row's bucket comes up,
 //! each triangle in it is transformed again and fully set up (edges, depth plane, shading) into
-//! the active list, which holds only the triangles crossing the current row. This trades a
-//! second transform for not storing transformed vertices (a 642-vertex mesh would need ~10 KiB).
+//! the active list, which holds only the triangles crossing the current row. By default this
+//! trades a second transform for not storing transformed vertices; a workspace with a vertex
+//! cache (`VERTS > 0`, [`crate::cache`]) transforms and projects each vertex once per frame
+//! instead, for [`CachedVertex::BYTES`] per vertex, with the same pixels.
 //!
 //! # Memory (all in [`Workspace`], sizes in bytes)
 //!
 //! `4·W` depth row + `size_of::<P>()·W` pixel row + `2·H` bucket heads + `4·TRIS` bucket lists +
-//! `ACTIVE · size_of` of an active triangle (about 104 for flat shading). See
-//! [`Workspace::BYTES`].
+//! `ACTIVE · size_of` of an active triangle (about 104 for flat shading) + `VERTS ·`
+//! [`CachedVertex::BYTES`]. See [`Workspace::BYTES`].
 
+use crate::cache::CachedVertex;
 use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping, FrustumClip};
 use crate::depth::{DepthFormat, DepthRow};
 use crate::math::NormalPrecision;
@@ -147,6 +150,10 @@ pub struct FrameStats {
     pub unclipped: u32,
     /// Triangles filed in row buckets.
     pub bucketed: u32,
+    /// Vertices transformed into the workspace's vertex cache ([`crate::cache`]) this frame;
+    /// 0 when it has none or the scene's vertices do not fit it (the frame is then rendered
+    /// uncached, with the same pixels).
+    pub cached_vertices: u32,
     /// Triangles (or clipped pieces) set up for the walk.
     pub activated: u32,
     /// Non-empty spans walked.
@@ -408,7 +415,10 @@ pub(crate) const NO_ENTRY: u16 = u16::MAX;
 /// * `ACTIVE`: triangles that may cross one row (more are dropped and reported in
 ///   [`FrameStats::dropped`], [`FrameStats::dropped_pieces`] and [`Row::complete`]);
 /// * `Z`: the depth format of the row's z-buffer ([`crate::depth`]): [`Depth`] (32-bit, the
-///   default) or [`Depth16`](crate::depth::Depth16) (half the depth row, coarser ties).
+///   default) or [`Depth16`](crate::depth::Depth16) (half the depth row, coarser ties);
+/// * `VERTS`: vertex cache entries ([`crate::cache`], default 0: none). When the scene's
+///   vertices fit, each is transformed and projected once per frame instead of once per
+///   triangle and pass: RAM for speed, with the same pixels.
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
@@ -428,6 +438,7 @@ pub struct Workspace<
     const ACTIVE: usize = 64,
     const INSTANCES: usize = MAX_INSTANCES,
     Z: DepthFormat = Depth,
+    const VERTS: usize = 0,
 > {
     depth: [Z; W],
     pixels: [P; W],
@@ -436,11 +447,13 @@ pub struct Workspace<
     next: [u16; TRIS],
     refs: [u16; TRIS],
     active: Vec<ActiveTri<S::Payload<P>>, ACTIVE>,
+    vertices: [CachedVertex; VERTS],
 }
 
 /// Bytes of a [`Workspace`] for pixel type `P`, shading `S` and depth format `Z` with the given
 /// size and capacities: what `Workspace::<P, S, W, H, TRIS, ACTIVE, INSTANCES, Z>::BYTES` is,
-/// computed at run time (for tools such as `sim analyze` that choose the capacities).
+/// computed at run time (for tools such as `sim analyze` that choose the capacities). A vertex
+/// cache adds [`crate::cache::vertex_cache_bytes`].
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
@@ -487,6 +500,8 @@ pub(crate) struct Frame<'a, T, K> {
     /// One sort key per bucket entry; empty unless `K::SORTED`.
     pub(crate) keys: &'a mut [u32],
     pub(crate) active: &'a mut VecView<ActiveTri<T, K>>,
+    /// The vertex cache; empty for workspaces without one.
+    pub(crate) vertices: &'a mut [CachedVertex],
 }
 
 /// Checks a `width × height` target against a workspace of `max_w × max_h` and builds its
@@ -515,7 +530,8 @@ impl<
         const ACTIVE: usize,
         const INSTANCES: usize,
         Z: DepthFormat,
-    > Workspace<P, S, W, H, TRIS, ACTIVE, INSTANCES, Z>
+        const VERTS: usize,
+    > Workspace<P, S, W, H, TRIS, ACTIVE, INSTANCES, Z, VERTS>
 {
     /// Size of this workspace in bytes.
     pub const BYTES: usize = core::mem::size_of::<Self>();
@@ -544,6 +560,7 @@ impl<
             next: [NO_ENTRY; TRIS],
             refs: [0; TRIS],
             active: Vec::new(),
+            vertices: [CachedVertex::EMPTY; VERTS],
         }
     }
 
@@ -632,6 +649,7 @@ impl<
             refs: &mut self.refs,
             keys: &mut [],
             active: self.active.as_mut_view(),
+            vertices: &mut self.vertices,
         };
         let mut resolve = SpanZBuffer {
             depth,
@@ -657,6 +675,8 @@ pub(crate) struct InstanceSetup<'a, T: TransformPrecision> {
     mv: T::Matrix,
     lighting: Lighting,
     first_id: u32,
+    /// Index of this instance's first vertex in the frame's vertex cache.
+    first_vertex: usize,
 }
 
 fn setup_instances<'a, T: TransformPrecision, E, const N: usize>(
@@ -664,7 +684,7 @@ fn setup_instances<'a, T: TransformPrecision, E, const N: usize>(
 ) -> Result<Vec<InstanceSetup<'a, T>, N>, RenderError<E>> {
     let mut out = Vec::new();
     let view = &scene.camera.view().world_to_eye;
-    let mut first_id = 0u32;
+    let (mut first_id, mut first_vertex) = (0u32, 0usize);
     for (i, inst) in scene.instances.iter().enumerate() {
         let max_abs_bits = inst.mesh.max_abs_bits();
         let mv = ModelView::new(&inst.transform, view, max_abs_bits)
@@ -676,6 +696,7 @@ fn setup_instances<'a, T: TransformPrecision, E, const N: usize>(
             mv,
             lighting,
             first_id,
+            first_vertex,
         };
         if out.push(setup).is_err() {
             return Err(RenderError::Capacity {
@@ -685,6 +706,7 @@ fn setup_instances<'a, T: TransformPrecision, E, const N: usize>(
             });
         }
         first_id += inst.mesh.triangles().len() as u32;
+        first_vertex += inst.mesh.vertices().len();
     }
     Ok(out)
 }
@@ -716,41 +738,80 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         shade(self.vertex_colors(tri, idx)[0], self.lighting.face::<N>(v))
     }
 
-    /// Transforms (and, for Gouraud, lights) the three vertices of triangle `tri`.
-    fn clip_vertices<A: Arithmetic<Transform = T>>(
+    /// The colour attributes of triangle `tri`'s vertices: lit per vertex for Gouraud
+    /// (`lit`), else zero (flat shading colours the face instead).
+    fn vertex_attributes<A: Arithmetic<Transform = T>>(
         &self,
         tri: usize,
         idx: [u16; 3],
         lit: bool,
-    ) -> [ClipVertex; 3] {
+    ) -> [[I16F16; 3]; 3] {
+        if !lit {
+            return [[I16F16::ZERO; 3]; 3];
+        }
         let mesh = self.instance.mesh;
-        let verts = mesh.vertices();
+        let zero = [I16F16::ZERO; 3];
+        let base = self.vertex_colors(tri, idx);
+        let intensity = match mesh.normals() {
+            Some(n) => idx.map(|i| {
+                self.lighting
+                    .vertex::<A::Normals>(n.get(i as usize).unwrap_or(&zero))
+            }),
+            None => {
+                let verts = mesh.vertices();
+                let v = idx.map(|i| verts.get(i as usize).unwrap_or(&zero));
+                [self.lighting.face::<A::Normals>(v); 3]
+            }
+        };
+        [0, 1, 2].map(|k| color_channels(shade(base[k], intensity[k])))
+    }
+
+    /// Transforms the three vertices `idx` to eye space, with colour attributes `colors`.
+    fn clip_vertices<A: Arithmetic<Transform = T>>(
+        &self,
+        idx: [u16; 3],
+        colors: [[I16F16; 3]; 3],
+    ) -> [ClipVertex; 3] {
+        let verts = self.instance.mesh.vertices();
         let zero = [I16F16::ZERO; 3];
         let v = idx.map(|i| verts.get(i as usize).unwrap_or(&zero));
-        let colors = if lit {
-            let base = self.vertex_colors(tri, idx);
-            let intensity = match mesh.normals() {
-                Some(n) => idx.map(|i| {
-                    self.lighting
-                        .vertex::<A::Normals>(n.get(i as usize).unwrap_or(&zero))
-                }),
-                None => [self.lighting.face::<A::Normals>(v); 3],
-            };
-            [0, 1, 2].map(|k| color_channels(shade(base[k], intensity[k])))
-        } else {
-            [[I16F16::ZERO; 3]; 3]
-        };
         [0, 1, 2].map(|k| ClipVertex {
             p: A::Transform::apply(&self.mv, v[k]),
             color: colors[k],
         })
     }
 
+    /// The cache entries of vertices `idx`, if the frame has a vertex cache.
+    fn cached<'c>(
+        &self,
+        cache: &'c [CachedVertex],
+        idx: [u16; 3],
+    ) -> Option<[&'c CachedVertex; 3]> {
+        let get = |i: u16| cache.get(self.first_vertex + i as usize);
+        Some([get(idx[0])?, get(idx[1])?, get(idx[2])?])
+    }
+
+    /// Fills this instance's part of the vertex cache: every vertex transformed, clip-tested
+    /// and (when inside) projected once, exactly as the uncached path does per triangle.
+    fn fill_cache<const S: u32, A: Arithmetic<Transform = T>>(
+        &self,
+        vp: &Viewport<S>,
+        cache: &mut [CachedVertex],
+    ) {
+        let verts = self.instance.mesh.vertices();
+        let slots = cache.iter_mut().skip(self.first_vertex);
+        for (slot, v) in slots.zip(verts) {
+            *slot = CachedVertex::new::<S, A::Projection>(vp, A::Transform::apply(&self.mv, v));
+        }
+    }
+
     /// Clips and projects triangle `tri`, calling `f` with each visible screen triangle (whose
-    /// depths are 0 unless `depth`).
+    /// depths are 0 unless `depth` or the vertex `cache`, when not empty, has them).
+    #[allow(clippy::too_many_arguments)]
     fn screen_triangles<const S: u32, C: Clipping, A: Arithmetic<Transform = T>>(
         &self,
         tri: usize,
+        cache: &[CachedVertex],
         vp: &Viewport<S>,
         cull: bool,
         lit: bool,
@@ -760,7 +821,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         let Some(&idx) = self.instance.mesh.triangles().get(tri) else {
             return Fate::Rejected;
         };
-        let cv = self.clip_vertices::<A>(tri, idx, lit);
+        let colors = self.vertex_attributes::<A>(tri, idx, lit);
         let (w, h) = (vp.width as i32, vp.height as i32);
         let mut first: Option<i32> = None;
         let mut culled = false;
@@ -781,25 +842,44 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         };
         let project = |c: &ClipVertex| vp.project_as::<A::Projection>(&c.p, c.color, depth);
         let mut polygon = ClipPolygon::new();
-        let clipped = match C::clip(vp, &cv, &mut polygon) {
-            Clipped::Outside => return Fate::Rejected,
-            Clipped::Skipped => return Fate::Unclipped,
-            Clipped::Inside => {
-                if let [Some(a), Some(b), Some(c)] = cv.each_ref().map(project) {
-                    emit([a, b, c]);
-                }
-                false
-            }
-            Clipped::Polygon => {
-                // Fan from the first vertex, projecting each vertex once as the fan reaches it.
-                let mut fan = polygon.iter().filter_map(project);
-                if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
-                    for c in fan {
-                        emit([a, b, c]);
-                        b = c;
+        let clipped = 'pieces: {
+            let cv = match self.cached(cache, idx) {
+                Some(c) => {
+                    if CachedVertex::all_outside_one_plane(c) {
+                        return Fate::Rejected;
                     }
+                    let screen = [0, 1, 2].map(|k| c[k].screen::<S>(colors[k]));
+                    if let [Some(a), Some(b), Some(d)] = screen {
+                        emit([a, b, d]);
+                        break 'pieces false;
+                    }
+                    [0, 1, 2].map(|k| ClipVertex {
+                        p: c[k].eye,
+                        color: colors[k],
+                    })
                 }
-                true
+                None => self.clip_vertices::<A>(idx, colors),
+            };
+            match C::clip(vp, &cv, &mut polygon) {
+                Clipped::Outside => return Fate::Rejected,
+                Clipped::Skipped => return Fate::Unclipped,
+                Clipped::Inside => {
+                    if let [Some(a), Some(b), Some(c)] = cv.each_ref().map(project) {
+                        emit([a, b, c]);
+                    }
+                    false
+                }
+                Clipped::Polygon => {
+                    // Fan from the first vertex, projecting each vertex once as the fan reaches it.
+                    let mut fan = polygon.iter().filter_map(project);
+                    if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
+                        for c in fan {
+                            emit([a, b, c]);
+                            b = c;
+                        }
+                    }
+                    true
+                }
             }
         };
         match first {
@@ -878,6 +958,22 @@ pub(crate) fn drive<
     let capacity = ws.refs.len().min(ws.next.len());
     let sorted = <R::Key as SortKey>::SORTED;
 
+    // The vertex cache, when the workspace has one and the scene's vertices fit it.
+    let vertices: usize = setups
+        .iter()
+        .map(|s| s.instance.mesh.vertices().len())
+        .sum();
+    let cache: &[CachedVertex] = match ws.vertices.get_mut(..vertices) {
+        Some(cache) if vertices > 0 => {
+            for setup in &setups {
+                setup.fill_cache::<SUB, A>(vp, cache);
+            }
+            stats.cached_vertices = vertices as u32;
+            cache
+        }
+        _ => &[],
+    };
+
     // Pass 1: file every visible triangle under its first row, in the order `order` gives
     // (reverse id order, which leaves each row's list in ascending id order, as pushing is at
     // the head). Depth sorting also keeps a key per triangle: its rank in `order` if that is a
@@ -893,6 +989,7 @@ pub(crate) fn drive<
         let depth = sorted && rank.is_none();
         let fate = setup.screen_triangles::<SUB, C, A>(
             tri,
+            cache,
             vp,
             options.cull_back_faces,
             false,
@@ -944,6 +1041,7 @@ pub(crate) fn drive<
         setups: &setups,
         refs: ws.refs,
         keys: ws.keys,
+        cache,
         vp,
         cull: options.cull_back_faces,
         stages: core::marker::PhantomData::<(C, A)>,
@@ -969,6 +1067,7 @@ struct MeshPieces<'a, 's, const SUB: u32, C, A: Arithmetic> {
     setups: &'a [InstanceSetup<'s, A::Transform>],
     refs: &'a [u16],
     keys: &'a [u32],
+    cache: &'a [CachedVertex],
     vp: &'a Viewport<SUB>,
     cull: bool,
     stages: core::marker::PhantomData<(C, A)>,
@@ -996,7 +1095,8 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> ActivePieces<SUB>
         } else {
             setup.face_color::<A::Normals>(tri, idx)
         };
-        setup.screen_triangles::<SUB, C, A>(tri, self.vp, self.cull, S::PER_VERTEX, true, |s| {
+        let (vp, cache) = (self.vp, self.cache);
+        setup.screen_triangles::<SUB, C, A>(tri, cache, vp, self.cull, S::PER_VERTEX, true, |s| {
             f(s, face, id as u32, key)
         });
     }
@@ -1200,6 +1300,7 @@ pub(crate) fn for_each_screen_piece<
             };
             let fate = setup.screen_triangles::<SUB, C, A>(
                 tri,
+                &[],
                 vp,
                 options.cull_back_faces,
                 S::PER_VERTEX,

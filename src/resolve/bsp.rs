@@ -364,6 +364,7 @@ impl<
             refs: &mut self.refs,
             keys: &mut self.keys,
             active: self.active.as_mut_view(),
+            vertices: &mut [],
         };
         let mut resolve = Painter {
             pixels,

@@ -247,6 +247,7 @@ impl<
             refs: &mut self.refs,
             keys: &mut [],
             active: self.active.as_mut_view(),
+            vertices: &mut [],
         };
         let mut band = Band {
             depth,
@@ -527,6 +528,7 @@ impl<
             refs: &mut self.refs,
             keys: &mut [],
             active: self.active.as_mut_view(),
+            vertices: &mut [],
         };
         let mut resolve = SpanSort {
             pixels,
@@ -681,6 +683,7 @@ impl<
             refs: &mut self.refs,
             keys: &mut self.keys,
             active: self.active.as_mut_view(),
+            vertices: &mut [],
         };
         let mut resolve = Painter {
             pixels,
