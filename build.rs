@@ -136,6 +136,9 @@ fn main() {
         "cargo::rustc-check-cfg=cfg(scanline3d_variant, values(\"fast\", \"balanced\", \"exact\", \"default\", \"bits0\", \"micromath\", \"narrowtransform\", \"reciprocal\", \"narrownormals\", \"depth16\", \"gouraudaffine\", \"gouraudsegments16\", \"gouraudsegments8\", \"gouraudperpixel\"))"
     );
     println!("cargo::rustc-check-cfg=cfg(scanline3d_corpus)");
+    // `examples/firmware.rs` with `--cfg scanline3d_vertex_cache` renders the demo with a
+    // vertex cache (`cargo xtask firmware` measures both).
+    println!("cargo::rustc-check-cfg=cfg(scanline3d_vertex_cache)");
     // The firmware example links with the runtime's link.x. On Arm, cortex-m-rt's link.x
     // includes memory.x from the linker search path (the top-level one). On RISC-V,
     // `.cargo/config.toml` passes memory-riscv-virt.x (QEMU virt's RAM, with the region

@@ -14,7 +14,9 @@
 //! the `minstret` counter counts every instruction. A calibration loop of known length checks
 //! the counter before anything is measured. Over semihosting the firmware prints one line per
 //! frame (hash, instructions, pixels), the inner span loop's cost and a summary with the stack
-//! high-water mark, then exits with status 0, or 1 on any error or panic.
+//! high-water mark, then exits with status 0, or 1 on any error or panic. Built with
+//! `--cfg scanline3d_vertex_cache` (through `cargo rustc`) it renders the same frames with a
+//! vertex cache holding every demo vertex.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -35,13 +37,20 @@ mod measure;
 mod firmware {
     use super::arch;
     use embedded_graphics::pixelcolor::Rgb565;
-    use scanline3d::demo::{self, PanelWorkspace};
+    use scanline3d::demo;
     use scanline3d::raster::PixelOrigin;
     use scanline3d::shading::{Shading, SpanDepth};
     use scanline3d::{Depth, Flat};
     use semihosting::println;
 
     use crate::measure::{self, _stack_start};
+
+    /// The demo's workspace; built with `--cfg scanline3d_vertex_cache` (`cargo xtask firmware`
+    /// does that too), with a vertex cache holding every demo vertex.
+    #[cfg(not(scanline3d_vertex_cache))]
+    type Ws = demo::PanelWorkspace;
+    #[cfg(scanline3d_vertex_cache)]
+    type Ws = demo::CachedPanelWorkspace<{ demo::PANEL_VERTICES }>;
 
     /// One flat span fill, called the way the renderer calls it: through row slices.
     #[inline(never)]
@@ -114,7 +123,7 @@ mod firmware {
         measure::paint_stack();
         let mut lines: [Option<FrameLine>; demo::ORBIT_FRAMES as usize] = Default::default();
         {
-            let mut ws = PanelWorkspace::new(demo::BACKGROUND.into());
+            let mut ws = Ws::new(demo::BACKGROUND.into());
             let instances = demo::instances();
             for (frame, line) in lines.iter_mut().enumerate() {
                 let frame = frame as u32;
@@ -169,7 +178,7 @@ mod firmware {
             "summary peak_stack {} static_ram {} renderer_ram {} max_bucketed {} max_active {}",
             peak_stack,
             measure::static_ram(),
-            PanelWorkspace::BYTES,
+            Ws::BYTES,
             max_bucketed,
             max_active
         );

@@ -121,15 +121,8 @@ pub const fn vertex_cache_bytes(vertices: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::project::tests::eye;
     use crate::project::{ExactDivision, Reciprocal};
-
-    fn eye(x: f32, y: f32, w: f32) -> EyePoint {
-        EyePoint {
-            x: I16F16::from_num(x),
-            y: I16F16::from_num(y),
-            w: I16F16::from_num(w),
-        }
-    }
 
     #[test]
     fn entries_match_the_uncached_projection() {
@@ -148,6 +141,13 @@ mod tests {
                 vp.project_as::<Reciprocal>(&p, c, true)
             );
         }
+    }
+
+    #[test]
+    fn an_entry_is_28_bytes() {
+        // Eye point (3 × 4), outcodes (1), screen x, y and depth (3 × 4), padded to 4.
+        assert_eq!(CachedVertex::BYTES, 28);
+        assert_eq!(vertex_cache_bytes(731), 20_468);
     }
 
     #[test]

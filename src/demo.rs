@@ -141,10 +141,27 @@ pub const PANEL_ACTIVE: usize = 63;
 /// Mesh instances in the demo ([`instances`] returns exactly this many).
 pub const PANEL_INSTANCES: usize = 3;
 
+/// Vertices of the demo's meshes together: what a vertex cache needs to hold them all.
+pub const PANEL_VERTICES: usize =
+    ICOSPHERE_VERTICES.len() + CUBE_VERTICES.len() + GROUND_VERTICES.len();
+
 /// The workspace the firmware examples use for the demo: RGB565 (an SPI panel's format), flat
 /// shading, 240×240, with exactly the capacities the orbit needs.
-pub type PanelWorkspace =
-    Workspace<Rgb565, Flat, WIDTH, HEIGHT, PANEL_TRIANGLES, PANEL_ACTIVE, PANEL_INSTANCES>;
+pub type PanelWorkspace = CachedPanelWorkspace<0>;
+
+/// [`PanelWorkspace`] with a vertex cache of `VERTS` entries ([`crate::cache`]);
+/// [`PANEL_VERTICES`] holds the whole demo.
+pub type CachedPanelWorkspace<const VERTS: usize> = Workspace<
+    Rgb565,
+    Flat,
+    WIDTH,
+    HEIGHT,
+    PANEL_TRIANGLES,
+    PANEL_ACTIVE,
+    PANEL_INSTANCES,
+    crate::Depth,
+    VERTS,
+>;
 
 /// What one demo frame produced on the hashing panel model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -157,9 +174,10 @@ pub struct PanelFrame {
 
 /// Renders `scene` (normally [`scene`] at some frame) into `ws`, hashing the rows as a
 /// frame-buffer-less panel would receive them. Firmware and host call this same function, so
-/// equal hashes mean bit-identical output across machines.
-pub fn render_panel_frame(
-    ws: &mut PanelWorkspace,
+/// equal hashes mean bit-identical output across machines. With or without a vertex cache the
+/// frames are the same.
+pub fn render_panel_frame<const VERTS: usize>(
+    ws: &mut CachedPanelWorkspace<VERTS>,
     scene: &Scene<'_>,
 ) -> Result<PanelFrame, RenderError<Infallible>> {
     let mut sink = HashSink::new();

@@ -300,10 +300,11 @@ impl<const S: u32> Viewport<S> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn eye(x: f32, y: f32, w: f32) -> EyePoint {
+    /// An eye-space point from floats (tests of the stages around projection use it too).
+    pub(crate) fn eye(x: f32, y: f32, w: f32) -> EyePoint {
         EyePoint {
             x: I16F16::from_num(x),
             y: I16F16::from_num(y),

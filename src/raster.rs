@@ -182,6 +182,12 @@ impl TriangleWalk {
         self.end_row as i32
     }
 
+    /// Whether the walk is past its last row (after [`Self::advance`] returned `false`).
+    #[inline]
+    pub fn is_done(&self) -> bool {
+        self.row >= self.end_row
+    }
+
     /// Moves to the next row; `false` when the triangle is finished.
     #[inline]
     pub fn advance<const S: u32>(&mut self) -> bool {
@@ -193,7 +199,10 @@ impl TriangleWalk {
         if self.row == self.mid_row {
             match EdgeWalk::new::<S>(self.lower[0], self.lower[1], self.row as i32) {
                 Some(e) => self.short = e,
-                None => return false,
+                None => {
+                    self.row = self.end_row;
+                    return false;
+                }
             }
         } else {
             self.short.step();

@@ -359,18 +359,40 @@ struct SpanZBuffer<'a, P, Z> {
     pixels: &'a mut [P],
     background: P,
     spans: u16,
+    /// Columns `[lo, hi)` written since the row was last cleared: only they need clearing
+    /// again (the whole row at the start of a frame).
+    dirty: (usize, usize),
+}
+
+impl<'a, P: RowPixel, Z: DepthFormat> SpanZBuffer<'a, P, Z> {
+    fn new(depth: &'a mut [Z], pixels: &'a mut [P], background: P) -> Self {
+        let width = pixels.len();
+        SpanZBuffer {
+            depth,
+            pixels,
+            background,
+            spans: 0,
+            dirty: (0, width),
+        }
+    }
 }
 
 impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for SpanZBuffer<'_, P, Z> {
     type Key = ();
     fn begin_band(&mut self, _: i32, _: usize) {
-        self.depth.fill(Z::FAR);
-        self.pixels.fill(self.background);
+        let (lo, hi) = self.dirty;
+        if let (Some(d), Some(p)) = (self.depth.get_mut(lo..hi), self.pixels.get_mut(lo..hi)) {
+            d.fill(Z::FAR);
+            p.fill(self.background);
+        }
+        self.dirty = (self.pixels.len(), 0);
         self.spans = 0;
     }
     #[inline(always)]
     fn span(&mut self, t: &ActiveTri<S::Payload<P>>, _: usize, y: i32, l: i32, r: i32) -> u32 {
         self.spans += 1;
+        // walk_band clamps spans to [0, width) and passes only non-empty ones.
+        self.dirty = (self.dirty.0.min(l as usize), self.dirty.1.max(r as usize));
         fill_span::<P, S, Z, ()>(t, y, l, r, self.depth, self.pixels)
     }
     fn finish_row(&mut self, _: i32) -> FinishedRow<'_, P> {
@@ -651,12 +673,7 @@ impl<
             active: self.active.as_mut_view(),
             vertices: &mut self.vertices,
         };
-        let mut resolve = SpanZBuffer {
-            depth,
-            pixels,
-            background: self.background,
-            spans: 0,
-        };
+        let mut resolve = SpanZBuffer::new(depth, pixels, self.background);
         drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _>(
             frame,
             &mut resolve,
@@ -1127,6 +1144,10 @@ pub(crate) fn walk_rows<
     active.clear();
     // Last row covered by any dropped piece so far: rows up to it are incomplete.
     let mut lost_until = -1i32;
+    // One row at a time, finished triangles stay in the list, marked done, until they are as
+    // many as the rest (or room is needed): removing each at once would move every triangle
+    // behind it, about 100 bytes each, on every row where one ends.
+    let mut done = 0usize;
     let mut y0 = 0usize;
     while y0 < height {
         let y1 = (y0 + band).min(height);
@@ -1161,6 +1182,10 @@ pub(crate) fn walk_rows<
                     };
                     let (first_row, last_row) =
                         (tri_state.walk.row(), tri_state.walk.end_row() - 1);
+                    if band == 1 && active.is_full() && done > 0 {
+                        active.retain(|t| !t.walk.is_done());
+                        done = 0;
+                    }
                     let kept = if band > 1 {
                         // Band z-buffer: draw it into the band now; keep it only if it reaches
                         // the next band (so a full z-buffer keeps nothing).
@@ -1197,12 +1222,21 @@ pub(crate) fn walk_rows<
                 });
             }
             if band == 1 {
-                stats.peak_active = stats.peak_active.max(active.len() as u16);
-                let mut order = 0;
-                active.retain_mut(|t| {
-                    order += 1;
-                    walk_band::<P, S, SUB, R>(t, order - 1, y + 1, width, resolve, &mut stats)
-                });
+                let live = active.len() - done;
+                stats.peak_active = stats.peak_active.max(live as u16);
+                // `order` is the place in the list: it grows with activation order, done
+                // triangles only leave gaps.
+                for (order, t) in active.iter_mut().enumerate() {
+                    if !t.walk.is_done()
+                        && !walk_band::<P, S, SUB, R>(t, order, y + 1, width, resolve, &mut stats)
+                    {
+                        done += 1;
+                    }
+                }
+                if done > 0 && done >= active.len() - done {
+                    active.retain(|t| !t.walk.is_done());
+                    done = 0;
+                }
             }
         }
         if band > 1 {
