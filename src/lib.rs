@@ -46,7 +46,8 @@
 //!
 //! [`scene`] → [`vertex`] (transform, lighting) → [`clip`] → [`project`] → [`raster`] (setup,
 //! edge walk) → [`render`] (buckets, active list, span z-buffer in a [`depth`] format) with
-//! [`shading`] → [`sink`].
+//! [`shading`] → [`sink`]. An optional [`cache`] keeps each vertex's transform and projection
+//! for the frame, trading RAM for set-up time.
 //!
 //! ## Rules
 //!
