@@ -1,7 +1,9 @@
 //! Host speed of the precision variants (`docs/tradeoff.md`): every variant of
 //! `scanline3d_sim::tradeoff::VARIANTS` on every corpus scene from its first camera, at 240×240,
-//! into the hashing panel model. `cargo bench --bench tradeoff`; `cargo xtask tradeoff` reads
-//! `target/criterion/tradeoff/<variant>/<scene>/new/estimates.json`.
+//! into the hashing panel model; and each Gouraud interpolation mode on the demo orbit (whose
+//! instructions the same table counts). `cargo bench --bench tradeoff`; `cargo xtask tradeoff`
+//! reads `target/criterion/tradeoff/<variant>/<scene>/new/estimates.json` and
+//! `target/criterion/tradeoff-gouraud/<mode>/demo-orbit/new/estimates.json`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
@@ -11,10 +13,12 @@ use scanline3d::preset::{Arithmetic, Frugal, Precise, Quick, Setup};
 use scanline3d::project::{ExactDivision, Reciprocal};
 use scanline3d::render::MAX_INSTANCES;
 use scanline3d::scene::Scene;
+use scanline3d::shading::{Affine, Interpolation, PerPixel, PerSegment};
 use scanline3d::sink::HashSink;
 use scanline3d::vertex::{NarrowTransform, WideTransform};
-use scanline3d::{Depth, Flat, RenderOptions, Workspace};
+use scanline3d::{demo, Depth, Flat, Gouraud, RenderOptions, Workspace};
 use scanline3d_sim::corpus;
+use scanline3d_sim::interpolation::Mode;
 use scanline3d_sim::scene::{DepthChoice, LightSpec, SceneSpec, SetupArith};
 use scanline3d_sim::tradeoff::VARIANTS;
 use std::hint::black_box;
@@ -99,5 +103,44 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+/// One demo orbit (every frame) with `Gouraud<I>`, as `examples/tradeoff.rs` renders it on the
+/// targets.
+fn time_gouraud<I: Interpolation>(group: &mut Group<'_>, mode: Mode) {
+    type GouraudWs<I> =
+        Workspace<Rgb565, Gouraud<I>, 240, 240, 640, 80, { demo::PANEL_INSTANCES }, Depth>;
+    let mut ws: Box<GouraudWs<I>> = Box::new(Workspace::new(Rgb565::BLACK));
+    let instances = demo::instances();
+    let scenes: Vec<Scene<'_>> = (0..demo::ORBIT_FRAMES)
+        .map(|f| demo::scene(&instances, f, demo::ORBIT_FRAMES).expect("demo scene"))
+        .collect();
+    let options = RenderOptions::default();
+    group.bench_function(BenchmarkId::new(mode.name(), "demo-orbit"), |b| {
+        b.iter(|| {
+            let mut sink = HashSink::new();
+            for scene in &scenes {
+                black_box(ws.render(scene, &options, &mut sink).ok());
+            }
+            sink.hash()
+        })
+    });
+}
+
+fn bench_gouraud(c: &mut Criterion) {
+    let mut group = c.benchmark_group("tradeoff-gouraud");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_millis(1000));
+    for mode in Mode::ALL {
+        match mode {
+            Mode::Affine => time_gouraud::<Affine>(&mut group, mode),
+            Mode::Segments16 => time_gouraud::<PerSegment<16>>(&mut group, mode),
+            Mode::Segments8 => time_gouraud::<PerSegment<8>>(&mut group, mode),
+            Mode::PerPixel => time_gouraud::<PerPixel>(&mut group, mode),
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench, bench_gouraud);
 criterion_main!(benches);

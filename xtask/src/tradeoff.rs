@@ -157,10 +157,10 @@ fn gouraud_section(
 ) {
     line("## Gouraud attribute interpolation".into());
     line(String::new());
-    line(format!("`Gouraud<I>` with `I` one of `shading::Affine` (the default), `PerSegment<16>`, `PerSegment<8>` and `PerPixel`; everything else as `RenderOptions::default()`. **Colour error:** every corpus scene from every camera ({} views) at {SIZE}×{SIZE}, each vertex a different colour (`interpolation::vertex_color`), against the f64 reference, which blends the vertex colours by the hit point's barycentric coordinates in space (`reference::Scene::with_vertex_colors`); channel differences over the pixels where both show the same triangle. **Cost:** the demo orbit with Gouraud shading on QEMU, as above (its sphere has vertex normals, so its colours vary across triangles; the corpus carries no vertex colours on firmware); every frame hash equals the host's.", errors.len() / Mode::ALL.len().max(1)));
+    line(format!("`Gouraud<I>` with `I` one of `shading::Affine` (the default), `PerSegment<16>`, `PerSegment<8>` and `PerPixel`; everything else as `RenderOptions::default()`. **Colour error:** every corpus scene from every camera ({} views) at {SIZE}×{SIZE}, each vertex a different colour (`interpolation::vertex_color`), against the f64 reference, which blends the vertex colours by the hit point's barycentric coordinates in space (`reference::Scene::with_vertex_colors`); channel differences over the pixels where both show the same triangle. **Cost:** the demo orbit with Gouraud shading on QEMU, as above (its sphere has vertex normals, so its colours vary across triangles; the corpus carries no vertex colours on firmware); every frame hash equals the host's. **Host time:** criterion (`cargo bench --bench tradeoff`, group `tradeoff-gouraud`), the whole 8-frame orbit, divided by 8.", errors.len() / Mode::ALL.len().max(1)));
     line(String::new());
-    line("| interpolation | mean channel error | worst view, mean | worst pixel | worst view PSNR | thumbv7em instr./frame | thumbv6m instr./frame | thumbv6m vs affine | flash thumbv7em / thumbv6m | RAM (workspace) |".into());
-    line("|---|---|---|---|---|---|---|---|---|---|".into());
+    line("| interpolation | mean channel error | worst view, mean | worst pixel | worst view PSNR | thumbv7em instr./frame | thumbv6m instr./frame | thumbv6m vs affine | host time per demo frame | flash thumbv7em / thumbv6m | RAM (workspace) |".into());
+    line("|---|---|---|---|---|---|---|---|---|---|---|".into());
     let affine_v6m = cost
         .get(&(Mode::Affine, TARGETS[1]))
         .map_or(1.0, |d| d.instructions);
@@ -176,8 +176,17 @@ fn gouraud_section(
         let at = |t: &'static str| cost.get(&(mode, t));
         let instr =
             |t: &'static str| at(t).map_or("n/a".into(), |d| thousands(d.instructions as u64));
+        let host = criterion_mean_ns_of("tradeoff-gouraud", mode.name(), "demo-orbit").map_or(
+            "n/a".into(),
+            |ns| {
+                format!(
+                    "{:.1} µs",
+                    ns / 1000.0 / scanline3d::demo::ORBIT_FRAMES as f64
+                )
+            },
+        );
         line(format!(
-            "| {} | {mean:.3} | {worst_view:.3} | {worst_pixel} | {psnr:.1} dB | {} | {} | {} | {} | {} |",
+            "| {} | {mean:.3} | {worst_view:.3} | {worst_pixel} | {psnr:.1} dB | {} | {} | {} | {host} | {} | {} |",
             mode.name(),
             instr(TARGETS[0]),
             instr(TARGETS[1]),
