@@ -13,17 +13,18 @@
 //! # Exact edge walking
 //!
 //! Internally coordinates are doubled (`2^-(S+1)` pixel units) so pixel centres, at odd
-//! multiples of `2^S`, are integers even with zero sub-pixel bits. An edge is pre-stepped to the
-//! first centre row with one i64 division, then walks down one row at a time with an integer
-//! quotient and a remainder (the classic DDA of Bresenham/Pineda, exact rational arithmetic):
-//! no drift and no accumulated rounding, whatever the edge's length.
+//! multiples of `2^S`, are integers even with zero sub-pixel bits. An edge is set up with one
+//! 32-bit division (its slope as quotient and remainder), pre-stepped to the first centre row
+//! below its upper end with comparisons, then walks down one row at a time with that quotient
+//! and a remainder (the classic DDA of Bresenham/Pineda, exact rational arithmetic): no drift
+//! and no accumulated rounding, whatever the edge's length.
 //!
 //! # Bit budget
 //!
 //! Vertices are within ±2^22 sub-pixels ([`crate::project`]), so doubled coordinates are below
-//! 2^23 and their differences below 2^24. Prestep numerators are below 2^49 (i64); the per-row
-//! remainder is below `dy < 2^24` and `rem + step < 2^25` (i32). Attribute planes are solved in
-//! i128 once per triangle and stepped in i64 (depth) or i32 (colour).
+//! 2^23 and their differences below 2^24 (i32). Prestep numerators are below 2^49 (i64); the
+//! per-row remainder is below `dy < 2^24` and `rem + step < 2^25` (i32). Attribute planes are
+//! solved in i128 once per triangle and stepped in i64 (depth) or i32 (colour).
 
 use crate::project::{Depth, ScreenVertex};
 use core::cmp::Ordering;
@@ -52,28 +53,39 @@ impl EdgeWalk {
     /// The edge from `a` to `b` (sub-pixel `(x, y)`, `a.y < b.y`) positioned on `row`.
     /// `None` if the edge is horizontal or upside down.
     pub fn new<const S: u32>(a: (i32, i32), b: (i32, i32), row: i32) -> Option<EdgeWalk> {
-        let (ax, ay) = (2 * a.0 as i64, 2 * a.1 as i64);
-        let dx = 2 * (b.0 as i64 - a.0 as i64);
-        let dy = 2 * (b.1 as i64 - a.1 as i64);
+        // Doubled differences are below 2^24, so the slope's quotient and remainder take one
+        // 32-bit division (a single SDIV, or a 32-bit library call on thumbv6m).
+        let dx = 2 * (b.0 - a.0);
+        let dy = 2 * (b.1 - a.1);
         if dy <= 0 {
             return None;
         }
-        let yc = (2 * row as i64 + 1) << S;
-        // Edge x at the row centre is ax + (yc − ay)·dx/dy. The first centre (2c + 1)·2^S at or
-        // right of it has c = ceil(num / den):
-        let num = (ax - (1i64 << S)) * dy + (yc - ay) * dx;
-        let den = dy << (S + 1);
-        let biased = num + den - 1;
-        let x = biased.div_euclid(den);
-        // The remainder's low S+1 bits never change while stepping (every increment is a
-        // multiple of 2^(S+1)), so only its high part, in [0, dy), is tracked.
-        let rem = biased.rem_euclid(den) >> (S + 1);
+        let (step, step_rem) = (dx.div_euclid(dy), dx.rem_euclid(dy));
+        // Edge x at the row centre is ax + t·dx/dy with t = yc − ay. The first centre
+        // (2c + 1)·2^S at or right of it has c = ceil(num / den), where
+        // num = (ax − 2^S)·dy + t·dx and den = dy·2^(S+1). With dx = step·dy + step_rem:
+        // num = dy·p + t·step_rem, p = ax − 2^S + t·step. Splitting p = pq·2^(S+1) + pr leaves
+        // c = pq + ceil(m' / den) with m' = dy·pr + t·step_rem, and 0 <= m' < 3·den when the
+        // row is the first at or below `a` (0 <= t < 2^(S+1)), the case of every triangle walk:
+        // the quotient is then 0, 1 or 2, found by comparison instead of a second division.
+        let t = (((2 * row as i64) + 1) << S) - 2 * a.1 as i64;
+        let p = 2 * a.0 as i64 - (1i64 << S) + t * step as i64;
+        let den = (dy as i64) << (S + 1);
+        let m = (dy as i64) * (p & ((1i64 << (S + 1)) - 1)) + t * step_rem as i64 + den - 1;
+        let (k, r) = if (0..3 * den).contains(&m) {
+            let k = (m >= den) as i64 + (m >= 2 * den) as i64;
+            (k, m - k * den)
+        } else {
+            (m.div_euclid(den), m.rem_euclid(den))
+        };
         Some(EdgeWalk {
-            x: x as i32,
-            rem: rem as i32,
-            step: dx.div_euclid(dy) as i32,
-            step_rem: dx.rem_euclid(dy) as i32,
-            dy: dy as i32,
+            x: ((p >> (S + 1)) + k) as i32,
+            // The remainder's low S+1 bits never change while stepping (every increment is a
+            // multiple of 2^(S+1)), so only its high part, in [0, dy), is tracked.
+            rem: (r >> (S + 1)) as i32,
+            step,
+            step_rem,
+            dy,
         })
     }
 
@@ -662,6 +674,64 @@ mod tests {
             assert_eq!(cross_diff(a, b, c, d), wide(a, b, c, d), "{a} {b} {c} {d}");
         }
     }
+    /// The edge set-up (one 32-bit division, comparisons for the first row) places and steps
+    /// the edge exactly: on every row, `column()` is the smallest c whose centre is at or right
+    /// of the edge, found here by the exact cross-product test, for rows next to `a`, far below
+    /// it and above it, with each sub-pixel precision.
+    #[test]
+    fn edge_walk_matches_exact_columns() {
+        fn check<const S: u32>(a: (i32, i32), b: (i32, i32), row: i32) {
+            let Some(mut e) = EdgeWalk::new::<S>(a, b, row) else {
+                assert!(b.1 <= a.1);
+                return;
+            };
+            // Centre c is at or right of the edge on row r iff
+            // (xc − ax)·dy >= (yc − ay)·dx (dy > 0), all in doubled units.
+            let at_or_right = |c: i64, r: i64| {
+                let (xc, yc) = ((2 * c + 1) << S, (2 * r + 1) << S);
+                let (ax, ay) = (2 * a.0 as i64, 2 * a.1 as i64);
+                let (dx, dy) = (2 * (b.0 - a.0) as i64, 2 * (b.1 - a.1) as i64);
+                (xc - ax) * dy >= (yc - ay) * dx
+            };
+            for r in row..row + 5 {
+                let c = e.column() as i64;
+                assert!(
+                    at_or_right(c, r as i64),
+                    "{a:?} {b:?} row {r}: {c} left of edge"
+                );
+                assert!(
+                    !at_or_right(c - 1, r as i64),
+                    "{a:?} {b:?} row {r}: {c} not first"
+                );
+                e.step();
+            }
+        }
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let lim = 1i64 << 22;
+        for i in 0..40_000 {
+            // Coordinates from tiny to the ±2^22 limit.
+            let shift = (next() % 23) as u32;
+            let mut coord = || ((next() as i64).rem_euclid(2 * lim) - lim) as i32 >> shift;
+            let a = (coord(), coord());
+            let b = (coord(), coord().max(a.1));
+            let first = |s: u32| (a.1 as i64 >> s) as i32;
+            let offset = match i % 4 {
+                0 | 1 => 0,
+                2 => (next() % 1000) as i32,
+                _ => -((next() % 1000) as i32),
+            };
+            check::<0>(a, b, first(0) + offset);
+            check::<4>(a, b, first(4) + offset);
+            check::<8>(a, b, first(8) + offset);
+        }
+    }
+
     use std::vec::Vec;
 
     /// Independent reference: exact edge functions with the top-left tie rule.
