@@ -7,6 +7,8 @@
 //!   sub-pixel bits) into a `FrameBuffer` of the whole frame (every row is written).
 //! * `ours-cached`: the same with a vertex cache (`VERTS` = 16384): each vertex transformed
 //!   and projected once per frame instead of once per triangle and pass; the same pixels.
+//! * `ours-exact`: the default `Workspace` with the `Exact` preset (8 sub-pixel bits, exact
+//!   set-up arithmetic): our most accurate frame.
 //! * `euc`: clear colour and depth buffers, draw the triangle list with per-vertex colours.
 //! * `embedded-3dgfx`: clear the frame, record + execute one solid mesh per triangle (its solid
 //!   mode has one colour per mesh, so per-face colours, as ours draws them, need that).
@@ -19,6 +21,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
+use scanline3d::preset::{Exact, Preset};
 use scanline3d::sink::FrameBuffer;
 use scanline3d::{Depth, Flat, RenderOptions, Workspace};
 use scanline3d_sim::corpus;
@@ -72,6 +75,17 @@ fn bench(c: &mut Criterion) {
             group.bench_function(BenchmarkId::new("ours-cached", name), |b| {
                 b.iter(|| {
                     let stats = cached.render(s, &options, &mut FrameBuffer::new(&mut frame, W));
+                    black_box(stats.ok());
+                })
+            });
+            let exact = Exact::options().with_back_face_culling(spec.cull_back_faces);
+            let stats = ours
+                .render(s, &exact, &mut FrameBuffer::new(&mut frame, W))
+                .expect("ours renders the corpus");
+            assert!(stats.is_complete(), "{name}: incomplete frame");
+            group.bench_function(BenchmarkId::new("ours-exact", name), |b| {
+                b.iter(|| {
+                    let stats = ours.render(s, &exact, &mut FrameBuffer::new(&mut frame, W));
                     black_box(stats.ok());
                 })
             });

@@ -65,7 +65,7 @@ impl EdgeWalk {
         // (2c + 1)·2^S at or right of it has c = ceil(num / den), where
         // num = (ax − 2^S)·dy + t·dx and den = dy·2^(S+1). With dx = step·dy + step_rem:
         // num = dy·p + t·step_rem, p = ax − 2^S + t·step. Splitting p = pq·2^(S+1) + pr leaves
-        // c = pq + ceil(m' / den) with m' = dy·pr + t·step_rem, and 0 <= m' < 3·den when the
+        // c = pq + ceil(m' / den) with m' = dy·pr + t·step_rem, and 0 <= m' < 2·den when the
         // row is the first at or below `a` (0 <= t < 2^(S+1)), the case of every triangle walk:
         // the quotient is then 0, 1 or 2, found by comparison instead of a second division.
         let t = (((2 * row as i64) + 1) << S) - 2 * a.1 as i64;

@@ -18,7 +18,7 @@
 
 use crate::metrics::{self, ErrorBound, Metrics};
 use crate::reference::{self, Image};
-use crate::scene::SceneSpec;
+use crate::scene::{Algorithm, PresetChoice, SceneSpec};
 use embedded_3dgfx::pipeline::command_buffer::CommandBuffer;
 use embedded_3dgfx::pipeline::renderer::FrameCtx;
 use embedded_3dgfx::pipeline::vertex::mesh::{Geometry, K3dMesh, RenderMode};
@@ -617,6 +617,8 @@ pub struct Row {
     pub reference_covered: usize,
     /// Ours: the default span z-buffer at 4 sub-pixel bits, as `accuracy` computes it.
     pub ours: Outcome,
+    /// Ours with the `Exact` preset (8 sub-pixel bits), our most accurate frame.
+    pub ours_exact: Outcome,
     /// Each peer, in [`Peer::ALL`] order.
     pub peers: Vec<(Peer, Outcome)>,
 }
@@ -718,6 +720,13 @@ pub fn compare_scene(
         &reference,
         &b,
     );
+    let ours_exact = outcome(
+        spec.render_fixed_preset(w, h, PresetChoice::Exact, Algorithm::SpanZBuffer)
+            .map(|r| r.image),
+        &ref_img,
+        &reference,
+        &b,
+    );
     let peers = Peer::ALL
         .iter()
         .map(|&p| {
@@ -732,6 +741,7 @@ pub fn compare_scene(
         camera,
         reference_covered: covered(&ref_img),
         ours,
+        ours_exact,
         peers,
     })
 }
@@ -770,8 +780,9 @@ pub fn format_table(rows: &[Row]) -> String {
         "depth rel"
     );
     for r in rows {
-        let all =
-            std::iter::once(("ours", &r.ours)).chain(r.peers.iter().map(|(p, o)| (p.name(), o)));
+        let all = [("ours", &r.ours), ("ours-exact", &r.ours_exact)]
+            .into_iter()
+            .chain(r.peers.iter().map(|(p, o)| (p.name(), o)));
         for (name, o) in all {
             match &o.metrics {
                 Ok(m) => {

@@ -68,6 +68,19 @@ fn every_corpus_scene_has_a_row_for_every_peer() {
         // Ours is judged by the same bound and must pass it (as the accuracy test checks).
         let ours = r.ours.metrics.as_ref().expect("ours renders every scene");
         assert_eq!(ours.real, 0, "{} cam {}: ours", r.scene, r.camera);
+        // The `Exact` row is the preset the trade table holds to 0 real and <= 0.1 %.
+        let exact = r
+            .ours_exact
+            .metrics
+            .as_ref()
+            .expect("Exact renders every scene");
+        assert_eq!(exact.real, 0, "{} cam {}: ours, Exact", r.scene, r.camera);
+        assert!(
+            exact.id_mismatch_percent() <= 0.1,
+            "{} cam {}: {exact}",
+            r.scene,
+            r.camera
+        );
         assert!(r.reference_covered > 500, "{} cam {}", r.scene, r.camera);
         for (p, o) in &r.peers {
             // A failed render is a row with its reason, never a missing row.

@@ -581,6 +581,7 @@ fn peers() -> Result<(), String> {
     let renderers = [
         "ours",
         "ours-cached",
+        "ours-exact",
         "euc",
         "embedded-3dgfx",
         "embedded-3dgfx-1mesh",
@@ -594,7 +595,7 @@ fn peers() -> Result<(), String> {
     line(String::new());
     line("Written by `cargo xtask peers` (also run by `cargo xtask tradeoff`); do not edit by hand. Every corpus scene at 240×240, rendered by".into());
     line(format!(
-        "scanline3d's default (`Workspace`: span z-buffer, flat shading, 4 sub-pixel bits; also with a vertex cache, `VERTS` = 16384, which renders the same pixels) and by the peers a user would otherwise pick: [`euc`](https://crates.io/crates/euc) {} and [`embedded-3dgfx`](https://crates.io/crates/embedded-3dgfx) {}. How the peers are driven (id images through per-triangle colours, cameras, what is set up once) is in `sim/src/peers.rs`.",
+        "scanline3d's default (`Workspace`: span z-buffer, flat shading, 4 sub-pixel bits; also with a vertex cache, `VERTS` = 16384, which renders the same pixels, and with the `Exact` preset, 8 sub-pixel bits, our most accurate frame) and by the peers a user would otherwise pick: [`euc`](https://crates.io/crates/euc) {} and [`embedded-3dgfx`](https://crates.io/crates/embedded-3dgfx) {}. How the peers are driven (id images through per-triangle colours, cameras, what is set up once) is in `sim/src/peers.rs`.",
         peers::EUC_VERSION,
         peers::EMBEDDED_3DGFX_VERSION
     ));
@@ -607,47 +608,50 @@ fn peers() -> Result<(), String> {
     line(String::new());
     line("## Time per frame".into());
     line(String::new());
-    line("Ratios = the peer's time / ours, then / ours with the vertex cache (above 1: ours is faster). The vertex cache (`scanline3d::cache`) costs 28 bytes per vertex and changes no pixel (`sim/tests/vertex_cache.rs`), so ours-cached has the accuracy of ours below. `embedded-3dgfx` draws one mesh per triangle, the only way it has to give each face its own colour as ours does; `embedded-3dgfx-1mesh` draws the whole scene as one mesh in one colour, its cheapest frame, for scale (not the same picture).".into());
+    line("Ratios = the peer's time / ours, then / ours with the vertex cache, then / ours with the `Exact` preset (above 1: ours is faster). The vertex cache (`scanline3d::cache`) costs 28 bytes per vertex and changes no pixel (`sim/tests/vertex_cache.rs`), so ours-cached has the accuracy of ours below. `embedded-3dgfx` draws one mesh per triangle, the only way it has to give each face its own colour as ours does; `embedded-3dgfx-1mesh` draws the whole scene as one mesh in one colour, its cheapest frame, for scale (not the same picture).".into());
     line(String::new());
     line(
-        "| scene | ours | ours, vertex cache | euc | embedded-3dgfx | embedded-3dgfx-1mesh |"
+        "| scene | ours | ours, vertex cache | ours, Exact | euc | embedded-3dgfx | embedded-3dgfx-1mesh |"
             .into(),
     );
-    line("|---|---|---|---|---|---|".into());
-    let (mut slower, mut slower_cached) = (Vec::new(), Vec::new());
+    line("|---|---|---|---|---|---|---|".into());
+    let mut slower = [Vec::new(), Vec::new(), Vec::new()];
     for scene in &scenes {
         let times: Vec<Option<f64>> = renderers
             .iter()
             .map(|r| criterion_mean_ns_of("peers", r, scene))
             .collect();
-        let ours = times[0].ok_or_else(|| format!("no criterion result for ours/{scene}"))?;
-        let cached =
-            times[1].ok_or_else(|| format!("no criterion result for ours-cached/{scene}"))?;
-        let mut cells = vec![
-            format!("{:.1} µs", ours / 1000.0),
-            format!("{:.1} µs", cached / 1000.0),
-        ];
-        for (r, t) in renderers.iter().zip(&times).skip(2) {
+        let ours: Vec<f64> = renderers[..3]
+            .iter()
+            .zip(&times)
+            .map(|(r, t)| t.ok_or_else(|| format!("no criterion result for {r}/{scene}")))
+            .collect::<Result<_, _>>()?;
+        let mut cells: Vec<String> = ours
+            .iter()
+            .map(|t| format!("{:.1} µs", t / 1000.0))
+            .collect();
+        for (r, t) in renderers.iter().zip(&times).skip(3) {
             let t = t.ok_or_else(|| format!("no criterion result for {r}/{scene}"))?;
-            let (ratio, ratio_cached) = (t / ours, t / cached);
-            if ratio < 2.0 {
-                slower.push(format!("{r} on {scene}: {ratio:.2}×"));
+            let ratios: Vec<f64> = ours.iter().map(|o| t / o).collect();
+            for (list, ratio) in slower.iter_mut().zip(&ratios) {
+                if *ratio < 2.0 {
+                    list.push(format!("{r} on {scene}: {ratio:.2}×"));
+                }
             }
-            if ratio_cached < 2.0 {
-                slower_cached.push(format!("{r} on {scene}: {ratio_cached:.2}×"));
-            }
-            cells.push(format!(
-                "{:.1} µs ({ratio:.2}× · {ratio_cached:.2}×)",
-                t / 1000.0
-            ));
+            let ratios: Vec<String> = ratios.iter().map(|x| format!("{x:.2}×")).collect();
+            cells.push(format!("{:.1} µs ({})", t / 1000.0, ratios.join(" · ")));
         }
         line(format!("| {scene} | {} |", cells.join(" | ")));
     }
     line(String::new());
     for (what, list) in [
-        ("ours", &slower),
-        ("ours with the vertex cache", &slower_cached),
-    ] {
+        "ours",
+        "ours with the vertex cache",
+        "ours with the `Exact` preset",
+    ]
+    .iter()
+    .zip(&slower)
+    {
         if list.is_empty() {
             line(format!(
                 "{what}: at least 2× faster than every peer on every scene."
@@ -674,6 +678,8 @@ fn peers() -> Result<(), String> {
                 .map(|r| {
                     if name == "ours" {
                         &r.ours
+                    } else if name == "ours, Exact" {
+                        &r.ours_exact
                     } else {
                         &r.peers
                             .iter()
@@ -684,7 +690,7 @@ fn peers() -> Result<(), String> {
                 })
                 .collect()
         };
-        for name in ["ours", "euc", "embedded-3dgfx"] {
+        for name in ["ours", "ours, Exact", "euc", "embedded-3dgfx"] {
             let o = outcomes(name);
             let failed: Vec<&str> = o
                 .iter()
