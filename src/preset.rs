@@ -23,7 +23,7 @@
 //! time, flash), with the default and single-knob variations beside the presets. On thumbv6m,
 //! which multiplies and divides 64-bit integers in software, `Fast` takes about 1.6× fewer
 //! instructions per demo frame than `Exact`. [`Micromath`] set-up is in no preset: its camera
-//! error moves vertices beyond the sub-pixel error bound (real mismatches) and saves 1.5–2.2 KB
+//! error moves vertices beyond the sub-pixel error bound (real mismatches) and saves 1.7–2.2 KB
 //! of flash.
 //!
 //! A preset gives the [`RenderOptions`] and the [`Camera`] of a frame:
