@@ -674,6 +674,7 @@ mod tests {
             assert_eq!(cross_diff(a, b, c, d), wide(a, b, c, d), "{a} {b} {c} {d}");
         }
     }
+
     /// The edge set-up (one 32-bit division, comparisons for the first row) places and steps
     /// the edge exactly: on every row, `column()` is the smallest c whose centre is at or right
     /// of the edge, found here by the exact cross-product test, for rows next to `a`, far below
