@@ -16,7 +16,8 @@ use scanline3d::scene::Scene;
 use scanline3d::shading::{Affine, Interpolation, PerPixel, PerSegment};
 use scanline3d::sink::HashSink;
 use scanline3d::vertex::{NarrowTransform, WideTransform};
-use scanline3d::{demo, Depth, Flat, Gouraud, RenderOptions, Workspace};
+use scanline3d_demo as demo;
+use scanline3d::{Depth, Flat, Gouraud, RenderOptions, Workspace};
 use scanline3d_sim::corpus;
 use scanline3d_sim::interpolation::Mode;
 use scanline3d_sim::scene::{DepthChoice, LightSpec, SceneSpec, SetupArith};
@@ -103,7 +104,7 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-/// One demo orbit (every frame) with `Gouraud<I>`, as `examples/tradeoff.rs` renders it on the
+/// One demo orbit (every frame) with `Gouraud<I>`, as `firmware/examples/tradeoff.rs` renders it on the
 /// targets.
 fn time_gouraud<I: Interpolation>(group: &mut Group<'_>, mode: Mode) {
     type GouraudWs<I> =

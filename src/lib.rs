@@ -87,7 +87,6 @@ extern crate std;
 
 pub mod cache;
 pub mod clip;
-pub mod demo;
 pub mod depth;
 pub mod math;
 pub mod preset;

@@ -634,7 +634,8 @@ impl<
     ///
     /// ```
     /// use embedded_graphics::pixelcolor::Gray8;
-    /// use scanline3d::{demo, sink::FnSink, Flat, RenderOptions, Workspace};
+    /// use scanline3d_demo as demo;
+    /// use scanline3d::{sink::FnSink, Flat, RenderOptions, Workspace};
     /// let mut ws: Box<Workspace<Gray8, Flat, 320, 240, 1536, 96>> = Box::new(Workspace::new(Gray8::new(0)));
     /// let instances = demo::instances();
     /// let scene = demo::scene(&instances, 0, demo::ORBIT_FRAMES)?;

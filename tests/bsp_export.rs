@@ -1,9 +1,9 @@
-//! The BSP tree `sim export --bsp` writes as `static` data (`examples/lean/cyclic_bsp.rs`, the
+//! The BSP tree `sim export --bsp` writes as `static` data (`firmware/examples/lean/cyclic_bsp.rs`, the
 //! lecture's cyclic-overlap case) renders on the host exactly as `sim`'s BSP method renders the
 //! OBJ it came from: the same frames the lean BSP firmware must print under QEMU.
 
 #[allow(dead_code)]
-#[path = "../examples/lean/cyclic_bsp.rs"]
+#[path = "../firmware/examples/lean/cyclic_bsp.rs"]
 mod scene;
 
 use embedded_graphics::pixelcolor::Rgb565;

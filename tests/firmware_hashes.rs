@@ -2,7 +2,7 @@
 //! hashing panel model as the firmware, and must reproduce the exact frame hashes the firmware
 //! prints on QEMU (thumbv7em and thumbv6m; `cargo xtask test` compares them run by run).
 
-use scanline3d::demo::{self, PanelWorkspace};
+use scanline3d_demo::{self as demo, PanelWorkspace};
 
 /// Printed by `cargo run --release --example firmware --target thumbv7em-none-eabihf` (and the
 /// same on thumbv6m). Integer arithmetic makes them machine-independent; a change here means

@@ -128,13 +128,13 @@ fn without_clipping_crossing_triangles_are_skipped_and_counted_never_drawn_wrong
 
 #[test]
 fn without_clipping_scenes_that_need_none_render_bit_identically() {
-    let mut ws = Box::new(scanline3d::demo::PanelWorkspace::new(Rgb565::new(0, 0, 0)));
+    let mut ws = Box::new(scanline3d_demo::PanelWorkspace::new(Rgb565::new(0, 0, 0)));
     // In some frames the ground crosses the guard band, but only off screen: no visible
     // triangle is cut (`clipped` is 0), so skipping the crossing ones changes nothing.
-    let instances = &scanline3d::demo::instances();
+    let instances = &scanline3d_demo::instances();
     let mut skipped = 0;
-    for frame in 0..scanline3d::demo::ORBIT_FRAMES {
-        let scene = scanline3d::demo::scene(instances, frame, 8).unwrap();
+    for frame in 0..scanline3d_demo::ORBIT_FRAMES {
+        let scene = scanline3d_demo::scene(instances, frame, 8).unwrap();
         let (mut a, mut b) = (HashSink::new(), HashSink::new());
         let sa = ws
             .render(&scene, &RenderOptions::default(), &mut a)
@@ -640,9 +640,9 @@ fn ids_and_depth<Z: scanline3d::depth::DepthFormat>(
 fn sixteen_bit_depth_differs_from_32_bit_only_by_its_resolution() {
     use scanline3d::depth::Depth16;
     use scanline3d::Depth;
-    let instances = scanline3d::demo::instances();
+    let instances = scanline3d_demo::instances();
     for frame in 0..8 {
-        let scene = scanline3d::demo::scene(&instances, frame, 8).unwrap();
+        let scene = scanline3d_demo::scene(&instances, frame, 8).unwrap();
         let (ids32, depth32) = ids_and_depth::<Depth>(&scene, false);
         let (ids16, depth16) = ids_and_depth::<Depth16>(&scene, false);
         // The full-frame z-buffer with 16-bit cells settles ties exactly as the span z-buffer.

@@ -352,7 +352,7 @@ impl Export<'_> {
 /// Every corpus scene ([`crate::corpus::all`]) as one Rust file for firmware: a module per
 /// scene ([`Export::source`] of its mesh, views, light and budget at `w × h`), then `SCENES`
 /// listing them and `MAX_TRIANGLES` / `MAX_ACTIVE` covering all. `cargo xtask tradeoff`
-/// writes it under `target/` and builds `examples/tradeoff.rs` with it
+/// writes it under `target/` and builds `firmware/examples/tradeoff.rs` with it
 /// (`--cfg scanline3d_corpus`, path in `SCANLINE3D_CORPUS`) to count instructions per corpus
 /// scene on the targets.
 pub fn corpus_source(w: usize, h: usize, margin_percent: u32) -> Result<String, String> {

@@ -1,6 +1,6 @@
 //! The hidden-surface comparison behind `docs/hsr-table.md` (`cargo xtask hsr-table`): the
 //! scene parameters and the list of methods, in one place for the firmware
-//! (`examples/hsr_table.rs` includes this file with `#[path]`, so it is `no_std`: `core` and the
+//! (`firmware/examples/hsr_table.rs` includes this file with `#[path]`, so it is `no_std`: `core` and the
 //! library only), the bench (`benches/hsr.rs`) and xtask.
 //!
 //! The scenes are [`crate::meshgen::hsr_scene`] at each level: the same objects tessellated
@@ -81,7 +81,7 @@ pub fn camera() -> Result<Camera, SceneError> {
 
 /// The demo's light.
 pub fn light() -> Result<Light, SceneError> {
-    scanline3d::demo::light()
+    scanline3d_demo::light()
 }
 
 /// The scene's instances over `meshes` (in [`crate::meshgen::hsr_scene`] order, already in

@@ -20,10 +20,10 @@ pub mod hsr;
 #[cfg(not(target_os = "none"))]
 pub mod interpolation;
 #[cfg(not(target_os = "none"))]
-pub mod meshgen;
+pub use scanline3d_meshgen as meshgen;
 #[cfg(not(target_os = "none"))]
 pub mod metrics;
-#[cfg(not(target_os = "none"))]
+#[cfg(all(not(target_os = "none"), feature = "peers"))]
 pub mod peers;
 #[cfg(not(target_os = "none"))]
 pub mod reference;

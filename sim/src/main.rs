@@ -258,7 +258,7 @@ impl Views {
     /// The scene (camera unused) and the cameras to analyse.
     fn resolve(&self) -> Result<(SceneSpec, Vec<CameraSpec>), String> {
         if self.demo {
-            let frames = scanline3d::demo::ORBIT_FRAMES;
+            let frames = scanline3d_demo::ORBIT_FRAMES;
             let cams = (0..frames)
                 .map(|f| SceneSpec::demo(f).map(|s| s.camera))
                 .collect::<Result<Vec<_>, _>>()?;
@@ -608,7 +608,7 @@ fn write_corpus(out: &Path) -> Result<(), String> {
 /// The default job: the demo frame, as the firmware renders it, and its accuracy.
 fn demo(out: &Path) -> Result<(), String> {
     let spec = SceneSpec::demo(0)?;
-    let (w, h) = (scanline3d::demo::WIDTH, scanline3d::demo::HEIGHT);
+    let (w, h) = (scanline3d_demo::WIDTH, scanline3d_demo::HEIGHT);
     let (m, fixed, _) = accuracy(&spec, w, h, 4)?;
     scene::write_png(out, w, h, &fixed.image.color)?;
     let s = fixed.stats;

@@ -318,7 +318,7 @@ impl SceneSpec {
 
     /// The built-in demo scene at frame `frame` of its orbit, as the firmware renders it.
     pub fn demo(frame: u32) -> Result<Self, String> {
-        use scanline3d::demo;
+        use scanline3d_demo as demo;
         let instances = demo::instances()
             .iter()
             .map(|inst| {
@@ -381,7 +381,7 @@ impl SceneSpec {
             .collect();
         let (eye, target, up, fovy, near, far) = crate::hsr::CAMERA;
         let f = |v: [f32; 3]| v.map(f64::from);
-        let (dir, ambient, diffuse) = scanline3d::demo::LIGHT;
+        let (dir, ambient, diffuse) = scanline3d_demo::LIGHT;
         Ok(SceneSpec {
             instances,
             camera: CameraSpec {

@@ -45,7 +45,7 @@ const fn choices(sub_bits: u32, arith: SetupArith) -> Precision {
     }
 }
 
-/// Every variant, in the order of `examples/tradeoff.rs` (a test keeps the presets' entries
+/// Every variant, in the order of `firmware/examples/tradeoff.rs` (a test keeps the presets' entries
 /// equal to `scanline3d::preset`). A knob's name is also its `scanline3d_variant` cfg value with
 /// `:` and spaces removed.
 pub const VARIANTS: [Variant; 10] = [

@@ -12,12 +12,12 @@ fn root() -> PathBuf {
 }
 
 /// The lean firmware's scene: an 80-triangle icosphere.
-const LEAN_OBJ: &str = "examples/lean/icosphere80.obj";
-const LEAN_RS: &str = "examples/lean/scene.rs";
+const LEAN_OBJ: &str = "firmware/examples/lean/icosphere80.obj";
+const LEAN_RS: &str = "firmware/examples/lean/scene.rs";
 /// The export command for it (run from the repository root).
 const LEAN_EXPORT: &[&str] = &["export", LEAN_OBJ, "--views", "8"];
 /// The lean BSP firmware's scene: the cyclic-overlap corpus scene with its BSP tree.
-const BSP_RS: &str = "examples/lean/cyclic_bsp.rs";
+const BSP_RS: &str = "firmware/examples/lean/cyclic_bsp.rs";
 const BSP_EXPORT: &[&str] = &[
     "export",
     "sim/corpus/cyclic.obj",
@@ -29,15 +29,15 @@ const BSP_EXPORT: &[&str] = &[
 
 #[test]
 fn demo_workspace_has_exactly_the_capacities_analyze_measures() {
-    let cams: Vec<_> = (0..scanline3d::demo::ORBIT_FRAMES)
+    let cams: Vec<_> = (0..scanline3d_demo::ORBIT_FRAMES)
         .map(|f| SceneSpec::demo(f).unwrap().camera)
         .collect();
     let a = analyze::analyze(&SceneSpec::demo(0).unwrap(), &cams, 240, 240).unwrap();
-    assert_eq!(a.triangle_capacity(0), scanline3d::demo::PANEL_TRIANGLES);
-    assert_eq!(a.active_capacity(0), scanline3d::demo::PANEL_ACTIVE);
+    assert_eq!(a.triangle_capacity(0), scanline3d_demo::PANEL_TRIANGLES);
+    assert_eq!(a.active_capacity(0), scanline3d_demo::PANEL_ACTIVE);
     assert_eq!(a.views_clipping, 0);
     let total = a.buffers(0).last().unwrap().1;
-    assert_eq!(total, scanline3d::demo::PanelWorkspace::BYTES);
+    assert_eq!(total, scanline3d_demo::PanelWorkspace::BYTES);
     // Every setting is free of real mismatches; 8 bits is the only one under 0.1 %.
     assert!(a.settings.iter().all(|s| s.real == 0));
     assert_eq!(a.recommended(0.1).unwrap().sub_bits, 8);

@@ -77,7 +77,8 @@ const fn check_sizes(w: usize, h: usize, tris: usize) {
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
-/// use scanline3d::{demo, resolve::BandWorkspace, sink::HashSink, Flat, RenderOptions};
+/// use scanline3d_demo as demo;
+/// use scanline3d::{resolve::BandWorkspace, sink::HashSink, Flat, RenderOptions};
 /// let mut ws: Box<BandWorkspace<Rgb565, Flat, 240, 240, 16, 1280, 96>> =
 ///     Box::new(BandWorkspace::new(Rgb565::new(0, 0, 0)));
 /// let instances = demo::instances();
@@ -307,7 +308,8 @@ impl<T> SortSpan<T> {
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
-/// use scanline3d::{demo, resolve::SpanSortWorkspace, sink::HashSink, Flat, RenderOptions};
+/// use scanline3d_demo as demo;
+/// use scanline3d::{resolve::SpanSortWorkspace, sink::HashSink, Flat, RenderOptions};
 /// let mut ws: Box<SpanSortWorkspace<Rgb565, Flat, 240, 240, 1280, 96>> =
 ///     Box::new(SpanSortWorkspace::new(Rgb565::new(0, 0, 0)));
 /// let instances = demo::instances();
@@ -559,7 +561,8 @@ impl<
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
-/// use scanline3d::{demo, resolve::DepthSortWorkspace, sink::HashSink, Flat, RenderOptions};
+/// use scanline3d_demo as demo;
+/// use scanline3d::{resolve::DepthSortWorkspace, sink::HashSink, Flat, RenderOptions};
 /// let mut ws: Box<DepthSortWorkspace<Rgb565, Flat, 240, 240, 1280, 96>> =
 ///     Box::new(DepthSortWorkspace::new(Rgb565::new(0, 0, 0)));
 /// let instances = demo::instances();

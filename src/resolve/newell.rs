@@ -140,7 +140,8 @@ pub struct SortStats {
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
-/// use scanline3d::{demo, resolve::NewellWorkspace, sink::HashSink, Flat, RenderOptions};
+/// use scanline3d_demo as demo;
+/// use scanline3d::{resolve::NewellWorkspace, sink::HashSink, Flat, RenderOptions};
 /// let mut ws: Box<NewellWorkspace<Rgb565, Flat, 240, 240, 1280, 96>> =
 ///     Box::new(NewellWorkspace::new(Rgb565::new(0, 0, 0)));
 /// let instances = demo::instances();

@@ -170,7 +170,8 @@ impl Window {
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
-/// use scanline3d::{demo, resolve::WarnockWorkspace, sink::HashSink, Flat, RenderOptions};
+/// use scanline3d_demo as demo;
+/// use scanline3d::{resolve::WarnockWorkspace, sink::HashSink, Flat, RenderOptions};
 /// let mut ws: Box<WarnockWorkspace<Rgb565, Flat, 240, 240, 1280>> =
 ///     Box::new(WarnockWorkspace::new(Rgb565::new(0, 0, 0)));
 /// let instances = demo::instances();

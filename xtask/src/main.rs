@@ -137,6 +137,9 @@ fn install() -> Result<(), String> {
     Ok(())
 }
 
+/// The package of the QEMU firmware images (`firmware/`).
+const FIRMWARE_PACKAGE: &str = "scanline3d-firmware";
+
 /// A firmware target and the QEMU machine its runner uses (see `.cargo/config.toml`).
 const FIRMWARE: [(&str, &str); 3] = [
     ("thumbv7em-none-eabihf", "mps2-an386 (Cortex-M4F)"),
@@ -151,7 +154,8 @@ const FIRMWARE: [(&str, &str); 3] = [
 /// with the given cargo profile, and returns its output.
 fn run_example(target: &str, profile: &str, example: &str) -> Result<String, String> {
     let out = cargo()
-        .args(["run", "--quiet", "--profile", profile, "--example", example])
+        .args(["run", "--package", FIRMWARE_PACKAGE, "--profile", profile])
+        .args(["--example", example])
         .args(["--target", target])
         .current_dir(root())
         .stderr(Stdio::inherit())
@@ -169,7 +173,7 @@ fn run_example(target: &str, profile: &str, example: &str) -> Result<String, Str
 
 /// Frame hashes the host computes for the demo orbit, through the same code as the firmware.
 fn host_hashes() -> Result<Vec<u32>, String> {
-    use scanline3d::demo;
+    use scanline3d_demo as demo;
     let mut ws = Box::new(demo::PanelWorkspace::new(demo::BACKGROUND.into()));
     let instances = demo::instances();
     (0..demo::ORBIT_FRAMES)
@@ -187,9 +191,9 @@ fn firmware() -> Result<(), String> {
     let expected = host_hashes()?;
     for (target, machine) in FIRMWARE {
         step(&format!("firmware on QEMU {machine}, {target}"));
-        let first = run_example(target, "release", "firmware")?;
+        let first = run_example(target, "firmware", "firmware")?;
         print!("{first}");
-        let second = run_example(target, "release", "firmware")?;
+        let second = run_example(target, "firmware", "firmware")?;
         if first != second {
             return Err(format!("{target}: two runs printed different output (instruction counts must be deterministic)\n{second}"));
         }
@@ -241,12 +245,13 @@ fn mean_frame_instructions(output: &str) -> f64 {
 fn vertex_cache_on_target(target: &str, uncached: &str, expected: &[u32]) -> Result<(), String> {
     step(&format!("firmware with a vertex cache, {target}"));
     run(cargo()
-        .args(["rustc", "--quiet", "--release", "--example", "firmware"])
+        .args(["rustc", "--package", FIRMWARE_PACKAGE, "--profile", "firmware"])
+        .args(["--example", "firmware"])
         .args(["--target", target, "--", "--cfg", "scanline3d_vertex_cache"]))?;
     let elf = root()
         .join("target")
         .join(target)
-        .join("release/examples/firmware");
+        .join("firmware/examples/firmware");
     let out = tradeoff::run_on_qemu_with(target, &elf, &[])?;
     let hashes = frame_hashes(&out);
     if hashes != expected {
@@ -269,13 +274,13 @@ fn vertex_cache_on_target(target: &str, uncached: &str, expected: &[u32]) -> Res
     Ok(())
 }
 
-/// The lean firmware variants (`examples/lean_*.rs`), built with the size-optimised `lean`
+/// The lean firmware variants (`firmware/examples/lean_*.rs`), built with the size-optimised `lean`
 /// profile.
 const LEAN_VARIANTS: [&str; 3] = ["minimal", "full", "baseline"];
 /// The scene the lean firmware was exported from, and how many views it was analysed from.
-const LEAN_OBJ: &str = "examples/lean/icosphere80.obj";
+const LEAN_OBJ: &str = "firmware/examples/lean/icosphere80.obj";
 const LEAN_VIEWS: usize = 8;
-/// The scene of the lean BSP build (`examples/lean_bsp.rs`), exported with
+/// The scene of the lean BSP build (`firmware/examples/lean_bsp.rs`), exported with
 /// `sim export sim/corpus/cyclic.obj --views 8 --no-cull --bsp`.
 const LEAN_BSP_OBJ: &str = "sim/corpus/cyclic.obj";
 
@@ -564,14 +569,15 @@ fn host_cpu() -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
+#[cfg(feature = "peers")]
 /// `cargo xtask peers`: ours against the peer renderers (`euc`, `embedded-3dgfx`) on the
-/// corpus, time per frame from one criterion run (`cargo bench --bench peers`) and mismatch
+/// corpus, time per frame from one criterion run (`cargo bench -p scanline3d-sim --features peers --bench peers`) and mismatch
 /// against the f64 reference, into `docs/peers.md`.
 fn peers() -> Result<(), String> {
     use scanline3d_sim::peers::{self, Peer};
     const SIZE: usize = 240;
     step("criterion: ours and the peers, every corpus scene (cargo bench --bench peers)");
-    run(cargo().args(["bench", "--bench", "peers"]))?;
+    run(cargo().args(["bench", "--package", "scanline3d-sim", "--features", "peers"]).args(["--bench", "peers"]))?;
     step("ours and the peers against the f64 reference (every corpus scene and camera)");
     let rows = peers::corpus_table(SIZE, SIZE)?;
     let scenes: Vec<&str> = scanline3d_sim::corpus::all()
@@ -601,7 +607,7 @@ fn peers() -> Result<(), String> {
     ));
     line(String::new());
     line(format!(
-        "Host: {} ({}). Times: criterion means from `cargo bench --bench peers`, one run, camera 0 of each scene, each renderer writing a whole Rgb565 frame; ours also lights every face (Lambert), the peers draw flat colours.",
+        "Host: {} ({}). Times: criterion means from `cargo bench -p scanline3d-sim --features peers --bench peers`, one run, camera 0 of each scene, each renderer writing a whole Rgb565 frame; ours also lights every face (Lambert), the peers draw flat colours.",
         host_cpu(),
         first_line(Command::new("rustc").arg("--version"))
     ));
@@ -818,7 +824,7 @@ fn hsr_table() -> Result<(), String> {
     ));
     // One run: the frames take minutes under QEMU; determinism of the counts is checked run by
     // run on the demo firmware (`cargo xtask firmware`), and the hashes below on this one.
-    let first = run_example(TARGET, "release", "hsr_table")?;
+    let first = run_example(TARGET, "firmware", "hsr_table")?;
     print!("{first}");
     let firmware: Vec<_> = first
         .lines()
@@ -848,7 +854,8 @@ fn hsr_table() -> Result<(), String> {
     } else {
         step("hidden-surface table: no criterion results, timing loop on the host");
         let out = cargo()
-            .args(["run", "--quiet", "--release", "--example", "hsr_table"])
+            .args(["run", "--package", FIRMWARE_PACKAGE, "--profile", "firmware"])
+            .args(["--example", "hsr_table"])
             .current_dir(root())
             .stderr(Stdio::inherit())
             .output()
@@ -870,7 +877,7 @@ fn hsr_table() -> Result<(), String> {
                 })
                 .and_then(|f| f.get("ns_per_frame")?.parse().ok());
         }
-        "in-process timing loop (`cargo run --release --example hsr_table` on the host, about 0.3 s per entry; less reliable than criterion)".to_string()
+        "in-process timing loop (`cargo run --profile firmware -p scanline3d-firmware --example hsr_table` on the host, about 0.3 s per entry; less reliable than criterion)".to_string()
     };
 
     let mut instructions = Vec::new();
@@ -929,7 +936,7 @@ fn hsr_table() -> Result<(), String> {
     );
     line(format!("* **Host time:** {timing}, on {cpu}."));
     line(format!(
-        "* **Scenes:** `sim/src/meshgen.rs` `hsr_scene`: a chain of three interlocked tori over a ground plane that one of them sinks into, tessellated into {} triangles; {}×{}, RGB565 on black, flat shading, 4 sub-pixel bits, back-face culling, one frame from a fixed camera. The firmware renders static arrays generated from the same code (`build.rs`); its frame hashes equal the host's.",
+        "* **Scenes:** `meshgen/src/lib.rs` `hsr_scene`: a chain of three interlocked tori over a ground plane that one of them sinks into, tessellated into {} triangles; {}×{}, RGB565 on black, flat shading, 4 sub-pixel bits, back-face culling, one frame from a fixed camera. The firmware renders static arrays generated from the same code (`demo/build.rs`); its frame hashes equal the host's.",
         hsr::LEVELS.iter().map(|l| thousands(l.polygons as u64)).collect::<Vec<_>>().join(", "),
         hsr::WIDTH,
         hsr::HEIGHT
@@ -988,7 +995,7 @@ fn hsr_table() -> Result<(), String> {
         ));
     }
     line(String::new());
-    line("* **Instructions per frame:** the render call alone, counted on the firmware (`examples/hsr_table.rs`). **Triangles drawn:** set up for the row walk after culling and clipping. **Depth complexity:** fragments (pixel centres covered before the depth test) per pixel showing a triangle.".into());
+    line("* **Instructions per frame:** the render call alone, counted on the firmware (`firmware/examples/hsr_table.rs`). **Triangles drawn:** set up for the row walk after culling and clipping. **Depth complexity:** fragments (pixel centres covered before the depth test) per pixel showing a triangle.".into());
     line("* **Workspace** is the method's `BYTES`, sized for the scene (`hsr::LEVELS`: triangles after culling, triangles per row); **render call stack** is the peak stack of the render call, measured by painting; **RAM** is their sum (the scene itself is in flash).".into());
     line("* **Id mismatches** are pixels whose triangle differs from the f64 ray-cast reference (`scanline3d_sim::metrics::compare`, host render through the same method); **real** ones are those not explained by the documented position error bound or a depth tie.".into());
     qualitative(
@@ -1153,7 +1160,7 @@ fn test() -> Result<(), String> {
     cargo_test(&["--release"], &mut totals)?;
     for target in TARGETS {
         step(&format!("library for {target} (no_std, no allocator)"));
-        run(cargo().args(["build", "--release", "--lib", "--target", target]))?;
+        run(cargo().args(["build", "--release", "--package", "scanline3d", "--lib", "--target", target]))?;
     }
     for target in TARGETS {
         // Link-time proof that the render path cannot panic: the example's panic handler calls
@@ -1161,9 +1168,10 @@ fn test() -> Result<(), String> {
         step(&format!("panic-never link check for {target}"));
         run(cargo().args([
             "build",
-            "--release",
             "--package",
-            "scanline3d",
+            FIRMWARE_PACKAGE,
+            "--profile",
+            "firmware",
             "--example",
             "panic_never",
             "--target",
@@ -1382,7 +1390,7 @@ fn sizes(target: &str, firmware_output: &str) -> Result<(), String> {
     let path = root()
         .join("target")
         .join(target)
-        .join("release/examples/firmware");
+        .join("firmware/examples/firmware");
     let e = elf(&path)?;
     let size = |n: &str| {
         e.sections
@@ -1430,4 +1438,11 @@ fn sizes(target: &str, firmware_output: &str) -> Result<(), String> {
     println!("sizes {target}: of which library code {lib_code}, compiler builtins {builtins}, demo mesh data {mesh_data}");
     println!("sizes {target}: RAM {} bytes (.data {data} + .bss {bss} + measured peak stack {stack}, workspace included)", data + bss + stack);
     Ok(())
+}
+
+/// Without the `peers` feature the peer renderers are not linked into the xtask: run it again
+/// with them (`cargo xtask test` stays free of their build).
+#[cfg(not(feature = "peers"))]
+fn peers() -> Result<(), String> {
+    run(cargo().args(["run", "--package", "xtask", "--features", "peers", "--", "peers"]))
 }

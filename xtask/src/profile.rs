@@ -51,7 +51,7 @@ fn is_builtin(name: &str) -> bool {
     name.starts_with("__") || name.contains("compiler_builtins")
 }
 
-/// The innermost frame of each address that lies in this repository's `src/` or `examples/`,
+/// The innermost frame of each address that lies in this repository's `src/` or `firmware/examples/`,
 /// as `path:line` (`llvm-addr2line -a -i`: an address line, then its inline chain, innermost
 /// first).
 fn source_lines(elf: &std::path::Path, addrs: &[u64]) -> Result<HashMap<u64, String>, String> {
@@ -70,7 +70,7 @@ fn source_lines(elf: &std::path::Path, addrs: &[u64]) -> Result<HashMap<u64, Str
             if let Some(hex) = line.strip_prefix("0x") {
                 current = u64::from_str_radix(hex, 16).ok();
             } else if let (Some(a), Some(path)) = (current, line.strip_prefix(&repo)) {
-                if path.starts_with("src/") || path.starts_with("examples/") {
+                if path.starts_with("src/") || path.starts_with("firmware/examples/") {
                     out.entry(a).or_insert_with(|| path.to_string());
                 }
             }
@@ -172,7 +172,7 @@ pub fn profile(variant: &str) -> Result<(), String> {
     for (site, n) in &per_site {
         let line = lines
             .get(site)
-            .map_or("(no line in src/ or examples/)", String::as_str);
+            .map_or("(no line in src/ or firmware/examples/)", String::as_str);
         *by_line.entry(line).or_default() += n;
     }
     let mut by_line: Vec<_> = by_line.into_iter().collect();

@@ -1,7 +1,7 @@
 //! `cargo xtask tradeoff`: the speed–accuracy trade of the precision presets and single-knob
 //! variations (`scanline3d_sim::tradeoff::VARIANTS`), measured: accuracy against the f64
 //! reference on every corpus scene and camera, instructions per frame of the demo orbit on
-//! thumbv7em and thumbv6m under QEMU (`examples/tradeoff.rs`), host time per frame (criterion,
+//! thumbv7em and thumbv6m under QEMU (`firmware/examples/tradeoff.rs`), host time per frame (criterion,
 //! `cargo bench --bench tradeoff`) and each preset's flash. Writes `docs/tradeoff.md` and the
 //! plot `docs/tradeoff.png` (cost against error, Pareto front marked).
 
@@ -61,7 +61,7 @@ fn corpus_frames(output: &str) -> Vec<CorpusFrame> {
         .collect()
 }
 
-/// Builds `examples/tradeoff.rs` in release for `target` (the host if `None`) with extra
+/// Builds `firmware/examples/tradeoff.rs` with the firmware profile for `target` (the host if `None`) with extra
 /// `--cfg`s; with `corpus`, also the generated corpus at that path. Returns the ELF path.
 pub(crate) fn build_tradeoff(
     target: Option<&str>,
@@ -69,7 +69,8 @@ pub(crate) fn build_tradeoff(
     corpus: Option<&std::path::Path>,
 ) -> Result<std::path::PathBuf, String> {
     let mut cmd = cargo();
-    cmd.args(["rustc", "--quiet", "--release", "--example", "tradeoff"]);
+    cmd.args(["rustc", "--package", crate::FIRMWARE_PACKAGE, "--profile", "firmware"]);
+    cmd.args(["--example", "tradeoff"]);
     if let Some(t) = target {
         cmd.args(["--target", t]);
     }
@@ -86,7 +87,7 @@ pub(crate) fn build_tradeoff(
     if let Some(t) = target {
         elf.push(t);
     }
-    Ok(elf.join("release/examples/tradeoff"))
+    Ok(elf.join("firmware/examples/tradeoff"))
 }
 
 /// Runs a firmware ELF with the runner `.cargo/config.toml` gives for `target` (QEMU with a
@@ -181,7 +182,7 @@ fn gouraud_section(
             |ns| {
                 format!(
                     "{:.1} µs",
-                    ns / 1000.0 / scanline3d::demo::ORBIT_FRAMES as f64
+                    ns / 1000.0 / scanline3d_demo::ORBIT_FRAMES as f64
                 )
             },
         );
@@ -458,7 +459,7 @@ pub fn tradeoff() -> Result<(), String> {
     line("Set-up arithmetic (`scanline3d::preset::Arithmetic`): *precise* transforms with 64-bit products, divides each coordinate exactly and takes lighting cosines to 30 bits; *quick* uses 32-bit transform products (`vertex::NarrowTransform`), one reciprocal per vertex (`project::Reciprocal`) and 15-bit normals (`math::NarrowNormals`). The three knob rows change one of these alone. Depth format (`scanline3d::depth`): 32-bit `q = near/w` (I2F30) or 16-bit (`Depth16`, U0F16). Each variant is judged under its own documented error bound: sub-pixel snapping plus what its arithmetic and depth format add (`Precision::documented_error`).".into());
     line(String::new());
     line(format!("* **Accuracy:** every corpus scene from every camera ({} views) at {SIZE}×{SIZE} against the f64 reference, each variant judged under its own sub-pixel error bound (`metrics::compare`). Id mismatches: pixels showing another triangle than the reference (mean and worst view); real: mismatches the bound does not explain, summed over all views; depth: pixels beyond their depth bound, summed.", accuracy.len() / VARIANTS.len()));
-    line(format!("* **Instructions** (main table): the demo orbit (1420 triangles, 8 frames, mean per frame) on QEMU ({}, `-icount shift=0`): mps2-an386 for thumbv7em (Cortex-M4F), mps2-an385 for thumbv6m. `examples/tradeoff.rs` is built once per variant, so each image carries only its own code (in one image holding every variant, LLVM inlined each variant differently, and the counts no longer compared like with like); every frame hash equals the host's.", first_line(Command::new("qemu-system-arm").arg("--version"))));
+    line(format!("* **Instructions** (main table): the demo orbit (1420 triangles, 8 frames, mean per frame) on QEMU ({}, `-icount shift=0`): mps2-an386 for thumbv7em (Cortex-M4F), mps2-an385 for thumbv6m. `firmware/examples/tradeoff.rs` is built once per variant, so each image carries only its own code (in one image holding every variant, LLVM inlined each variant differently, and the counts no longer compared like with like); every frame hash equals the host's.", first_line(Command::new("qemu-system-arm").arg("--version"))));
     line(format!("* **Host time:** criterion (`cargo bench --bench tradeoff`), the sum over the corpus scenes (first camera each) of the mean time per frame, on {} ({}).", host_cpu(), first_line(Command::new("rustc").arg("--version"))));
     line("* **Flash:** that variant's trade-off firmware (release profile, demo mesh data included). **RAM:** its demo workspace (`Workspace::BYTES`, 240×240, capacities 640 triangles and 80 active, as the firmware reports it); the render's stack comes on top and is the same for every variant.".into());
     line("* **Pareto front:** variants without real mismatches that no other such variant beats on both thumbv6m instructions and mean id mismatches.".into());

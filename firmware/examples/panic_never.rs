@@ -23,7 +23,7 @@ fn main() {
 #[cfg(target_os = "none")]
 mod firmware {
     use embedded_graphics::pixelcolor::Rgb565;
-    use scanline3d::demo::{self, PanelWorkspace};
+    use scanline3d_demo::{self as demo, PanelWorkspace};
     use scanline3d::depth::Depth16;
     use scanline3d::preset::{Fast, Preset};
     use scanline3d::shading::{Gouraud, PerPixel, PerSegment};

@@ -1,8 +1,8 @@
 //! Procedural meshes (f64 positions, counter-clockwise triangles seen from outside).
 //!
-//! Shared by the library's `build.rs` (which turns them into the demo's static arrays), the
-//! corpus and the tests, so each shape is defined once. Plain std code with no dependencies,
-//! because `build.rs` includes this file directly.
+//! Shared by the demo crate's `build.rs` (which turns them into the demo's static arrays), the
+//! corpus and the tests, so each shape is defined once. Plain std code with no dependencies, so
+//! a build script can use it.
 
 use std::collections::HashMap;
 

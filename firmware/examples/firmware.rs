@@ -37,7 +37,7 @@ mod measure;
 mod firmware {
     use super::arch;
     use embedded_graphics::pixelcolor::Rgb565;
-    use scanline3d::demo;
+    use scanline3d_demo as demo;
     use scanline3d::raster::PixelOrigin;
     use scanline3d::shading::{Shading, SpanDepth};
     use scanline3d::{Depth, Flat};
