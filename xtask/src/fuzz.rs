@@ -1,0 +1,85 @@
+//! `cargo xtask fuzz SECONDS`: coverage-guided fuzzing of scene input.
+
+use crate::*;
+
+/// Length of the bounded fuzzing session inside `cargo xtask test`.
+pub(crate) const FUZZ_SECONDS_IN_TEST: u32 = 60;
+
+/// Coverage-guided fuzzing of scene/OBJ input with AFL++ (`cargo afl`, stable Rust) for
+/// `seconds`, seeded with the corpus. Fails on any crash or hang.
+pub(crate) fn fuzz(seconds: u32) -> Result<(), String> {
+    step(&format!(
+        "fuzz scene input for {seconds} s (AFL++ via cargo afl)"
+    ));
+    let have_afl = cargo()
+        .args(["afl", "--version"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !have_afl {
+        run(cargo().args(["install", "cargo-afl", "--version", "0.18.2", "--locked"]))?;
+    }
+    // Builds AFL++'s runtime for this rustc once; it refuses (harmlessly) when already built.
+    let _ = cargo()
+        .args(["afl", "config", "--build"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status();
+    run(cargo().args([
+        "afl",
+        "build",
+        "--release",
+        "--manifest-path",
+        "fuzz/Cargo.toml",
+    ]))?;
+    let dir = root().join("target/fuzz");
+    let _ = std::fs::remove_dir_all(&dir);
+    let seeds = dir.join("seeds");
+    std::fs::create_dir_all(&seeds).map_err(|e| e.to_string())?;
+    for (i, seed) in scanline3d_sim::fuzz::seeds().iter().enumerate() {
+        std::fs::write(seeds.join(format!("seed{i}")), seed).map_err(|e| e.to_string())?;
+    }
+    let binary = root().join("fuzz/target/release/scanline3d-fuzz");
+    let out = dir.join("out");
+    run(cargo()
+        .args(["afl", "fuzz", "-i"])
+        .arg(&seeds)
+        .arg("-o")
+        .arg(&out)
+        .args(["-V", &seconds.to_string()])
+        .arg(&binary)
+        .env("AFL_NO_UI", "1")
+        .env("AFL_SKIP_CPUFREQ", "1")
+        .env("AFL_I_DONT_CARE_ABOUT_MISSING_CRASHES", "1")
+        .stdout(Stdio::null()))?;
+    let stats = std::fs::read_to_string(out.join("default/fuzzer_stats"))
+        .map_err(|e| format!("fuzzer_stats: {e}"))?;
+    let field = |name: &str| {
+        stats
+            .lines()
+            .find_map(|l| {
+                l.split_once(':')
+                    .filter(|(k, _)| k.trim() == name)
+                    .map(|(_, v)| v.trim().to_string())
+            })
+            .unwrap_or_default()
+    };
+    println!(
+        "fuzz: {} executions in {} s ({} per second), {} paths, coverage {}, {} crashes, {} hangs",
+        field("execs_done"),
+        seconds,
+        field("execs_per_sec"),
+        field("corpus_count"),
+        field("bitmap_cvg"),
+        field("saved_crashes"),
+        field("saved_hangs")
+    );
+    if field("saved_crashes") != "0" || field("saved_hangs") != "0" {
+        return Err(format!(
+            "fuzzing found crashes or hangs: see {}",
+            out.join("default").display()
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,88 @@
+//! `cargo xtask test`: the one test command (README, `.ci/run`).
+
+use crate::*;
+
+/// Runs `cargo test` with the given extra arguments, echoing its output and summing the
+/// per-binary "test result" lines.
+pub(crate) fn cargo_test(extra: &[&str], totals: &mut (u64, u64)) -> Result<(), String> {
+    let mut cmd = cargo();
+    cmd.args(["test", "--workspace"])
+        .args(extra)
+        .current_dir(root());
+    cmd.stdout(Stdio::piped());
+    let shown = format!("{cmd:?}");
+    let mut child = cmd.spawn().map_err(|e| format!("{shown}: {e}"))?;
+    if let Some(out) = child.stdout.take() {
+        for line in BufReader::new(out).lines().map_while(Result::ok) {
+            println!("{line}");
+            if let Some(rest) = line.strip_prefix("test result: ") {
+                let count = |word: &str| {
+                    rest.split(';')
+                        .find_map(|part| {
+                            part.trim().strip_suffix(word).map(|n| {
+                                n.trim()
+                                    .trim_start_matches("ok. ")
+                                    .trim_start_matches("FAILED. ")
+                                    .to_string()
+                            })
+                        })
+                        .and_then(|n| n.parse::<u64>().ok())
+                        .unwrap_or(0)
+                };
+                totals.0 += count(" passed");
+                totals.1 += count(" failed");
+            }
+        }
+    }
+    let status = child.wait().map_err(|e| format!("{shown}: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("{shown} failed ({status})"))
+    }
+}
+
+pub(crate) fn test() -> Result<(), String> {
+    install()?;
+    step("format");
+    run(cargo().args(["fmt", "--all", "--", "--check"]))?;
+    step("clippy (warnings denied)");
+    run(cargo().args([
+        "clippy",
+        "--workspace",
+        "--all-targets",
+        "--",
+        "-D",
+        "warnings",
+    ]))?;
+    let mut totals = (0, 0);
+    step("tests, debug (overflow checks on)");
+    cargo_test(&[], &mut totals)?;
+    step("tests, release");
+    cargo_test(&["--release"], &mut totals)?;
+    for target in TARGETS {
+        step(&format!("library for {target} (no_std, no allocator)"));
+        run(cargo().args(["build", "--release", "--package", "scanline3d", "--lib", "--target", target]))?;
+    }
+    for target in TARGETS {
+        // Link-time proof that the render path cannot panic: the example's panic handler calls
+        // an undefined symbol, so the link fails if any panic is reachable.
+        step(&format!("panic-never link check for {target}"));
+        run(cargo().args([
+            "build",
+            "--package",
+            FIRMWARE_PACKAGE,
+            "--profile",
+            "firmware",
+            "--example",
+            "panic_never",
+            "--target",
+            target,
+        ]))?;
+    }
+    firmware()?;
+    lean()?;
+    fuzz(FUZZ_SECONDS_IN_TEST)?;
+    println!("\nxtask: {} passed, {} failed", totals.0, totals.1);
+    Ok(())
+}
