@@ -8,8 +8,8 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use embedded_graphics::pixelcolor::Rgb565;
 use scanline3d::sink::HashSink;
-use scanline3d_demo as demo;
 use scanline3d::{Flat, Gouraud, RenderOptions, Shading, Workspace};
+use scanline3d_demo as demo;
 use std::hint::black_box;
 
 type Ws<S> = Workspace<Rgb565, S, { demo::WIDTH }, { demo::HEIGHT }, 1024, 96>;

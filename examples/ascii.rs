@@ -4,8 +4,8 @@
 
 use embedded_graphics::pixelcolor::{Gray8, GrayColor};
 use scanline3d::sink::FrameBuffer;
-use scanline3d_demo as demo;
 use scanline3d::{Flat, RenderOptions, Workspace};
+use scanline3d_demo as demo;
 
 const W: usize = 72;
 const H: usize = 36;

@@ -1,8 +1,8 @@
 //! The hidden-surface test scenes of `docs/hsr-table.md`: the firmware's generated copy has the
 //! polygon counts the table claims and holds exactly the data the host tools render.
 
-use scanline3d_demo::hsr::HSR_MESHES;
 use scanline3d::scene::MeshColors;
+use scanline3d_demo::hsr::HSR_MESHES;
 use scanline3d_sim::{hsr, meshgen, scene::SceneSpec};
 
 #[test]

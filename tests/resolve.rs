@@ -7,8 +7,8 @@ use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use scanline3d::resolve::{BandWorkspace, DepthSortWorkspace, SpanSortWorkspace, ZBufferWorkspace};
 use scanline3d::scene::Scene;
 use scanline3d::sink::{FnSink, HashSink, Row, TriangleId};
-use scanline3d_demo as demo;
 use scanline3d::{Flat, FrameStats, Gouraud, RenderOptions, Shading, Workspace};
+use scanline3d_demo as demo;
 
 const W: usize = demo::WIDTH;
 const H: usize = demo::HEIGHT;

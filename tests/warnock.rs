@@ -9,8 +9,8 @@ use scanline3d::resolve::warnock::stack_needed;
 use scanline3d::resolve::WarnockWorkspace;
 use scanline3d::scene::Scene;
 use scanline3d::sink::{FnSink, HashSink, Row, RowPixel, TriangleId};
-use scanline3d_demo as demo;
 use scanline3d::{Flat, Gouraud, RenderError, RenderOptions, Shading, Workspace};
+use scanline3d_demo as demo;
 use scanline3d_sim::corpus;
 use scanline3d_sim::scene::{LightSpec, SceneSpec};
 

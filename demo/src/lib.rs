@@ -19,13 +19,13 @@
 #![deny(missing_docs)]
 
 use core::convert::Infallible;
+use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
+use fixed::types::I16F16;
 use scanline3d::scene::{
     Camera, Instance, Light, Mesh, MeshColors, Scene, SceneError, Transform, Vertex,
 };
 use scanline3d::sink::HashSink;
 use scanline3d::{Flat, FrameStats, RenderError, RenderOptions, Workspace};
-use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
-use fixed::types::I16F16;
 
 const fn c(bits: i32) -> I16F16 {
     I16F16::from_bits(bits)

@@ -37,10 +37,10 @@ mod measure;
 mod firmware {
     use super::arch;
     use embedded_graphics::pixelcolor::Rgb565;
-    use scanline3d_demo as demo;
     use scanline3d::raster::PixelOrigin;
     use scanline3d::shading::{Shading, SpanDepth};
     use scanline3d::{Depth, Flat};
+    use scanline3d_demo as demo;
     use semihosting::println;
 
     use crate::measure::{self, _stack_start};

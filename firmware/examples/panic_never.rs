@@ -23,11 +23,11 @@ fn main() {
 #[cfg(target_os = "none")]
 mod firmware {
     use embedded_graphics::pixelcolor::Rgb565;
-    use scanline3d_demo::{self as demo, PanelWorkspace};
     use scanline3d::depth::Depth16;
     use scanline3d::preset::{Fast, Preset};
     use scanline3d::shading::{Gouraud, PerPixel, PerSegment};
     use scanline3d::{Depth, Flat, RenderOptions, Workspace};
+    use scanline3d_demo::{self as demo, PanelWorkspace};
 
     /// The demo's capacities with another shading and depth format.
     type Ws<Sh, Z> = Workspace<Rgb565, Sh, 240, 240, 640, 80, 3, Z>;

@@ -23,8 +23,8 @@ use scanline3d::preset::{self, Arithmetic, Preset};
 use scanline3d::scene::{Camera, Scene, SceneError};
 use scanline3d::shading::{Affine, Gouraud, Interpolation, PerPixel, PerSegment};
 use scanline3d::sink::HashSink;
-use scanline3d_demo as demo;
 use scanline3d::{Depth, Flat, RenderOptions, Shading, Workspace};
+use scanline3d_demo as demo;
 
 /// The demo's panel workspace with room to spare: the approximate set-up of some variants moves
 /// the camera slightly, so the exact capacities `sim analyze --demo` measured may not cover it.

@@ -7,8 +7,8 @@ use embedded_graphics::pixelcolor::Rgb888;
 use scanline3d::preset::{Arithmetic, Fast, Preset};
 use scanline3d::scene::Scene;
 use scanline3d::sink::{FnSink, Row};
-use scanline3d_demo as demo;
 use scanline3d::{Depth, Flat, FrameStats, Gouraud, RenderOptions, Shading, Workspace};
+use scanline3d_demo as demo;
 use scanline3d_sim::corpus;
 
 const W: usize = 160;

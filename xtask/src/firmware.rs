@@ -108,10 +108,20 @@ pub(crate) fn mean_frame_instructions(output: &str) -> f64 {
 /// The demo firmware again with a vertex cache holding every demo vertex (`--cfg
 /// scanline3d_vertex_cache`): the frames must hash the same; prints its cost against the
 /// uncached run `uncached` (firmware output) and its renderer RAM.
-pub(crate) fn vertex_cache_on_target(target: &str, uncached: &str, expected: &[u32]) -> Result<(), String> {
+pub(crate) fn vertex_cache_on_target(
+    target: &str,
+    uncached: &str,
+    expected: &[u32],
+) -> Result<(), String> {
     step(&format!("firmware with a vertex cache, {target}"));
     run(cargo()
-        .args(["rustc", "--package", FIRMWARE_PACKAGE, "--profile", "firmware"])
+        .args([
+            "rustc",
+            "--package",
+            FIRMWARE_PACKAGE,
+            "--profile",
+            "firmware",
+        ])
         .args(["--example", "firmware"])
         .args(["--target", target, "--", "--cfg", "scanline3d_vertex_cache"]))?;
     let elf = root()

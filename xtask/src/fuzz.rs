@@ -11,15 +11,6 @@ pub(crate) fn fuzz(seconds: u32) -> Result<(), String> {
     step(&format!(
         "fuzz scene input for {seconds} s (AFL++ via cargo afl)"
     ));
-    let have_afl = cargo()
-        .args(["afl", "--version"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    if !have_afl {
-        run(cargo().args(["install", "cargo-afl", "--version", "0.18.2", "--locked"]))?;
-    }
     // Builds AFL++'s runtime for this rustc once; it refuses (harmlessly) when already built.
     let _ = cargo()
         .args(["afl", "config", "--build"])
@@ -30,6 +21,7 @@ pub(crate) fn fuzz(seconds: u32) -> Result<(), String> {
         "afl",
         "build",
         "--release",
+        "--locked",
         "--manifest-path",
         "fuzz/Cargo.toml",
     ]))?;

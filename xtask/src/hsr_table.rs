@@ -169,7 +169,13 @@ pub(crate) fn hsr_table() -> Result<(), String> {
     } else {
         step("hidden-surface table: no criterion results, timing loop on the host");
         let out = cargo()
-            .args(["run", "--package", FIRMWARE_PACKAGE, "--profile", "firmware"])
+            .args([
+                "run",
+                "--package",
+                FIRMWARE_PACKAGE,
+                "--profile",
+                "firmware",
+            ])
             .args(["--example", "hsr_table"])
             .current_dir(root())
             .stderr(Stdio::inherit())

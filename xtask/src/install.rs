@@ -6,13 +6,26 @@ pub(crate) fn install() -> Result<(), String> {
     step("install rustup targets and components (no-op when present)");
     run(Command::new("rustup").args(["target", "add"]).args(TARGETS))?;
     run(Command::new("rustup").args(["component", "add", "rustfmt", "clippy"]))?;
+    step(&format!(
+        "install the minimum supported Rust ({MSRV}) with thumbv6m-none-eabi (no-op when present)"
+    ));
+    run(Command::new("rustup").args(["toolchain", "install", MSRV, "--profile", "minimal"]))?;
+    run(Command::new("rustup").args(["target", "add", "--toolchain", MSRV, "thumbv6m-none-eabi"]))?;
     step("install QEMU for the firmware runs (no-op when present)");
-    let have_qemu = Command::new("qemu-system-arm")
-        .arg("--version")
-        .stdout(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    if !have_qemu {
+    // Each emulator the firmware runs need, checked on its own: a machine may have one package
+    // (qemu-system-arm) without the other (qemu-system-misc, which holds RISC-V).
+    let missing: Vec<&str> = ["qemu-system-arm", "qemu-system-riscv32"]
+        .into_iter()
+        .filter(|tool| {
+            !Command::new(tool)
+                .arg("--version")
+                .stdout(Stdio::null())
+                .status()
+                .is_ok_and(|s| s.success())
+        })
+        .collect();
+    if !missing.is_empty() {
+        println!("missing: {}", missing.join(", "));
         let root = Command::new("id")
             .arg("-u")
             .output()
@@ -52,6 +65,16 @@ pub(crate) fn install() -> Result<(), String> {
                 &[&install[..], &["--allow-downgrades", &utils]].concat()
             ))?;
         }
+    }
+    step("install cargo-afl for the fuzzing step (no-op when present)");
+    let have_afl = cargo()
+        .args(["afl", "--version"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !have_afl {
+        run(cargo().args(["install", "cargo-afl", "--version", "0.18.2", "--locked"]))?;
     }
     Ok(())
 }

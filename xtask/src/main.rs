@@ -1,6 +1,7 @@
-//! Project tasks. `cargo xtask test` is the one test command (README, `.ci/run`): it installs
-//! what it needs on a fresh machine, then checks formatting, lints, tests (debug with overflow
-//! checks, and release) and the bare-metal library builds.
+//! Project tasks, one module per command. `cargo xtask test` is the one test command (README,
+//! `.ci/run`): it installs what it needs on a fresh machine, then checks formatting, lints,
+//! tests (debug with overflow checks, and release), the package, the bare-metal builds, the
+//! firmware under QEMU and fuzzes scene input.
 
 use std::io::{BufRead, BufReader};
 use std::process::{Command, ExitCode, Stdio};
@@ -10,6 +11,7 @@ mod fuzz;
 mod hsr_table;
 mod install;
 mod lean;
+mod package;
 mod peers;
 mod profile;
 mod test;
@@ -20,6 +22,7 @@ use fuzz::*;
 use hsr_table::*;
 use install::*;
 use lean::*;
+use package::*;
 use peers::*;
 use test::*;
 
@@ -37,8 +40,15 @@ pub(crate) fn root() -> std::path::PathBuf {
         .unwrap_or(manifest)
 }
 
+/// When the xtask started: each step prints the time since, so a long run shows where it is.
+static START: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
+
 pub(crate) fn step(name: &str) {
-    println!("\n== xtask: {name}");
+    let t = START
+        .get_or_init(std::time::Instant::now)
+        .elapsed()
+        .as_secs();
+    println!("\n== xtask [{}:{:02}]: {name}", t / 60, t % 60);
 }
 
 pub(crate) fn run(cmd: &mut Command) -> Result<(), String> {
@@ -124,11 +134,13 @@ pub(crate) fn first_line(cmd: &mut Command) -> String {
 }
 
 fn main() -> ExitCode {
+    START.get_or_init(std::time::Instant::now);
     let task = std::env::args().nth(1).unwrap_or_default();
     let result = match task.as_str() {
         "test" => test(),
         "firmware" => install().and_then(|_| firmware()),
         "lean" => install().and_then(|_| lean()),
+        "package" => install().and_then(|_| package()),
         "peers" => peers(),
         // The trade table and, in the same command, the peers (`docs/peers.md`).
         "tradeoff" => install()
@@ -157,7 +169,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | lean | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }
@@ -170,4 +182,3 @@ fn main() -> ExitCode {
         }
     }
 }
-

@@ -10,7 +10,15 @@ pub(crate) fn peers() -> Result<(), String> {
     use scanline3d_sim::peers::{self, Peer};
     const SIZE: usize = 240;
     step("criterion: ours and the peers, every corpus scene (cargo bench --bench peers)");
-    run(cargo().args(["bench", "--package", "scanline3d-sim", "--features", "peers"]).args(["--bench", "peers"]))?;
+    run(cargo()
+        .args([
+            "bench",
+            "--package",
+            "scanline3d-sim",
+            "--features",
+            "peers",
+        ])
+        .args(["--bench", "peers"]))?;
     step("ours and the peers against the f64 reference (every corpus scene and camera)");
     let rows = peers::corpus_table(SIZE, SIZE)?;
     let scenes: Vec<&str> = scanline3d_sim::corpus::all()
@@ -194,5 +202,13 @@ pub(crate) fn peers() -> Result<(), String> {
 /// with them (`cargo xtask test` stays free of their build).
 #[cfg(not(feature = "peers"))]
 pub(crate) fn peers() -> Result<(), String> {
-    run(cargo().args(["run", "--package", "xtask", "--features", "peers", "--", "peers"]))
+    run(cargo().args([
+        "run",
+        "--package",
+        "xtask",
+        "--features",
+        "peers",
+        "--",
+        "peers",
+    ]))
 }

@@ -58,11 +58,22 @@ pub(crate) fn test() -> Result<(), String> {
     let mut totals = (0, 0);
     step("tests, debug (overflow checks on)");
     cargo_test(&[], &mut totals)?;
-    step("tests, release");
-    cargo_test(&["--release"], &mut totals)?;
+    step("tests, release (with the peer renderers: sim/tests/peers.rs)");
+    cargo_test(
+        &["--release", "--features", "scanline3d-sim/peers"],
+        &mut totals,
+    )?;
     for target in TARGETS {
         step(&format!("library for {target} (no_std, no allocator)"));
-        run(cargo().args(["build", "--release", "--package", "scanline3d", "--lib", "--target", target]))?;
+        run(cargo().args([
+            "build",
+            "--release",
+            "--package",
+            "scanline3d",
+            "--lib",
+            "--target",
+            target,
+        ]))?;
     }
     for target in TARGETS {
         // Link-time proof that the render path cannot panic: the example's panic handler calls
@@ -80,6 +91,7 @@ pub(crate) fn test() -> Result<(), String> {
             target,
         ]))?;
     }
+    package()?;
     firmware()?;
     lean()?;
     fuzz(FUZZ_SECONDS_IN_TEST)?;

@@ -69,7 +69,13 @@ pub(crate) fn build_tradeoff(
     corpus: Option<&std::path::Path>,
 ) -> Result<std::path::PathBuf, String> {
     let mut cmd = cargo();
-    cmd.args(["rustc", "--package", crate::FIRMWARE_PACKAGE, "--profile", "firmware"]);
+    cmd.args([
+        "rustc",
+        "--package",
+        crate::FIRMWARE_PACKAGE,
+        "--profile",
+        "firmware",
+    ]);
     cmd.args(["--example", "tradeoff"]);
     if let Some(t) = target {
         cmd.args(["--target", t]);
