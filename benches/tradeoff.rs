@@ -7,9 +7,9 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
+use scanline3d::arithmetic::{Arithmetic, Frugal, Precise, Quick, Setup};
 use scanline3d::depth::{Depth16, DepthFormat};
 use scanline3d::math::{NarrowNormals, WideNormals};
-use scanline3d::preset::{Arithmetic, Frugal, Precise, Quick, Setup};
 use scanline3d::project::{ExactDivision, Reciprocal};
 use scanline3d::render::MAX_INSTANCES;
 use scanline3d::scene::Scene;

@@ -20,8 +20,14 @@
 //! would gain under one bit unless the far plane is within a few near-plane distances. `q`
 //! needs no far plane and is what the renderer already steps.
 
-use crate::project::Depth;
-use fixed::types::U0F16;
+use fixed::types::{I2F30, U0F16};
+
+/// Depth as stored in the span z-buffer: `q = near / w` in I2F30.
+///
+/// `q` is linear in screen space, so interpolating it across a triangle is perspective-correct.
+/// It is 1.0 at the near plane and `near/far` at the far plane; larger is nearer; 0 means
+/// nothing was drawn. Eye distance is `near / q`.
+pub type Depth = I2F30;
 
 mod sealed {
     pub trait Sealed {}

@@ -85,20 +85,26 @@
 #[cfg(test)]
 extern crate std;
 
+pub mod arithmetic;
 pub mod cache;
 pub mod clip;
+pub mod config;
 pub mod depth;
 pub mod math;
+pub mod method;
 pub mod preset;
 pub mod project;
 pub mod raster;
 pub mod render;
+pub mod renderer;
 pub mod resolve;
 pub mod scene;
 pub mod shading;
 pub mod sink;
 pub mod vertex;
 
-pub use project::Depth;
+pub use config::{Config, Settings};
+pub use depth::Depth;
 pub use render::{FrameStats, RenderError, RenderOptions, Workspace};
+pub use renderer::{Renderer, Storage, View};
 pub use shading::{Flat, Gouraud, Shading};

@@ -137,7 +137,7 @@ pub(crate) fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i64; 3]> {
 }
 
 /// How precisely lighting takes the cosine between a normal and the light, chosen at compile
-/// time (see [`crate::preset::Arithmetic`]).
+/// time (see [`crate::arithmetic::Arithmetic`]).
 pub trait NormalPrecision:
     Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed + 'static
 {

@@ -36,60 +36,15 @@
 //! # Ok::<(), scanline3d::scene::SceneError>(())
 //! ```
 
+use crate::arithmetic::{Arithmetic, Frugal, Precise, Quick};
 use crate::clip::FrustumClip;
 #[cfg(doc)]
 use crate::math::Micromath;
-use crate::math::{Libm, MathBackend, NarrowNormals, NormalPrecision, WideNormals};
-use crate::project::{ExactDivision, ProjectionPrecision, Reciprocal};
+use crate::math::{Libm, MathBackend};
+use crate::method::Options;
 use crate::render::RenderOptions;
 use crate::scene::{Camera, SceneError};
 use crate::shading::{Affine, Interpolation, PerPixel, PerSegment};
-use crate::vertex::{NarrowTransform, TransformPrecision, WideTransform};
-use core::marker::PhantomData;
-
-/// The integer arithmetic of the per-vertex and per-triangle set-up, one compile-time choice
-/// per stage: how vertices are transformed ([`TransformPrecision`]), divided by `w`
-/// ([`ProjectionPrecision`]) and lit ([`NormalPrecision`]). [`Setup`] combines one of each;
-/// [`Precise`] is the default of [`RenderOptions`], [`Quick`] the narrow choice at every
-/// stage.
-///
-/// Pixel-level work (edge walking, depth and colour interpolation) is exact in every
-/// arithmetic: the choices move vertices and shades by the bounds each knob documents, never
-/// break the fill rule or the watertightness of shared edges (a shared vertex gives the same
-/// result in every triangle).
-pub trait Arithmetic: Copy + Default + core::fmt::Debug + PartialEq + Eq + 'static {
-    /// Transform stage.
-    type Transform: TransformPrecision;
-    /// Projection stage.
-    type Projection: ProjectionPrecision;
-    /// Lighting stage.
-    type Normals: NormalPrecision;
-}
-
-/// The arithmetic made of transform `T`, projection `P` and normals `N`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Setup<T, P, N>(PhantomData<(T, P, N)>);
-
-impl<T: TransformPrecision, P: ProjectionPrecision, N: NormalPrecision> Arithmetic
-    for Setup<T, P, N>
-{
-    type Transform = T;
-    type Projection = P;
-    type Normals = N;
-}
-
-/// Wide arithmetic everywhere: 64-bit transform products, exact division per coordinate,
-/// 30-bit normals. The default.
-pub type Precise = Setup<WideTransform, ExactDivision, WideNormals>;
-
-/// Wide transform, with the two narrow knobs that cost no measured accuracy on the corpus: one
-/// reciprocal per vertex and 15-bit normals (the [`Balanced`] preset's arithmetic).
-pub type Frugal = Setup<WideTransform, Reciprocal, NarrowNormals>;
-
-/// Narrow arithmetic everywhere: 32-bit transform products, one reciprocal per vertex, 15-bit
-/// normals. Vertices move by about 10^-4 of their offsets, shades by far less than a colour
-/// step; on cores without 64-bit multiply and divide this removes most of the set-up's cost.
-pub type Quick = Setup<NarrowTransform, Reciprocal, NarrowNormals>;
 
 /// A named bundle of precision choices.
 pub trait Preset {
@@ -98,7 +53,7 @@ pub trait Preset {
     /// Sub-pixel bits of [`Preset::Options`].
     const SUB_BITS: u32;
     /// Render options: sub-pixel bits and the clipping stage.
-    type Options;
+    type Options: Options;
     /// Math backend for per-frame set-up (camera, model rotations).
     type Math: MathBackend;
     /// Integer arithmetic of the per-vertex and per-triangle set-up.
@@ -176,6 +131,25 @@ impl Preset for Exact {
     type Interpolation = PerPixel;
     fn options() -> Self::Options {
         RenderOptions::default().with_sub_pixel_bits::<8>()
+    }
+}
+
+/// The library's reference precision, what [`RenderOptions::default`] gives: 4 sub-pixel bits,
+/// [`Precise`] arithmetic, [`Libm`] set-up, [`Affine`] Gouraud colour. It is the exactly
+/// rounded configuration the conformance tests are built on, and the default of
+/// [`Settings`](crate::Settings).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Reference;
+
+impl Preset for Reference {
+    const NAME: &'static str = "reference";
+    const SUB_BITS: u32 = 4;
+    type Options = RenderOptions<4>;
+    type Math = Libm;
+    type Arithmetic = Precise;
+    type Interpolation = Affine;
+    fn options() -> Self::Options {
+        RenderOptions::default()
     }
 }
 

@@ -13,8 +13,9 @@
 //! * `X = round(C + N / w)` is computed as one i64 division: `C·w < 2^49`, `2N < 2^56`.
 //! * Depth `q = near / w` in I2F30: `near · 2^30 < 2^61`.
 
+use crate::depth::Depth;
 use crate::vertex::EyePoint;
-use fixed::types::{I16F16, I2F30};
+use fixed::types::I16F16;
 
 /// Largest width or height of a render target, in pixels.
 pub const MAX_SCREEN: usize = 2048;
@@ -25,13 +26,6 @@ pub const MAX_SUB_PIXEL_BITS: u32 = 8;
 /// Guard band half-width in units of the half-screen: vertices are kept within 8 half-screens of
 /// the screen centre.
 pub const GUARD_BAND_HALF_SCREENS: i64 = 8;
-
-/// Depth as stored in the span z-buffer: `q = near / w` in I2F30.
-///
-/// `q` is linear in screen space, so interpolating it across a triangle is perspective-correct.
-/// It is 1.0 at the near plane and `near/far` at the far plane; larger is nearer; 0 means
-/// nothing was drawn. Eye distance is `near / q`.
-pub type Depth = I2F30;
 
 /// A screen coordinate with `S` sub-pixel bits: Q(32−S).S in pixels, in an `i32`.
 ///
@@ -248,7 +242,7 @@ fn screen_vertex<const S: u32>(x: i64, y: i64, q: i64, color: [I16F16; 3]) -> Sc
 }
 
 /// How vertices are divided by `w`, chosen at compile time (see
-/// [`crate::preset::Arithmetic`]); [`Viewport::project_as`] projects with it.
+/// [`crate::arithmetic::Arithmetic`]); [`Viewport::project_as`] projects with it.
 pub trait ProjectionPrecision:
     Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed + 'static
 {

@@ -26,7 +26,8 @@
 //! per-row remainder is below `dy < 2^24` and `rem + step < 2^25` (i32). Attribute planes are
 //! solved in i128 once per triangle and stepped in i64 (depth) or i32 (colour).
 
-use crate::project::{Depth, ScreenVertex};
+use crate::depth::Depth;
+use crate::project::ScreenVertex;
 use core::cmp::Ordering;
 use fixed::types::I16F16;
 

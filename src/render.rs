@@ -19,12 +19,13 @@
 //! `ACTIVE · size_of` of an active triangle (about 104 for flat shading) + `VERTS ·`
 //! [`CachedVertex::BYTES`]. See [`Workspace::BYTES`].
 
+use crate::arithmetic::{Arithmetic, Precise};
 use crate::cache::CachedVertex;
 use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping, FrustumClip};
+use crate::depth::Depth;
 use crate::depth::{DepthFormat, DepthRow};
 use crate::math::NormalPrecision;
-use crate::preset::{Arithmetic, Precise};
-use crate::project::{Depth, ScreenVertex, Viewport};
+use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{
     color_channels, first_row, signed_area, xy, DepthPlane, PlaneSolver, TriangleWalk,
 };
@@ -112,10 +113,10 @@ impl<const SUB_BITS: u32, C: Clipping, A: Arithmetic> RenderOptions<SUB_BITS, C,
         }
     }
 
-    /// The same options with another set-up arithmetic ([`crate::preset::Arithmetic`]).
+    /// The same options with another set-up arithmetic ([`crate::arithmetic::Arithmetic`]).
     ///
     /// ```
-    /// use scanline3d::preset::{Quick, Setup};
+    /// use scanline3d::arithmetic::{Quick, Setup};
     /// use scanline3d::{project::Reciprocal, vertex::WideTransform, math::WideNormals};
     /// let quick = scanline3d::RenderOptions::default().with_arithmetic(Quick::default());
     /// // One knob alone: reciprocal projection, the rest precise.
@@ -354,7 +355,7 @@ pub(crate) struct FinishedRow<'a, P> {
 }
 
 /// The span z-buffer: one row of depth, spans depth-tested as they come.
-struct SpanZBuffer<'a, P, Z> {
+pub(crate) struct SpanZBuffer<'a, P, Z> {
     depth: &'a mut [Z],
     pixels: &'a mut [P],
     background: P,
@@ -365,7 +366,7 @@ struct SpanZBuffer<'a, P, Z> {
 }
 
 impl<'a, P: RowPixel, Z: DepthFormat> SpanZBuffer<'a, P, Z> {
-    fn new(depth: &'a mut [Z], pixels: &'a mut [P], background: P) -> Self {
+    pub(crate) fn new(depth: &'a mut [Z], pixels: &'a mut [P], background: P) -> Self {
         let width = pixels.len();
         SpanZBuffer {
             depth,
@@ -658,7 +659,57 @@ impl<
         options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
-        let vp = viewport::<SUB_BITS, K::Error>(width, height, W, H, scene)?;
+        self.span_view()
+            .render_sized(width, height, scene, options, sink)
+    }
+
+    /// The workspace as slices, so code that renders through it is not generic over the sizes.
+    pub(crate) fn span_view(&mut self) -> SpanView<'_, P, S, Z, INSTANCES> {
+        SpanView {
+            depth: &mut self.depth,
+            pixels: &mut self.pixels,
+            background: self.background,
+            heads: &mut self.heads,
+            next: &mut self.next,
+            refs: &mut self.refs,
+            active: self.active.as_mut_view(),
+            vertices: &mut self.vertices,
+        }
+    }
+}
+
+/// A span z-buffer workspace borrowed as slices: its width and height are the lengths of its
+/// rows and bucket heads, so nothing here is generic over the sizes.
+pub(crate) struct SpanView<'a, P: RowPixel, S: Shading, Z, const INSTANCES: usize> {
+    depth: &'a mut [Z],
+    pixels: &'a mut [P],
+    background: P,
+    heads: &'a mut [u16],
+    next: &'a mut [u16],
+    refs: &'a mut [u16],
+    active: &'a mut VecView<ActiveTri<S::Payload<P>>>,
+    vertices: &'a mut [CachedVertex],
+}
+
+impl<P: RowPixel, S: Shading, Z: DepthFormat, const INSTANCES: usize>
+    SpanView<'_, P, S, Z, INSTANCES>
+{
+    /// Renders a `width × height` target (at most the workspace's size).
+    pub(crate) fn render_sized<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
+        &mut self,
+        width: usize,
+        height: usize,
+        scene: &Scene<'_>,
+        options: &RenderOptions<SUB_BITS, C, A>,
+        sink: &mut K,
+    ) -> Result<FrameStats, RenderError<K::Error>> {
+        let vp = viewport::<SUB_BITS, K::Error>(
+            width,
+            height,
+            self.pixels.len(),
+            self.heads.len(),
+            scene,
+        )?;
         let (Some(depth), Some(pixels), Some(heads)) = (
             self.depth.get_mut(..width),
             self.pixels.get_mut(..width),
@@ -668,11 +719,11 @@ impl<
         };
         let frame = Frame {
             heads,
-            next: &mut self.next,
-            refs: &mut self.refs,
+            next: self.next,
+            refs: self.refs,
             keys: &mut [],
-            active: self.active.as_mut_view(),
-            vertices: &mut self.vertices,
+            active: self.active,
+            vertices: self.vertices,
         };
         let mut resolve = SpanZBuffer::new(depth, pixels, self.background);
         drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _>(
@@ -684,6 +735,17 @@ impl<
             &vp,
             sink,
         )
+    }
+
+    /// Renders the whole target.
+    pub(crate) fn render<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
+        &mut self,
+        scene: &Scene<'_>,
+        options: &RenderOptions<SUB_BITS, C, A>,
+        sink: &mut K,
+    ) -> Result<FrameStats, RenderError<K::Error>> {
+        let (width, height) = (self.pixels.len(), self.heads.len());
+        self.render_sized(width, height, scene, options, sink)
     }
 }
 

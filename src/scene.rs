@@ -34,7 +34,7 @@ pub const MAX_EYE_DISTANCE: f32 = 16384.0;
 pub const MIN_NEAR: f32 = 1.0 / 256.0;
 
 /// Largest far/near ratio: 2^20. At the far plane 1/w then still has 10 significant bits in the
-/// I2F30 depth format (see [`crate::project::Depth`]).
+/// I2F30 depth format (see [`crate::depth::Depth`]).
 pub const MAX_FAR_NEAR_RATIO: f32 = 1048576.0;
 
 /// Why a scene part was rejected. Every variant names what was wrong.
@@ -575,7 +575,7 @@ impl Camera {
     /// assert_eq!(cam.eye_distance(Depth::ZERO), None);
     /// # Ok::<(), scanline3d::scene::SceneError>(())
     /// ```
-    pub fn eye_distance(&self, q: crate::project::Depth) -> Option<f32> {
+    pub fn eye_distance(&self, q: crate::depth::Depth) -> Option<f32> {
         let near = I16F16::checked_from_num(self.near)?.to_num::<f64>();
         let q = q.to_num::<f64>();
         (q > 0.0).then(|| (near / q) as f32)

@@ -391,7 +391,8 @@ impl<I: Interpolation> Shading for Gouraud<I> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::project::{Depth, SubPx};
+    use crate::depth::Depth;
+    use crate::project::SubPx;
     use fixed::types::I16F16;
     use std::vec::Vec;
 

@@ -5,9 +5,9 @@
 //! [`OrderedDither`] for monochrome targets, [`FrameBuffer`] for a frame in RAM and [`FnSink`]
 //! for a closure (for example a panel driver that streams the row over SPI).
 
-use crate::depth::DepthRow;
 #[cfg(test)]
-use crate::project::Depth;
+use crate::depth::Depth;
+use crate::depth::DepthRow;
 use embedded_graphics::pixelcolor::raw::RawData;
 use embedded_graphics::pixelcolor::{
     BinaryColor, Gray8, GrayColor, PixelColor, Rgb565, Rgb888, RgbColor,

@@ -42,7 +42,7 @@ pub enum TransformError {
 }
 
 /// How precisely vertices are transformed, chosen at compile time (see
-/// [`crate::preset::Arithmetic`]).
+/// [`crate::arithmetic::Arithmetic`]).
 pub trait TransformPrecision:
     Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed + 'static
 {

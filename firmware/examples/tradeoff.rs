@@ -16,10 +16,11 @@
 #![cfg_attr(target_os = "none", no_main)]
 
 use embedded_graphics::pixelcolor::Rgb565;
+use scanline3d::arithmetic::Arithmetic;
 use scanline3d::clip::FrustumClip;
 use scanline3d::depth::{Depth16, DepthFormat};
 use scanline3d::math::MathBackend;
-use scanline3d::preset::{self, Arithmetic, Preset};
+use scanline3d::preset::{self, Preset};
 use scanline3d::scene::{Camera, Scene, SceneError};
 use scanline3d::shading::{Affine, Gouraud, Interpolation, PerPixel, PerSegment};
 use scanline3d::sink::HashSink;
@@ -178,7 +179,8 @@ const fn renders(name: &str) -> bool {
 /// The three presets, then `RenderOptions::default()` alone and with one knob changed (those
 /// this build renders).
 fn variants(r: &mut impl Renders) -> Result<(), &'static str> {
-    use preset::{Balanced, Exact, Fast, Setup};
+    use preset::{Balanced, Exact, Fast};
+    use scanline3d::arithmetic::Setup;
     use scanline3d::math::{Libm, Micromath, NarrowNormals, WideNormals};
     use scanline3d::project::{ExactDivision, Reciprocal};
     use scanline3d::vertex::{NarrowTransform, WideTransform};

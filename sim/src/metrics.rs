@@ -42,7 +42,7 @@ pub struct ErrorBound {
 }
 
 /// The documented error that narrow choices (a set-up arithmetic of
-/// `scanline3d::preset::Arithmetic`, a 16-bit depth format) add to the default's, for one scene
+/// `scanline3d::arithmetic::Arithmetic`, a 16-bit depth format) add to the default's, for one scene
 /// and screen.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ArithmeticError {

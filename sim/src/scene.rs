@@ -6,10 +6,11 @@ use crate::metrics::ArithmeticError;
 use crate::reference::{self, Image};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::I16F16;
+use scanline3d::arithmetic::{Arithmetic, Precise, Setup};
 use scanline3d::clip::FrustumClip;
 use scanline3d::depth::{Depth16, DepthFormat};
 use scanline3d::math::{Libm, MathBackend, Micromath, NarrowNormals, WideNormals};
-use scanline3d::preset::{self, Arithmetic, Precise, Preset, Setup};
+use scanline3d::preset::{self, Preset};
 use scanline3d::project::{ExactDivision, Reciprocal};
 use scanline3d::render::MAX_INSTANCES;
 use scanline3d::resolve::bsp::{BspTree, BspWorkspace};
@@ -616,7 +617,7 @@ impl SceneSpec {
         precision: Precision,
         algorithm: Algorithm,
     ) -> Result<FixedRender, String> {
-        use preset::Quick;
+        use scanline3d::arithmetic::Quick;
         let p = precision;
         macro_rules! bits {
             ($a:ty) => {
@@ -634,7 +635,7 @@ impl SceneSpec {
         match precision.arith {
             SetupArith::Precise => bits!(Precise),
             SetupArith::Quick => bits!(Quick),
-            SetupArith::Frugal => bits!(preset::Frugal),
+            SetupArith::Frugal => bits!(scanline3d::arithmetic::Frugal),
             SetupArith::NarrowTransform => {
                 bits!(Setup<NarrowTransform, ExactDivision, WideNormals>)
             }
@@ -736,14 +737,14 @@ pub enum SetupMath {
     Micromath,
 }
 
-/// Set-up arithmetic (`scanline3d::preset::Arithmetic`), chosen at run time.
+/// Set-up arithmetic (`scanline3d::arithmetic::Arithmetic`), chosen at run time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SetupArith {
-    /// [`preset::Precise`]: the default.
+    /// [`scanline3d::arithmetic::Precise`]: the default.
     Precise,
-    /// [`preset::Quick`]: narrow at every stage.
+    /// [`scanline3d::arithmetic::Quick`]: narrow at every stage.
     Quick,
-    /// [`preset::Frugal`]: reciprocal projection and narrow normals.
+    /// [`scanline3d::arithmetic::Frugal`]: reciprocal projection and narrow normals.
     Frugal,
     /// Precise but for the transform (`vertex::NarrowTransform`).
     NarrowTransform,
@@ -905,11 +906,11 @@ impl PresetChoice {
         fn of<P: Preset>() -> SetupArith {
             use std::any::TypeId;
             let a = TypeId::of::<P::Arithmetic>();
-            if a == TypeId::of::<preset::Precise>() {
+            if a == TypeId::of::<scanline3d::arithmetic::Precise>() {
                 SetupArith::Precise
-            } else if a == TypeId::of::<preset::Quick>() {
+            } else if a == TypeId::of::<scanline3d::arithmetic::Quick>() {
                 SetupArith::Quick
-            } else if a == TypeId::of::<preset::Frugal>() {
+            } else if a == TypeId::of::<scanline3d::arithmetic::Frugal>() {
                 SetupArith::Frugal
             } else {
                 unreachable!("presets use Precise, Frugal or Quick arithmetic")
@@ -1214,8 +1215,8 @@ macro_rules! span_zbuffer_only {
 }
 
 span_zbuffer_only!(
-    preset::Quick,
-    preset::Frugal,
+    scanline3d::arithmetic::Quick,
+    scanline3d::arithmetic::Frugal,
     Setup<NarrowTransform, ExactDivision, WideNormals>,
     Setup<WideTransform, Reciprocal, WideNormals>,
     Setup<WideTransform, ExactDivision, NarrowNormals>

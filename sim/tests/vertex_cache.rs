@@ -4,7 +4,8 @@
 //! scene (which falls back to the uncached path and says so).
 
 use embedded_graphics::pixelcolor::Rgb888;
-use scanline3d::preset::{Arithmetic, Fast, Preset};
+use scanline3d::arithmetic::Arithmetic;
+use scanline3d::preset::{Fast, Preset};
 use scanline3d::scene::Scene;
 use scanline3d::sink::{FnSink, Row};
 use scanline3d::{Depth, Flat, FrameStats, Gouraud, RenderOptions, Shading, Workspace};

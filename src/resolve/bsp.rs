@@ -13,8 +13,8 @@
 //! `STACK` entries: no recursion), each triangle's place in the order becomes its sort key,
 //! and the rows are painted like the depth sort's, far to near.
 
+use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
-use crate::preset::Arithmetic;
 use crate::render::{
     drive, viewport, ActiveTri, CapacityKind, Frame, FrameStats, InstanceSetup, RenderError,
     RenderOptions, TriangleOrder, NO_ENTRY,

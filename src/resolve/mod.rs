@@ -31,10 +31,10 @@
 //!
 //! [`Row::depth`]: crate::sink::Row::depth
 
+use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
+use crate::depth::Depth;
 use crate::depth::{DepthFormat, DepthRow};
-use crate::preset::Arithmetic;
-use crate::project::Depth;
 use crate::raster::PixelOrigin;
 use crate::render::{
     drive, fill_span, viewport, ActiveTri, FinishedRow, Frame, FrameStats, IdOrder, RenderError,

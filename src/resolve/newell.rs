@@ -80,8 +80,8 @@
 //!
 //! [`NewellWorkspace::BYTES`] gives the total.
 
+use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
-use crate::preset::Arithmetic;
 use crate::render::{
     viewport, walk_rows, ActiveTri, CapacityKind, FrameStats, RenderError, RenderOptions,
     MAX_INSTANCES, NO_ENTRY,

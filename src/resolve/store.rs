@@ -6,9 +6,10 @@
 //! plane stays a plane in `(x, y, q)`: depth comparisons and splits are exact linear algebra
 //! there, and the eye is at `q = +∞` (larger `q` is nearer).
 
+use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
-use crate::preset::Arithmetic;
-use crate::project::{Depth, ScreenVertex, SubPx, Viewport};
+use crate::depth::Depth;
+use crate::project::{ScreenVertex, SubPx, Viewport};
 use crate::raster::{channel, color_channels, first_row};
 use crate::render::{
     for_each_screen_piece, ActivePieces, CapacityKind, FrameStats, RenderError, RenderOptions,

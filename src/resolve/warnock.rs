@@ -64,9 +64,9 @@
 //! `peak_spans` have no meaning here and are 0; the subdivision's own counts are in
 //! [`WarnockWorkspace::subdivision`]. Nothing is ever dropped: the frame is always complete.
 
+use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::depth::DepthRow;
-use crate::preset::Arithmetic;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{DepthPlane, PlaneSolver, TriangleWalk};
 use crate::render::{
