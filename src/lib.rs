@@ -104,6 +104,12 @@ pub mod sink;
 pub mod vertex;
 
 pub use config::{Config, Settings};
+
+// The README's example is compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
+
 pub use depth::Depth;
 pub use render::{FrameStats, RenderError, RenderOptions, Workspace};
 pub use renderer::{Renderer, Storage, View};
