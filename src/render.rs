@@ -28,7 +28,7 @@ use crate::project::{Depth, ScreenVertex, Viewport};
 use crate::raster::{
     color_channels, first_row, signed_area, xy, DepthPlane, PlaneSolver, TriangleWalk,
 };
-use crate::scene::{Instance, MeshColors, Scene};
+use crate::scene::{Instance, MeshColors, Scene, MAX_SCENE_TRIANGLES};
 use crate::shading::{Shading, SpanDepth};
 use crate::sink::{Row, RowPixel, RowSink};
 use crate::vertex::{shade, Lighting, ModelView, TransformError, TransformPrecision};
@@ -244,6 +244,13 @@ pub enum RenderError<E> {
     /// The BSP tree was built for another mesh, or the scene does not have exactly one
     /// instance (its mesh) for it.
     TreeMismatch,
+    /// The scene's instances hold `triangles` triangles together, more than
+    /// [`MAX_SCENE_TRIANGLES`] (65,535; [`Scene::new`] rejects such a scene too). Returned before
+    /// any row is sent.
+    TooManyTriangles {
+        /// Triangles over all instances.
+        triangles: usize,
+    },
     /// A capacity was exceeded before any row was sent (the sink received nothing).
     Capacity {
         /// Which buffer.
@@ -283,6 +290,10 @@ impl<E: core::fmt::Debug> core::fmt::Display for RenderError<E> {
             }
             Self::Sink { row, error } => write!(f, "sink failed on row {row}: {error:?}"),
             Self::TreeMismatch => write!(f, "the BSP tree does not match the scene's mesh"),
+            Self::TooManyTriangles { triangles } => write!(
+                f,
+                "the scene has {triangles} triangles, more than the limit of {MAX_SCENE_TRIANGLES} per frame"
+            ),
         }
     }
 }
@@ -431,7 +442,8 @@ pub(crate) const NO_ENTRY: u16 = u16::MAX;
 /// * `P`: the pixel type ([`RowPixel`]); `S`: the shading model ([`crate::Flat`] or
 ///   [`crate::Gouraud`]);
 /// * `W × H`: the target size (1..=2048 each);
-/// * `TRIS`: triangles that may survive culling in one frame (≤ 65535);
+/// * `TRIS`: triangles that may survive culling in one frame (at most
+///   [`MAX_SCENE_TRIANGLES`] = 65,535);
 /// * `INSTANCES`: mesh instances a scene may have (their set-up lives on the stack during a
 ///   render; default [`MAX_INSTANCES`]);
 /// * `ACTIVE`: triangles that may cross one row (more are dropped and reported in
@@ -567,7 +579,7 @@ impl<
             H >= 1 && H <= crate::project::MAX_SCREEN,
             "height must be 1..=2048"
         );
-        assert!(TRIS < NO_ENTRY as usize, "TRIS must be below 65535");
+        assert!(TRIS <= MAX_SCENE_TRIANGLES, "TRIS must be at most 65535");
     };
 
     /// An empty workspace whose background pixels are `background`.
@@ -699,6 +711,11 @@ pub(crate) struct InstanceSetup<'a, T: TransformPrecision> {
 fn setup_instances<'a, T: TransformPrecision, E, const N: usize>(
     scene: &'a Scene<'a>,
 ) -> Result<Vec<InstanceSetup<'a, T>, N>, RenderError<E>> {
+    // Triangle ids (and so the u16 ids in the row buckets) must stay below 65,535.
+    let triangles = scene.triangle_count();
+    if triangles > MAX_SCENE_TRIANGLES {
+        return Err(RenderError::TooManyTriangles { triangles });
+    }
     let mut out = Vec::new();
     let view = &scene.camera.view().world_to_eye;
     let (mut first_id, mut first_vertex) = (0u32, 0usize);
@@ -1028,14 +1045,21 @@ pub(crate) fn drive<
                 if filed < capacity {
                     let id = setup.first_id + tri as u32;
                     let row = first_row as usize;
-                    if let (Some(head), Some(next), Some(r)) = (
+                    // Ids fit 16 bits (at most MAX_SCENE_TRIANGLES triangles, checked by
+                    // `setup_instances`), and so do entries (`filed < TRIS <= 65535`), which
+                    // stay below NO_ENTRY: nothing is truncated.
+                    if let (Some(head), Some(next), Some(r), Ok(id), Ok(entry)) = (
                         ws.heads.get_mut(row),
                         ws.next.get_mut(filed),
                         ws.refs.get_mut(filed),
+                        u16::try_from(id),
+                        u16::try_from(filed),
                     ) {
-                        *r = id as u16;
+                        *r = id;
                         *next = *head;
-                        *head = filed as u16;
+                        *head = entry;
+                    } else {
+                        debug_assert!(false, "internal error: triangle {id} not filed");
                     }
                     if let Some(k) = ws.keys.get_mut(filed) {
                         *k = rank.unwrap_or((q_sum / q_count.max(1)) as u32);

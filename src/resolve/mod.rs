@@ -62,7 +62,10 @@ const fn check_sizes(w: usize, h: usize, tris: usize) {
         h >= 1 && h <= crate::project::MAX_SCREEN,
         "height must be 1..=2048"
     );
-    assert!(tris < NO_ENTRY as usize, "TRIS must be below 65535");
+    assert!(
+        tris <= crate::scene::MAX_SCENE_TRIANGLES,
+        "TRIS must be at most 65535"
+    );
 }
 
 // ---------------------------------------------------------------------------------------------

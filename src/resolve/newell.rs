@@ -188,8 +188,11 @@ impl<
 
     const VALID: () = {
         check_sizes(W, H, 0);
-        // Pieces are named by `u16` indices in the list and the buckets.
-        assert!(PIECES < NO_ENTRY as usize, "PIECES must be below 65535");
+        // Pieces are named by `u16` indices in the list and the buckets, below NO_ENTRY.
+        assert!(
+            PIECES <= crate::scene::MAX_SCENE_TRIANGLES,
+            "PIECES must be at most 65535"
+        );
     };
 
     /// An empty workspace whose background pixels are `background`.
