@@ -395,6 +395,12 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for SpanZBuffer<'_, 
         if let (Some(d), Some(p)) = (self.depth.get_mut(lo..hi), self.pixels.get_mut(lo..hi)) {
             d.fill(Z::FAR);
             p.fill(self.background);
+        } else {
+            // Only a clean row (lo > hi: nothing written) has no range to clear.
+            debug_assert!(
+                lo > hi,
+                "internal error: dirty columns {lo}..{hi} out of the row"
+            );
         }
         self.dirty = (self.pixels.len(), 0);
         self.spans = 0;
@@ -431,11 +437,31 @@ pub(crate) fn fill_span<P: RowPixel, S: Shading, Z: DepthFormat, K>(
     let cols = l as usize..r as usize;
     match (depth.get_mut(cols.clone()), pixels.get_mut(cols)) {
         (Some(d), Some(p)) => S::fill(&t.payload, t.depth.origin(), span, d, p),
-        _ => 0,
+        _ => {
+            // walk_band clamps spans to the row.
+            debug_assert!(false, "internal error: span {l}..{r} out of the row");
+            0
+        }
     }
 }
 
 pub(crate) const NO_ENTRY: u16 = u16::MAX;
+
+/// `value`, or `fallback` if it is `None`: for look-ups that validation (of meshes, trees and
+/// capacities) or the frame's own set-up make infallible, so that `None` is an internal error.
+/// Debug builds, the tests among them, stop there; release builds, whose render path must not
+/// panic, go on with the fallback.
+#[inline(always)]
+#[track_caller]
+pub(crate) fn internal<T>(value: Option<T>, fallback: T) -> T {
+    match value {
+        Some(value) => value,
+        None => {
+            debug_assert!(false, "internal error: a look-up that cannot fail failed");
+            fallback
+        }
+    }
+}
 
 /// All the memory a render needs, sized at compile time.
 ///
@@ -758,8 +784,9 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         let mesh = self.instance.mesh;
         let pick = |i: u16| match mesh.colors() {
             MeshColors::Uniform(c) => c,
-            MeshColors::PerFace(c) => c.get(tri).copied().unwrap_or(Rgb888::new(0, 0, 0)),
-            MeshColors::PerVertex(c) => c.get(i as usize).copied().unwrap_or(Rgb888::new(0, 0, 0)),
+            // Mesh::new checked both lengths.
+            MeshColors::PerFace(c) => internal(c.get(tri).copied(), Rgb888::new(0, 0, 0)),
+            MeshColors::PerVertex(c) => internal(c.get(i as usize).copied(), Rgb888::new(0, 0, 0)),
         };
         idx.map(pick)
     }
@@ -768,7 +795,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
     fn face_color<N: NormalPrecision>(&self, tri: usize, idx: [u16; 3]) -> Rgb888 {
         let verts = self.instance.mesh.vertices();
         let zero = [I16F16::ZERO; 3];
-        let v = idx.map(|i| verts.get(i as usize).unwrap_or(&zero));
+        let v = idx.map(|i| internal(verts.get(i as usize), &zero));
         shade(self.vertex_colors(tri, idx)[0], self.lighting.face::<N>(v))
     }
 
@@ -789,11 +816,11 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         let intensity = match mesh.normals() {
             Some(n) => idx.map(|i| {
                 self.lighting
-                    .vertex::<A::Normals>(n.get(i as usize).unwrap_or(&zero))
+                    .vertex::<A::Normals>(internal(n.get(i as usize), &zero))
             }),
             None => {
                 let verts = mesh.vertices();
-                let v = idx.map(|i| verts.get(i as usize).unwrap_or(&zero));
+                let v = idx.map(|i| internal(verts.get(i as usize), &zero));
                 [self.lighting.face::<A::Normals>(v); 3]
             }
         };
@@ -808,7 +835,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
     ) -> [ClipVertex; 3] {
         let verts = self.instance.mesh.vertices();
         let zero = [I16F16::ZERO; 3];
-        let v = idx.map(|i| verts.get(i as usize).unwrap_or(&zero));
+        let v = idx.map(|i| internal(verts.get(i as usize), &zero));
         [0, 1, 2].map(|k| ClipVertex {
             p: A::Transform::apply(&self.mv, v[k]),
             color: colors[k],
@@ -821,8 +848,19 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         cache: &'c [CachedVertex],
         idx: [u16; 3],
     ) -> Option<[&'c CachedVertex; 3]> {
+        if cache.is_empty() {
+            return None;
+        }
         let get = |i: u16| cache.get(self.first_vertex + i as usize);
-        Some([get(idx[0])?, get(idx[1])?, get(idx[2])?])
+        let [Some(a), Some(b), Some(c)] = idx.map(get) else {
+            // A cache holds every vertex of the scene; without it the triangle is drawn uncached.
+            debug_assert!(
+                false,
+                "internal error: vertices {idx:?} not in the vertex cache"
+            );
+            return None;
+        };
+        Some([a, b, c])
     }
 
     /// Fills this instance's part of the vertex cache: every vertex transformed, clip-tested
@@ -833,6 +871,11 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         cache: &mut [CachedVertex],
     ) {
         let verts = self.instance.mesh.vertices();
+        // The cache was sized for every vertex of the scene.
+        debug_assert!(
+            cache.len() >= self.first_vertex + verts.len(),
+            "internal error: the vertex cache is short"
+        );
         let slots = cache.iter_mut().skip(self.first_vertex);
         for (slot, v) in slots.zip(verts) {
             *slot = CachedVertex::new::<S, A::Projection>(vp, A::Transform::apply(&self.mv, v));
@@ -853,6 +896,8 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         mut f: impl FnMut([ScreenVertex<S>; 3]),
     ) -> Fate {
         let Some(&idx) = self.instance.mesh.triangles().get(tri) else {
+            // Callers pass the mesh's own triangles (a BSP tree's ranges are checked against it).
+            debug_assert!(false, "internal error: no triangle {tri}");
             return Fate::Rejected;
         };
         let colors = self.vertex_attributes::<A>(tri, idx, lit);
@@ -1063,6 +1108,9 @@ pub(crate) fn drive<
                     }
                     if let Some(k) = ws.keys.get_mut(filed) {
                         *k = rank.unwrap_or((q_sum / q_count.max(1)) as u32);
+                    } else {
+                        // Only methods that do not sort have no keys.
+                        debug_assert!(!sorted, "internal error: no sort key for entry {filed}");
                     }
                 }
                 filed += 1;
@@ -1123,12 +1171,23 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> ActivePieces<SUB>
         e: usize,
         mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
-        let Some(&id) = self.refs.get(e) else { return };
-        let key = self.keys.get(e).copied().unwrap_or(0);
+        // Entries, ids and triangles all come from pass 1 of this frame.
+        let Some(&id) = self.refs.get(e) else {
+            debug_assert!(false, "internal error: no bucket entry {e}");
+            return;
+        };
+        // Keys exist (one per entry) only for methods that sort.
+        let key = if self.keys.is_empty() {
+            0
+        } else {
+            internal(self.keys.get(e).copied(), 0)
+        };
         let Some((setup, tri)) = locate(self.setups, id as u32) else {
+            debug_assert!(false, "internal error: no instance has triangle {id}");
             return;
         };
         let Some(&idx) = setup.instance.mesh.triangles().get(tri) else {
+            debug_assert!(false, "internal error: no triangle {tri} for id {id}");
             return;
         };
         let face = if S::PER_VERTEX {
@@ -1187,15 +1246,19 @@ pub(crate) fn walk_rows<
         for row in y0..y1 {
             let y = row as i32;
             // Activate this row's bucket.
-            let mut entry = heads.get(row).copied().unwrap_or(NO_ENTRY);
+            // Rows are below `height`, entries below the bucket capacity.
+            let mut entry = internal(heads.get(row).copied(), NO_ENTRY);
             while entry != NO_ENTRY {
                 let e = entry as usize;
-                entry = next.get(e).copied().unwrap_or(NO_ENTRY);
+                entry = internal(next.get(e).copied(), NO_ENTRY);
                 pieces.each_piece::<S>(e, |s, face, id, key| {
                     let (Some(walk), Some(solver)) = (
                         TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32),
                         PlaneSolver::new(&s),
                     ) else {
+                        // Pieces have screen area and rows from this one on (their bucket is
+                        // their first row, or the first of their triangle's pieces).
+                        debug_assert!(false, "internal error: piece of {id} not walkable");
                         return;
                     };
                     let mut tri_state = ActiveTri {
@@ -1377,4 +1440,27 @@ pub(crate) fn for_each_screen_piece<
         }
     }
     Ok(stats)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_internal_look_up_passes_its_value_through() {
+        assert_eq!(internal(Some(7u8), 0), 7);
+    }
+
+    #[test]
+    #[cfg(debug_assertions)]
+    #[should_panic(expected = "internal error")]
+    fn a_failed_internal_look_up_stops_a_debug_build() {
+        internal::<u8>(None, 0);
+    }
+
+    #[test]
+    #[cfg(not(debug_assertions))]
+    fn a_failed_internal_look_up_falls_back_in_release() {
+        assert_eq!(internal::<u8>(None, 9), 9);
+    }
 }

@@ -16,8 +16,8 @@
 use crate::clip::Clipping;
 use crate::preset::Arithmetic;
 use crate::render::{
-    drive, viewport, ActiveTri, CapacityKind, Frame, FrameStats, InstanceSetup, RenderError,
-    RenderOptions, TriangleOrder, NO_ENTRY,
+    drive, internal, viewport, ActiveTri, CapacityKind, Frame, FrameStats, InstanceSetup,
+    RenderError, RenderOptions, TriangleOrder, NO_ENTRY,
 };
 use crate::scene::{Scene, Transform};
 use crate::shading::Shading;
@@ -278,8 +278,10 @@ impl<'a> BspTree<'a> {
         push(stack, &mut top, 0)?;
         while top > 0 {
             top -= 1;
-            let entry = stack.get(top).copied().unwrap_or(0);
+            // `top` entries were pushed, and a checked tree names only its own nodes.
+            let entry = internal(stack.get(top).copied(), 0);
             let Some(node) = self.nodes.get((entry & !DRAW) as usize) else {
+                debug_assert!(false, "internal error: node {entry:#x} not in the tree");
                 continue;
             };
             if entry & DRAW != 0 {
@@ -347,6 +349,8 @@ impl TriangleOrder for BspOrder<'_, '_> {
         mut f: impl FnMut(&InstanceSetup<'s, T>, usize, Option<u32>),
     ) -> Result<(), RenderError<E>> {
         let Some(setup) = setups.first() else {
+            // BspWorkspace::render_sized requires exactly one instance.
+            debug_assert!(false, "internal error: a BSP scene without its instance");
             return Ok(());
         };
         let capacity = self.stack.len();

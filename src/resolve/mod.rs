@@ -37,8 +37,8 @@ use crate::preset::Arithmetic;
 use crate::project::Depth;
 use crate::raster::PixelOrigin;
 use crate::render::{
-    drive, fill_span, viewport, ActiveTri, FinishedRow, Frame, FrameStats, IdOrder, RenderError,
-    RenderOptions, Resolve, MAX_INSTANCES, NO_ENTRY,
+    drive, fill_span, internal, viewport, ActiveTri, FinishedRow, Frame, FrameStats, IdOrder,
+    RenderError, RenderOptions, Resolve, MAX_INSTANCES, NO_ENTRY,
 };
 use crate::scene::Scene;
 use crate::shading::Shading;
@@ -152,14 +152,18 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for Band<'_, P, Z> {
     }
     #[inline]
     fn span(&mut self, t: &ActiveTri<S::Payload<P>>, _: usize, y: i32, l: i32, r: i32) -> u32 {
+        // The row walker hands over rows of the current band only.
         let at = self.row_start(y);
         if let Some(n) = self.spans.get_mut((y - self.y0) as usize) {
             *n += 1;
+        } else {
+            debug_assert!(false, "internal error: row {y} outside the band");
         }
         let (Some(depth), Some(pixels)) = (
             self.depth.get_mut(at..at + self.width),
             self.pixels.get_mut(at..at + self.width),
         ) else {
+            debug_assert!(false, "internal error: row {y} outside the band");
             return 0;
         };
         fill_span::<P, S, Z, ()>(t, y, l, r, depth, pixels)
@@ -168,9 +172,9 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for Band<'_, P, Z> {
         let at = self.row_start(y);
         let rows = at..at + self.width;
         FinishedRow {
-            pixels: self.pixels.get(rows.clone()).unwrap_or(&[]),
-            depth: Z::row(self.depth.get(rows).unwrap_or(&[])),
-            spans: self.spans.get((y - self.y0) as usize).copied().unwrap_or(0),
+            pixels: internal(self.pixels.get(rows.clone()), &[]),
+            depth: Z::row(internal(self.depth.get(rows), &[])),
+            spans: internal(self.spans.get((y - self.y0) as usize).copied(), 0),
             written: 0,
         }
     }
@@ -355,7 +359,7 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanSort<'_, P, S::Payload<P>> {
     fn span(&mut self, t: &ActiveTri<S::Payload<P>>, order: usize, y: i32, l: i32, r: i32) -> u32 {
         let (q, dq) = t.depth.span_start(l, y);
         // At most one span per active triangle, and the list holds as many as the active list.
-        let _ = self.spans.push(SortSpan {
+        let pushed = self.spans.push(SortSpan {
             l,
             r,
             q: q as i64,
@@ -364,6 +368,10 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanSort<'_, P, S::Payload<P>> {
             payload: t.payload,
             origin: *t.depth.origin(),
         });
+        debug_assert!(
+            pushed.is_ok(),
+            "internal error: more spans than active triangles"
+        );
         0
     }
     fn finish_row(&mut self, y: i32) -> FinishedRow<'_, P> {
@@ -410,7 +418,7 @@ fn sweep<P: RowPixel, S: Shading>(
                 i += 1;
             }
         }
-        let present = spans.get(..live).unwrap_or(&[]);
+        let present = internal(spans.get(..live), &[]);
         // The end of the segment: the first span end or span start after x.
         let mut end = spans.get(next).map_or(width, |s| s.l.min(width));
         let mut front: Option<usize> = None;
@@ -422,12 +430,14 @@ fn sweep<P: RowPixel, S: Shading>(
         }
         let front = front.filter(|&f| present.get(f).is_some_and(|f| f.depth_at(x) > 0));
         let end = next_change(present, x, end, front);
-        if let (Some(f), Some(out)) = (
-            front.and_then(|f| present.get(f)),
-            pixels.get_mut(x as usize..end as usize),
-        ) {
-            S::paint(&f.payload, &f.origin, x, y, out);
-            written += (end - x) as u32;
+        if let Some(f) = front.and_then(|f| present.get(f)) {
+            if let Some(out) = pixels.get_mut(x as usize..end as usize) {
+                S::paint(&f.payload, &f.origin, x, y, out);
+                written += (end - x) as u32;
+            } else {
+                // Spans are clamped to the row and segments end within it.
+                debug_assert!(false, "internal error: segment {x}..{end} out of the row");
+            }
         }
         // end > x: present spans end after x and the next one starts after it.
         x = end;
@@ -611,7 +621,11 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for Painter<'_, P> {
                 S::paint(&t.payload, t.depth.origin(), l, y, out);
                 (r - l) as u32
             }
-            None => 0,
+            None => {
+                // walk_band clamps spans to the row.
+                debug_assert!(false, "internal error: span {l}..{r} out of the row");
+                0
+            }
         }
     }
     fn finish_row(&mut self, _: i32) -> FinishedRow<'_, P> {

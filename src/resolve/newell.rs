@@ -83,7 +83,7 @@
 use crate::clip::Clipping;
 use crate::preset::Arithmetic;
 use crate::render::{
-    viewport, walk_rows, ActiveTri, CapacityKind, FrameStats, RenderError, RenderOptions,
+    internal, viewport, walk_rows, ActiveTri, CapacityKind, FrameStats, RenderError, RenderOptions,
     MAX_INSTANCES, NO_ENTRY,
 };
 use crate::resolve::store::{self, StoredPieces, StoredTriangle};
@@ -278,16 +278,19 @@ impl<
         result?;
 
         // Key = position in the final order: the row walker's painter draws ascending keys.
+        // (List entries index the store's first `n` pieces, `n <= PIECES`.)
         for (k, &i) in self.list.iter().take(len).enumerate() {
             if let Some(key) = self.keys.get_mut(i as usize) {
                 *key = k as u32;
+            } else {
+                debug_assert!(false, "internal error: list entry {i} out of the store");
             }
         }
-        let store = self.store.get(..n).unwrap_or(&[]);
+        let store = internal(self.store.get(..n), &[]);
         store::bucket(store, &vp, heads, &mut self.next);
         let pieces = StoredPieces {
             store,
-            keys: self.keys.get(..n).unwrap_or(&[]),
+            keys: internal(self.keys.get(..n), &[]),
         };
         let mut painter = Painter {
             pixels,
@@ -437,7 +440,7 @@ impl Sort<'_> {
         let n = self.n;
         let mut start = 0;
         while start < n {
-            let id = self.store.get(start).map_or(0, |t| t.id);
+            let id = internal(self.store.get(start), &StoredTriangle::EMPTY).id;
             let end = (start..n)
                 .find(|&i| self.store.get(i).is_none_or(|t| t.id != id))
                 .unwrap_or(n);
@@ -462,6 +465,9 @@ impl Sort<'_> {
                         *slot = i as u16;
                         *mark = false;
                         self.len += 1;
+                    } else {
+                        // The list and the marks have room for every piece in the store.
+                        debug_assert!(false, "internal error: piece {i} not listed");
                     }
                 } else if let Some(t) = self.store.get_mut(i) {
                     // Not drawn: make sure no bucket picks it up.
@@ -477,16 +483,18 @@ impl Sort<'_> {
         }
     }
 
+    // Pieces are named by list entries, which index the store (and its keys and marks).
+
     fn piece(&self, i: u16) -> &StoredTriangle {
-        self.store.get(i as usize).unwrap_or(&StoredTriangle::EMPTY)
+        internal(self.store.get(i as usize), &StoredTriangle::EMPTY)
     }
 
     fn rank(&self, i: u16) -> u32 {
-        self.keys.get(i as usize).copied().unwrap_or(u32::MAX)
+        internal(self.keys.get(i as usize).copied(), u32::MAX)
     }
 
     fn is_marked(&self, i: u16) -> bool {
-        self.marked.get(i as usize).copied().unwrap_or(false)
+        internal(self.marked.get(i as usize).copied(), false)
     }
 
     /// How head `p` and piece `q` (whose depth ranges overlap) must be ordered.
@@ -519,13 +527,22 @@ impl Sort<'_> {
 
     /// Moves list entry `j` to the head (entry `done`), marking it.
     fn move_to_head(&mut self, done: usize, j: usize, front: &mut usize) {
+        // `done <= j < len`, and list entries index the marks.
         if let Some(run) = self.list.get_mut(done..=j) {
             run.rotate_right(1);
+        } else {
+            debug_assert!(
+                false,
+                "internal error: list run {done}..={j} out of the list"
+            );
         }
-        if let Some(&q) = self.list.get(done) {
-            if let Some(m) = self.marked.get_mut(q as usize) {
-                *m = true;
-            }
+        match self
+            .list
+            .get(done)
+            .and_then(|&q| self.marked.get_mut(q as usize))
+        {
+            Some(m) => *m = true,
+            None => debug_assert!(false, "internal error: head {done} has no mark"),
         }
         if j >= *front {
             *front += 1;
@@ -547,11 +564,17 @@ impl Sort<'_> {
                     capacity: limit,
                 });
             }
-            let Some(&p) = self.list.get(done) else { break };
+            let Some(&p) = self.list.get(done) else {
+                debug_assert!(false, "internal error: head {done} out of the list");
+                break;
+            };
             let p_max = max_q(self.piece(p));
             let mut found = None;
             for j in done + 1..self.len {
-                let Some(&q) = self.list.get(j) else { break };
+                let Some(&q) = self.list.get(j) else {
+                    debug_assert!(false, "internal error: entry {j} out of the list");
+                    break;
+                };
                 if min_q(self.piece(q)) > p_max {
                     if j >= front {
                         break;
@@ -617,6 +640,7 @@ impl Sort<'_> {
         front: &mut usize,
     ) -> Result<(), RenderError<E>> {
         let Some(&x) = self.list.get(at) else {
+            debug_assert!(false, "internal error: entry {at} out of the list");
             return Ok(());
         };
         let t = *self.piece(x);
@@ -635,6 +659,8 @@ impl Sort<'_> {
         // Take the piece out of the list.
         if let Some(rest) = self.list.get_mut(at..self.len) {
             rest.rotate_left(1);
+        } else {
+            debug_assert!(false, "internal error: entry {at} out of the list");
         }
         self.len -= 1;
         if at < *front {
@@ -655,20 +681,32 @@ impl Sort<'_> {
                 *s = part;
                 *k = rank;
                 *m = false;
+            } else {
+                // The store had room: checked above.
+                debug_assert!(false, "internal error: no store entry {i} for a part");
             }
             // File it in the sorted part.
             let (store, keys) = (&*self.store, &*self.keys);
             let key = sort_key(store, keys, i as u16);
             let Some(sorted) = self.list.get(*front..self.len) else {
+                debug_assert!(
+                    false,
+                    "internal error: sorted part {front}.. out of the list"
+                );
                 continue;
             };
             let pos = *front + sorted.partition_point(|&j| sort_key(store, keys, j) <= key);
             self.len += 1;
+            // The list has room for every piece in the store, and the run is not empty.
             if let Some(run) = self.list.get_mut(pos..self.len) {
                 run.rotate_right(1);
                 if let Some(first) = run.first_mut() {
                     *first = i as u16;
+                } else {
+                    debug_assert!(false, "internal error: no list room for piece {i}");
                 }
+            } else {
+                debug_assert!(false, "internal error: no list room for piece {i}");
             }
         }
         if let Some(s) = slot.and_then(|i| self.store.get_mut(i)) {
@@ -681,8 +719,9 @@ impl Sort<'_> {
 
 /// The sorted part's order: farthest point first; on a tie the later-activated piece first.
 fn sort_key(store: &[StoredTriangle], keys: &[u32], i: u16) -> (i32, Reverse<u32>) {
-    let q = store.get(i as usize).map_or(i32::MAX, min_q);
-    (q, Reverse(keys.get(i as usize).copied().unwrap_or(0)))
+    // List entries index the store and its keys.
+    let q = internal(store.get(i as usize).map(min_q), i32::MAX);
+    (q, Reverse(internal(keys.get(i as usize).copied(), 0)))
 }
 
 /// Cuts `t` by `plane` into up to three triangles of the same orientation, each on one side
@@ -695,9 +734,8 @@ fn cut(t: &StoredTriangle, plane: &PlaneEq) -> ([Option<StoredTriangle>; 3], usi
     let lead = if let Some(z) = (0..3).find(|&k| s[k] == 0) {
         z
     } else {
-        (0..3)
-            .find(|&k| s[(k + 1) % 3] == s[(k + 2) % 3])
-            .unwrap_or(0)
+        // The plane straddles `t`: its signs are +1 and −1, and two of the three agree.
+        internal((0..3).find(|&k| s[(k + 1) % 3] == s[(k + 2) % 3]), 0)
     };
     let v = |k: usize| (lead + k) % 3;
     let vertex = |k: usize| Vertex::of(t, v(k));

@@ -11,8 +11,8 @@ use crate::preset::Arithmetic;
 use crate::project::{Depth, ScreenVertex, SubPx, Viewport};
 use crate::raster::{channel, color_channels, first_row};
 use crate::render::{
-    for_each_screen_piece, ActivePieces, CapacityKind, FrameStats, RenderError, RenderOptions,
-    NO_ENTRY,
+    for_each_screen_piece, internal, ActivePieces, CapacityKind, FrameStats, RenderError,
+    RenderOptions, NO_ENTRY,
 };
 use crate::scene::Scene;
 use crate::shading::Shading;
@@ -140,6 +140,9 @@ pub(crate) fn bucket<const SUB: u32>(
         if let (Some(head), Some(link)) = (heads.get_mut(row as usize), next.get_mut(i)) {
             *link = *head;
             *head = i as u16;
+        } else {
+            // First rows are on screen; there is a link per kept piece.
+            debug_assert!(false, "internal error: piece {i} not filed on row {row}");
         }
     }
 }
@@ -158,9 +161,12 @@ impl<const SUB: u32> ActivePieces<SUB> for StoredPieces<'_> {
         entry: usize,
         mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
+        // Entries index the store, which has a key per piece.
         if let Some(t) = self.store.get(entry) {
-            let key = self.keys.get(entry).copied().unwrap_or(0);
+            let key = internal(self.keys.get(entry).copied(), 0);
             f(t.screen::<SUB>(), t.face(), t.id, key);
+        } else {
+            debug_assert!(false, "internal error: no kept piece {entry}");
         }
     }
 }
