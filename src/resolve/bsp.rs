@@ -127,10 +127,12 @@ const fn subtree_end(nodes: &[BspNode], mut x: usize, mut budget: usize) -> Opti
 /// the walks take `nodes.len()` steps in all; a budget of that many stops any other input.
 const fn is_pre_order(nodes: &[BspNode]) -> bool {
     let mut budget = nodes.len();
-    let mut i = nodes.len();
-    while i > 0 {
-        i -= 1;
-        let (first, second) = children(&nodes[i]);
+    // Last node first, by slice patterns rather than indexing (no panic path).
+    let mut rest = nodes;
+    while let [before @ .., node] = rest {
+        let i = before.len();
+        rest = before;
+        let (first, second) = children(node);
         if first == NO_CHILD {
             continue; // a leaf
         }
@@ -154,15 +156,20 @@ const fn check_parents(nodes: &[BspNode]) -> Result<(), BspError> {
     let mut child = 1;
     while child < nodes.len() {
         let mut named = false;
-        let mut node = 0;
-        while node < child {
-            let (a, b) = (nodes[node].front as usize, nodes[node].back as usize);
+        // Parents come before their children: the nodes before `child`, by slice patterns.
+        let (mut node, mut rest) = (0, nodes);
+        while let [parent, after @ ..] = rest {
+            if node == child {
+                break;
+            }
+            let (a, b) = (parent.front as usize, parent.back as usize);
             let times = (a == child) as usize + (b == child) as usize;
             if times > 0 && (named || times > 1) {
                 return Err(BspError::SharedChild { node, child });
             }
             named |= times > 0;
             node += 1;
+            rest = after;
         }
         if !named {
             return Err(BspError::Unreachable { node: child });

@@ -87,7 +87,7 @@ use crate::render::{
     MAX_INSTANCES, NO_ENTRY,
 };
 use crate::resolve::store::{self, StoredPieces, StoredTriangle};
-use crate::resolve::{check_sizes, Painter};
+use crate::resolve::{check_sizes, sort_by_key, Painter};
 use crate::scene::Scene;
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
@@ -348,10 +348,13 @@ impl PlaneEq {
         })
     }
 
-    /// `s` at vertex `k` of `t`.
+    /// `s` at vertex `k` (0, 1 or 2) of `t`.
     fn at(&self, t: &StoredTriangle, k: usize) -> i128 {
-        self.n[0] * t.x[k] as i128 + self.n[1] * t.y[k] as i128 + self.n[2] * t.q[k] as i128
-            - self.d
+        let (Some(&x), Some(&y), Some(&q)) = (t.x.get(k), t.y.get(k), t.q.get(k)) else {
+            debug_assert!(false, "internal error: no vertex {k}");
+            return 0;
+        };
+        self.n[0] * x as i128 + self.n[1] * y as i128 + self.n[2] * q as i128 - self.d
     }
 
     /// Whether all of `t` is behind this plane or on it.
@@ -415,7 +418,15 @@ enum Order {
 
 /// Rounds `num / den` (with `den > 0`) to the nearest integer, halves up.
 fn div_round(num: i128, den: i128) -> i128 {
-    (2 * num + den).div_euclid(2 * den)
+    // Callers divide by the gap between two plane distances of opposite sign, never 0 and far
+    // below 2^126; 0 is the release fallback for that internal error (no panic path).
+    match (2 * num + den).checked_div_euclid(2 * den) {
+        Some(q) => q,
+        None => {
+            debug_assert!(false, "internal error: {num} / {den}");
+            0
+        }
+    }
 }
 
 /// The search over one frame's pieces.
@@ -479,7 +490,8 @@ impl Sort<'_> {
         self.stats.pieces_in = self.len as u32;
         let (store, keys) = (&*self.store, &*self.keys);
         if let Some(list) = self.list.get_mut(..self.len) {
-            list.sort_unstable_by_key(|&i| sort_key(store, keys, i));
+            // (Keys are unique: the rank holds the piece's index.)
+            sort_by_key(list, |&i| sort_key(store, keys, i));
         }
     }
 
@@ -528,7 +540,8 @@ impl Sort<'_> {
     /// Moves list entry `j` to the head (entry `done`), marking it.
     fn move_to_head(&mut self, done: usize, j: usize, front: &mut usize) {
         // `done <= j < len`, and list entries index the marks.
-        if let Some(run) = self.list.get_mut(done..=j) {
+        // (Rotating only a non-empty run: no panic path.)
+        if let Some(run @ [_, ..]) = self.list.get_mut(done..=j) {
             run.rotate_right(1);
         } else {
             debug_assert!(
@@ -657,7 +670,7 @@ impl Sort<'_> {
         self.stats.splits += 1;
         self.stats.dropped_slivers += (made - count) as u32;
         // Take the piece out of the list.
-        if let Some(rest) = self.list.get_mut(at..self.len) {
+        if let Some(rest @ [_, ..]) = self.list.get_mut(at..self.len) {
             rest.rotate_left(1);
         } else {
             debug_assert!(false, "internal error: entry {at} out of the list");
@@ -698,12 +711,10 @@ impl Sort<'_> {
             let pos = *front + sorted.partition_point(|&j| sort_key(store, keys, j) <= key);
             self.len += 1;
             // The list has room for every piece in the store, and the run is not empty.
-            if let Some(run) = self.list.get_mut(pos..self.len) {
+            if let Some(run @ [_, ..]) = self.list.get_mut(pos..self.len) {
                 run.rotate_right(1);
                 if let Some(first) = run.first_mut() {
                     *first = i as u16;
-                } else {
-                    debug_assert!(false, "internal error: no list room for piece {i}");
                 }
             } else {
                 debug_assert!(false, "internal error: no list room for piece {i}");

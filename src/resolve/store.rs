@@ -70,12 +70,20 @@ impl StoredTriangle {
 
     /// The screen vertices again, for set-up.
     pub(crate) fn screen<const S: u32>(&self) -> [ScreenVertex<S>; 3] {
-        [0, 1, 2].map(|k| ScreenVertex {
-            x: SubPx(self.x[k]),
-            y: SubPx(self.y[k]),
-            q: Depth::from_bits(self.q[k]),
-            color: color_channels(self.colors[k]),
-        })
+        // Destructured rather than indexed: no bounds check to leave a panic path.
+        let vertex = |x, y, q, c| ScreenVertex {
+            x: SubPx(x),
+            y: SubPx(y),
+            q: Depth::from_bits(q),
+            color: color_channels(c),
+        };
+        let ([x0, x1, x2], [y0, y1, y2], [q0, q1, q2], [c0, c1, c2]) =
+            (self.x, self.y, self.q, self.colors);
+        [
+            vertex(x0, y0, q0, c0),
+            vertex(x1, y1, q1, c1),
+            vertex(x2, y2, q2, c2),
+        ]
     }
 
     /// The face colour (vertex 0's colour).
