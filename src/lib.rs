@@ -71,7 +71,7 @@
 //! | far plane | ≤ [`MAX_EYE_DISTANCE`](scene::MAX_EYE_DISTANCE) = 16384 | eye-space envelope |
 //! | far/near | ≤ [`MAX_FAR_NEAR_RATIO`](scene::MAX_FAR_NEAR_RATIO) = 2^20 | `q = near/w` keeps ≥ 2^10 steps of I2F30 at the far plane: relative depth resolution 2^-30 · far/near ≤ 2^-10 there |
 //! | instances | `INSTANCES` of the [`Workspace`], default [`MAX_INSTANCES`](render::MAX_INSTANCES) = 8 | per-frame set-up on the stack, about 120 B each |
-//! | triangles per frame | `TRIS` ≤ 65534 | 16-bit bucket links |
+//! | triangles per frame | [`MAX_SCENE_TRIANGLES`](scene::MAX_SCENE_TRIANGLES) = 65535 over all instances, checked by [`Scene::new`](scene::Scene::new) and per frame; `TRIS` (and `PIECES`) ≤ 65535 | 16-bit triangle ids and bucket links, `u16::MAX` ends a list |
 //!
 //! Any triangle size works: triangles far larger than the screen are clipped to a guard band of
 //! 8 half-screens; triangles smaller than a pixel cover exactly the centres they contain (often

@@ -29,7 +29,7 @@ use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{
     color_channels, first_row, signed_area, xy, DepthPlane, PlaneSolver, TriangleWalk,
 };
-use crate::scene::{Instance, MeshColors, Scene};
+use crate::scene::{Instance, MeshColors, Scene, MAX_SCENE_TRIANGLES};
 use crate::shading::{Shading, SpanDepth};
 use crate::sink::{Row, RowPixel, RowSink};
 use crate::vertex::{shade, Lighting, ModelView, TransformError, TransformPrecision};
@@ -245,6 +245,13 @@ pub enum RenderError<E> {
     /// The BSP tree was built for another mesh, or the scene does not have exactly one
     /// instance (its mesh) for it.
     TreeMismatch,
+    /// The scene's instances hold `triangles` triangles together, more than
+    /// [`MAX_SCENE_TRIANGLES`] (65,535; [`Scene::new`] rejects such a scene too). Returned before
+    /// any row is sent.
+    TooManyTriangles {
+        /// Triangles over all instances.
+        triangles: usize,
+    },
     /// A capacity was exceeded before any row was sent (the sink received nothing).
     Capacity {
         /// Which buffer.
@@ -284,6 +291,10 @@ impl<E: core::fmt::Debug> core::fmt::Display for RenderError<E> {
             }
             Self::Sink { row, error } => write!(f, "sink failed on row {row}: {error:?}"),
             Self::TreeMismatch => write!(f, "the BSP tree does not match the scene's mesh"),
+            Self::TooManyTriangles { triangles } => write!(
+                f,
+                "the scene has {triangles} triangles, more than the limit of {MAX_SCENE_TRIANGLES} per frame"
+            ),
         }
     }
 }
@@ -385,6 +396,12 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for SpanZBuffer<'_, 
         if let (Some(d), Some(p)) = (self.depth.get_mut(lo..hi), self.pixels.get_mut(lo..hi)) {
             d.fill(Z::FAR);
             p.fill(self.background);
+        } else {
+            // Only a clean row (lo > hi: nothing written) has no range to clear.
+            debug_assert!(
+                lo > hi,
+                "internal error: dirty columns {lo}..{hi} out of the row"
+            );
         }
         self.dirty = (self.pixels.len(), 0);
         self.spans = 0;
@@ -421,18 +438,39 @@ pub(crate) fn fill_span<P: RowPixel, S: Shading, Z: DepthFormat, K>(
     let cols = l as usize..r as usize;
     match (depth.get_mut(cols.clone()), pixels.get_mut(cols)) {
         (Some(d), Some(p)) => S::fill(&t.payload, t.depth.origin(), span, d, p),
-        _ => 0,
+        _ => {
+            // walk_band clamps spans to the row.
+            debug_assert!(false, "internal error: span {l}..{r} out of the row");
+            0
+        }
     }
 }
 
 pub(crate) const NO_ENTRY: u16 = u16::MAX;
+
+/// `value`, or `fallback` if it is `None`: for look-ups that validation (of meshes, trees and
+/// capacities) or the frame's own set-up make infallible, so that `None` is an internal error.
+/// Debug builds, the tests among them, stop there; release builds, whose render path must not
+/// panic, go on with the fallback.
+#[inline(always)]
+#[track_caller]
+pub(crate) fn internal<T>(value: Option<T>, fallback: T) -> T {
+    match value {
+        Some(value) => value,
+        None => {
+            debug_assert!(false, "internal error: a look-up that cannot fail failed");
+            fallback
+        }
+    }
+}
 
 /// All the memory a render needs, sized at compile time.
 ///
 /// * `P`: the pixel type ([`RowPixel`]); `S`: the shading model ([`crate::Flat`] or
 ///   [`crate::Gouraud`]);
 /// * `W × H`: the target size (1..=2048 each);
-/// * `TRIS`: triangles that may survive culling in one frame (≤ 65535);
+/// * `TRIS`: triangles that may survive culling in one frame (at most
+///   [`MAX_SCENE_TRIANGLES`] = 65,535);
 /// * `INSTANCES`: mesh instances a scene may have (their set-up lives on the stack during a
 ///   render; default [`MAX_INSTANCES`]);
 /// * `ACTIVE`: triangles that may cross one row (more are dropped and reported in
@@ -568,7 +606,7 @@ impl<
             H >= 1 && H <= crate::project::MAX_SCREEN,
             "height must be 1..=2048"
         );
-        assert!(TRIS < NO_ENTRY as usize, "TRIS must be below 65535");
+        assert!(TRIS <= MAX_SCENE_TRIANGLES, "TRIS must be at most 65535");
     };
 
     /// An empty workspace whose background pixels are `background`.
@@ -762,6 +800,11 @@ pub(crate) struct InstanceSetup<'a, T: TransformPrecision> {
 fn setup_instances<'a, T: TransformPrecision, E, const N: usize>(
     scene: &'a Scene<'a>,
 ) -> Result<Vec<InstanceSetup<'a, T>, N>, RenderError<E>> {
+    // Triangle ids (and so the u16 ids in the row buckets) must stay below 65,535.
+    let triangles = scene.triangle_count();
+    if triangles > MAX_SCENE_TRIANGLES {
+        return Err(RenderError::TooManyTriangles { triangles });
+    }
     let mut out = Vec::new();
     let view = &scene.camera.view().world_to_eye;
     let (mut first_id, mut first_vertex) = (0u32, 0usize);
@@ -804,8 +847,9 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         let mesh = self.instance.mesh;
         let pick = |i: u16| match mesh.colors() {
             MeshColors::Uniform(c) => c,
-            MeshColors::PerFace(c) => c.get(tri).copied().unwrap_or(Rgb888::new(0, 0, 0)),
-            MeshColors::PerVertex(c) => c.get(i as usize).copied().unwrap_or(Rgb888::new(0, 0, 0)),
+            // Mesh::new checked both lengths.
+            MeshColors::PerFace(c) => internal(c.get(tri).copied(), Rgb888::new(0, 0, 0)),
+            MeshColors::PerVertex(c) => internal(c.get(i as usize).copied(), Rgb888::new(0, 0, 0)),
         };
         idx.map(pick)
     }
@@ -814,7 +858,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
     fn face_color<N: NormalPrecision>(&self, tri: usize, idx: [u16; 3]) -> Rgb888 {
         let verts = self.instance.mesh.vertices();
         let zero = [I16F16::ZERO; 3];
-        let v = idx.map(|i| verts.get(i as usize).unwrap_or(&zero));
+        let v = idx.map(|i| internal(verts.get(i as usize), &zero));
         shade(self.vertex_colors(tri, idx)[0], self.lighting.face::<N>(v))
     }
 
@@ -835,11 +879,11 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         let intensity = match mesh.normals() {
             Some(n) => idx.map(|i| {
                 self.lighting
-                    .vertex::<A::Normals>(n.get(i as usize).unwrap_or(&zero))
+                    .vertex::<A::Normals>(internal(n.get(i as usize), &zero))
             }),
             None => {
                 let verts = mesh.vertices();
-                let v = idx.map(|i| verts.get(i as usize).unwrap_or(&zero));
+                let v = idx.map(|i| internal(verts.get(i as usize), &zero));
                 [self.lighting.face::<A::Normals>(v); 3]
             }
         };
@@ -854,7 +898,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
     ) -> [ClipVertex; 3] {
         let verts = self.instance.mesh.vertices();
         let zero = [I16F16::ZERO; 3];
-        let v = idx.map(|i| verts.get(i as usize).unwrap_or(&zero));
+        let v = idx.map(|i| internal(verts.get(i as usize), &zero));
         [0, 1, 2].map(|k| ClipVertex {
             p: A::Transform::apply(&self.mv, v[k]),
             color: colors[k],
@@ -867,8 +911,19 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         cache: &'c [CachedVertex],
         idx: [u16; 3],
     ) -> Option<[&'c CachedVertex; 3]> {
+        if cache.is_empty() {
+            return None;
+        }
         let get = |i: u16| cache.get(self.first_vertex + i as usize);
-        Some([get(idx[0])?, get(idx[1])?, get(idx[2])?])
+        let [Some(a), Some(b), Some(c)] = idx.map(get) else {
+            // A cache holds every vertex of the scene; without it the triangle is drawn uncached.
+            debug_assert!(
+                false,
+                "internal error: vertices {idx:?} not in the vertex cache"
+            );
+            return None;
+        };
+        Some([a, b, c])
     }
 
     /// Fills this instance's part of the vertex cache: every vertex transformed, clip-tested
@@ -879,6 +934,11 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         cache: &mut [CachedVertex],
     ) {
         let verts = self.instance.mesh.vertices();
+        // The cache was sized for every vertex of the scene.
+        debug_assert!(
+            cache.len() >= self.first_vertex + verts.len(),
+            "internal error: the vertex cache is short"
+        );
         let slots = cache.iter_mut().skip(self.first_vertex);
         for (slot, v) in slots.zip(verts) {
             *slot = CachedVertex::new::<S, A::Projection>(vp, A::Transform::apply(&self.mv, v));
@@ -899,6 +959,8 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         mut f: impl FnMut([ScreenVertex<S>; 3]),
     ) -> Fate {
         let Some(&idx) = self.instance.mesh.triangles().get(tri) else {
+            // Callers pass the mesh's own triangles (a BSP tree's ranges are checked against it).
+            debug_assert!(false, "internal error: no triangle {tri}");
             return Fate::Rejected;
         };
         let colors = self.vertex_attributes::<A>(tri, idx, lit);
@@ -1091,17 +1153,27 @@ pub(crate) fn drive<
                 if filed < capacity {
                     let id = setup.first_id + tri as u32;
                     let row = first_row as usize;
-                    if let (Some(head), Some(next), Some(r)) = (
+                    // Ids fit 16 bits (at most MAX_SCENE_TRIANGLES triangles, checked by
+                    // `setup_instances`), and so do entries (`filed < TRIS <= 65535`), which
+                    // stay below NO_ENTRY: nothing is truncated.
+                    if let (Some(head), Some(next), Some(r), Ok(id), Ok(entry)) = (
                         ws.heads.get_mut(row),
                         ws.next.get_mut(filed),
                         ws.refs.get_mut(filed),
+                        u16::try_from(id),
+                        u16::try_from(filed),
                     ) {
-                        *r = id as u16;
+                        *r = id;
                         *next = *head;
-                        *head = filed as u16;
+                        *head = entry;
+                    } else {
+                        debug_assert!(false, "internal error: triangle {id} not filed");
                     }
                     if let Some(k) = ws.keys.get_mut(filed) {
                         *k = rank.unwrap_or((q_sum / q_count.max(1)) as u32);
+                    } else {
+                        // Only methods that do not sort have no keys.
+                        debug_assert!(!sorted, "internal error: no sort key for entry {filed}");
                     }
                 }
                 filed += 1;
@@ -1162,12 +1234,23 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> ActivePieces<SUB>
         e: usize,
         mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
-        let Some(&id) = self.refs.get(e) else { return };
-        let key = self.keys.get(e).copied().unwrap_or(0);
+        // Entries, ids and triangles all come from pass 1 of this frame.
+        let Some(&id) = self.refs.get(e) else {
+            debug_assert!(false, "internal error: no bucket entry {e}");
+            return;
+        };
+        // Keys exist (one per entry) only for methods that sort.
+        let key = if self.keys.is_empty() {
+            0
+        } else {
+            internal(self.keys.get(e).copied(), 0)
+        };
         let Some((setup, tri)) = locate(self.setups, id as u32) else {
+            debug_assert!(false, "internal error: no instance has triangle {id}");
             return;
         };
         let Some(&idx) = setup.instance.mesh.triangles().get(tri) else {
+            debug_assert!(false, "internal error: no triangle {tri} for id {id}");
             return;
         };
         let face = if S::PER_VERTEX {
@@ -1226,15 +1309,19 @@ pub(crate) fn walk_rows<
         for row in y0..y1 {
             let y = row as i32;
             // Activate this row's bucket.
-            let mut entry = heads.get(row).copied().unwrap_or(NO_ENTRY);
+            // Rows are below `height`, entries below the bucket capacity.
+            let mut entry = internal(heads.get(row).copied(), NO_ENTRY);
             while entry != NO_ENTRY {
                 let e = entry as usize;
-                entry = next.get(e).copied().unwrap_or(NO_ENTRY);
+                entry = internal(next.get(e).copied(), NO_ENTRY);
                 pieces.each_piece::<S>(e, |s, face, id, key| {
                     let (Some(walk), Some(solver)) = (
                         TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32),
                         PlaneSolver::new(&s),
                     ) else {
+                        // Pieces have screen area and rows from this one on (their bucket is
+                        // their first row, or the first of their triangle's pieces).
+                        debug_assert!(false, "internal error: piece of {id} not walkable");
                         return;
                     };
                     let mut tri_state = ActiveTri {
@@ -1416,4 +1503,27 @@ pub(crate) fn for_each_screen_piece<
         }
     }
     Ok(stats)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_internal_look_up_passes_its_value_through() {
+        assert_eq!(internal(Some(7u8), 0), 7);
+    }
+
+    #[test]
+    #[cfg(debug_assertions)]
+    #[should_panic(expected = "internal error")]
+    fn a_failed_internal_look_up_stops_a_debug_build() {
+        internal::<u8>(None, 0);
+    }
+
+    #[test]
+    #[cfg(not(debug_assertions))]
+    fn a_failed_internal_look_up_falls_back_in_release() {
+        assert_eq!(internal::<u8>(None, 9), 9);
+    }
 }

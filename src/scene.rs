@@ -23,8 +23,17 @@ pub type Vertex = [Coord; 3];
 /// [`crate::vertex`] for the full bit budget).
 pub const MAX_MODEL_COORD: i32 = 1 << 12;
 
-/// Largest number of triangles in one frame (all instances together): ids are 16-bit in the
-/// triangle buckets.
+/// Largest number of triangles in one frame, all instances together: 65,535.
+///
+/// The row walkers keep each bucketed triangle's id in 16 bits and thread their row buckets
+/// through 16-bit links that end at `u16::MAX`; with at most 65,535 triangles every id and every
+/// link index is in `0..=65534`, so neither is ever truncated nor taken for the end of a list.
+/// The same bound applies to one mesh ([`Mesh::new`], [`SceneError::MeshTooLarge`]), to a
+/// workspace's `TRIS` and to the `PIECES` of [`NewellWorkspace`](crate::resolve::NewellWorkspace)
+/// and [`WarnockWorkspace`](crate::resolve::WarnockWorkspace) (checked when the workspace is
+/// built). A scene over it is rejected by [`Scene::new`] ([`SceneError::TooManyTriangles`]) and,
+/// as `Scene`'s fields are public, again by every render before any row is sent
+/// ([`RenderError::TooManyTriangles`](crate::RenderError::TooManyTriangles)).
 pub const MAX_SCENE_TRIANGLES: usize = u16::MAX as usize;
 
 /// Largest |eye-space coordinate| the camera's near and far planes may use: 2^14 units.
@@ -63,8 +72,15 @@ pub enum SceneError {
         /// Length given.
         found: usize,
     },
-    /// A mesh has more triangles or vertices than 16-bit indices allow.
+    /// A mesh has more than 65,535 triangles ([`MAX_SCENE_TRIANGLES`]) or vertices: more than
+    /// 16-bit indices allow.
     MeshTooLarge,
+    /// The scene's instances hold `triangles` triangles together, more than
+    /// [`MAX_SCENE_TRIANGLES`] (65,535).
+    TooManyTriangles {
+        /// Triangles over all instances.
+        triangles: usize,
+    },
     /// A floating-point input was NaN or infinite.
     NonFinite {
         /// Which input.
@@ -98,6 +114,10 @@ impl core::fmt::Display for SceneError {
                 write!(f, "{what}: expected {expected} entries, found {found}")
             }
             Self::MeshTooLarge => write!(f, "mesh exceeds 65535 vertices or triangles"),
+            Self::TooManyTriangles { triangles } => write!(
+                f,
+                "the scene has {triangles} triangles, more than the limit of {MAX_SCENE_TRIANGLES} per frame"
+            ),
             Self::NonFinite { what } => write!(f, "{what} is not a finite number"),
             Self::EyeEqualsTarget => write!(f, "camera eye and target are the same point"),
             Self::DegenerateUp => {
@@ -654,13 +674,55 @@ pub struct Scene<'a> {
     pub light: Light,
 }
 
-impl Scene<'_> {
-    /// Total number of triangles over all instances.
-    pub fn triangle_count(&self) -> usize {
-        self.instances
-            .iter()
-            .map(|i| i.mesh.triangles().len())
-            .sum()
+impl<'a> Scene<'a> {
+    /// A scene of `instances` seen by `camera` under `light`, rejected if the instances hold
+    /// more than [`MAX_SCENE_TRIANGLES`] triangles together. `const`, like [`Mesh::new`].
+    ///
+    /// (The fields are public, so a scene can also be built as a struct literal; the render
+    /// checks the same limit then, see [`RenderError::TooManyTriangles`].)
+    ///
+    /// [`RenderError::TooManyTriangles`]: crate::RenderError::TooManyTriangles
+    ///
+    /// ```
+    /// use embedded_graphics::pixelcolor::Rgb888;
+    /// use fixed::types::I16F16;
+    /// use scanline3d::scene::*;
+    ///
+    /// const Z: I16F16 = I16F16::ZERO;
+    /// static VERTS: [Vertex; 3] = [[Z, Z, Z], [I16F16::ONE, Z, Z], [Z, I16F16::ONE, Z]];
+    /// static TRIS: [[u16; 3]; 1] = [[0, 1, 2]];
+    /// let mesh = Mesh::new(&VERTS, &TRIS, MeshColors::Uniform(Rgb888::new(9, 9, 9)), None)?;
+    /// let instances = [Instance { mesh: &mesh, transform: Transform::IDENTITY }; 2];
+    /// let camera = Camera::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0])?.perspective(60.0, 0.5, 10.0)?;
+    /// let scene = Scene::new(&instances, camera, Light::new([0.0, 0.0, 1.0], 0.2, 0.8)?)?;
+    /// assert_eq!(scene.triangle_count(), 2);
+    /// # Ok::<(), scanline3d::scene::SceneError>(())
+    /// ```
+    pub const fn new(
+        instances: &'a [Instance<'a>],
+        camera: Camera,
+        light: Light,
+    ) -> Result<Self, SceneError> {
+        let scene = Scene {
+            instances,
+            camera,
+            light,
+        };
+        let triangles = scene.triangle_count();
+        if triangles > MAX_SCENE_TRIANGLES {
+            return Err(SceneError::TooManyTriangles { triangles });
+        }
+        Ok(scene)
+    }
+
+    /// Total number of triangles over all instances (saturating at `usize::MAX`).
+    pub const fn triangle_count(&self) -> usize {
+        let (mut total, mut rest) = (0usize, self.instances);
+        while let [instance, tail @ ..] = rest {
+            total = total.saturating_add(instance.mesh.triangles().len());
+            rest = tail;
+        }
+        total
     }
 }
 

@@ -9,8 +9,9 @@ use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use fixed::types::I16F16;
 use scanline3d::project::{Viewport, MAX_SCREEN};
 use scanline3d::render::{CapacityKind, MAX_INSTANCES};
+use scanline3d::resolve::{DepthSortWorkspace, NewellWorkspace, WarnockWorkspace};
 use scanline3d::scene::*;
-use scanline3d::sink::{FnSink, Row};
+use scanline3d::sink::{FnSink, Row, RowSink, TriangleId};
 use scanline3d::vertex::{ModelView, TransformError};
 use scanline3d::{Flat, RenderError, RenderOptions, Workspace};
 
@@ -164,4 +165,166 @@ fn depth_keeps_order_at_the_far_near_limit() {
         "the far square shows around it: {}",
         ids[10 * 32 + 16]
     );
+}
+
+/// The triangle (−1, −1), (1, −1), (0, 1) in z = 0, `count` times: front-facing seen from +z,
+/// or back-facing (culled) if `front` is false.
+fn repeated_triangle(count: usize, front: bool) -> (Vec<Vertex>, Vec<[u16; 3]>) {
+    let vertices = vec![
+        vert([-1.0, -1.0, 0.0]),
+        vert([1.0, -1.0, 0.0]),
+        vert([0.0, 1.0, 0.0]),
+    ];
+    let winding = if front { [0, 1, 2] } else { [0, 2, 1] };
+    (vertices, vec![winding; count])
+}
+
+/// The instances seen from (0, 0, 3), as a struct literal (not checked by `Scene::new`).
+fn scene_of<'a>(instances: &'a [Instance<'a>]) -> Scene<'a> {
+    Scene {
+        instances,
+        camera: Camera::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0])
+            .unwrap()
+            .perspective(60.0, 0.5, 10.0)
+            .unwrap(),
+        light: light(),
+    }
+}
+
+/// An id image, row by row.
+#[derive(Default)]
+struct IdImage(Vec<i32>);
+
+impl RowSink<TriangleId> for IdImage {
+    type Error = ();
+    fn write_row(&mut self, row: Row<'_, TriangleId>) -> Result<(), ()> {
+        self.0.extend(row.pixels.iter().map(|p| p.0));
+        Ok(())
+    }
+}
+
+#[test]
+fn up_to_65535_triangles_per_scene() {
+    assert_eq!(MAX_SCENE_TRIANGLES, 65_535);
+    let color = MeshColors::Uniform(Rgb888::new(200, 200, 200));
+    // 65,534 culled triangles and one visible one, whose id is the largest a scene may have.
+    let (v, t) = repeated_triangle(MAX_SCENE_TRIANGLES - 1, false);
+    let hidden = Mesh::new(&v, &t, color, None).unwrap();
+    let (v1, t1) = repeated_triangle(1, true);
+    let shown = Mesh::new(&v1, &t1, color, None).unwrap();
+    let place = |mesh| Instance {
+        mesh,
+        transform: Transform::IDENTITY,
+    };
+    let at_limit = [place(&hidden), place(&shown)];
+    let past_limit = [place(&hidden), place(&shown), place(&shown)];
+    // Far past it: the visible triangle's id would wrap to one of the culled ones in 16 bits.
+    let wrapped = [place(&hidden), place(&hidden), place(&shown)];
+
+    // Scene::new checks the total.
+    let light = light();
+    let camera = scene_of(&[]).camera;
+    assert_eq!(
+        Scene::new(&at_limit, camera, light)
+            .unwrap()
+            .triangle_count(),
+        65_535
+    );
+    let err = Scene::new(&past_limit, camera, light).unwrap_err();
+    assert_eq!(err, SceneError::TooManyTriangles { triangles: 65_536 });
+    assert_eq!(
+        err.to_string(),
+        "the scene has 65536 triangles, more than the limit of 65535 per frame"
+    );
+    assert_eq!(
+        Scene::new(&wrapped, camera, light).unwrap_err(),
+        SceneError::TooManyTriangles { triangles: 131_069 }
+    );
+
+    // So does every render of a scene built as a struct literal, before any row is sent.
+    let options = RenderOptions::default();
+    let mut ws: Box<Workspace<TriangleId, Flat, 8, 8, 4, 4>> =
+        Box::new(Workspace::new(TriangleId::NONE));
+    let mut image = IdImage::default();
+    let stats = ws
+        .render(&scene_of(&at_limit), &options, &mut image)
+        .unwrap();
+    assert_eq!(
+        (stats.triangles_in, stats.culled, stats.bucketed),
+        (65_535, 65_534, 1)
+    );
+    assert_eq!(image.0.len(), 64);
+    assert_eq!(image.0[4 * 8 + 4], 65_534, "the last id is drawn as itself");
+    for instances in [&past_limit[..], &wrapped[..]] {
+        let mut image = IdImage::default();
+        let triangles = scene_of(instances).triangle_count();
+        assert_eq!(
+            ws.render(&scene_of(instances), &options, &mut image),
+            Err(RenderError::TooManyTriangles { triangles })
+        );
+        assert!(image.0.is_empty(), "no row may be sent");
+    }
+    assert_eq!(
+        RenderError::<()>::TooManyTriangles { triangles: 65_536 }.to_string(),
+        "the scene has 65536 triangles, more than the limit of 65535 per frame"
+    );
+
+    // The other methods' set-up: a painter's order (bucketed ids), and the whole-frame methods
+    // (kept pieces).
+    let mut sorted: Box<DepthSortWorkspace<TriangleId, Flat, 8, 8, 4, 4>> =
+        Box::new(DepthSortWorkspace::new(TriangleId::NONE));
+    let mut newell: Box<NewellWorkspace<TriangleId, Flat, 8, 8, 4, 4>> =
+        Box::new(NewellWorkspace::new(TriangleId::NONE));
+    let mut warnock: Box<WarnockWorkspace<TriangleId, Flat, 8, 8, 4, 64>> =
+        Box::new(WarnockWorkspace::new(TriangleId::NONE));
+    for instances in [&at_limit[..], &past_limit[..]] {
+        let scene = scene_of(instances);
+        let triangles = scene.triangle_count();
+        let results = [
+            (
+                "depth sort",
+                sorted.render(&scene, &options, &mut IdImage::default()),
+            ),
+            (
+                "newell",
+                newell.render(&scene, &options, &mut IdImage::default()),
+            ),
+            (
+                "warnock",
+                warnock.render(&scene, &options, &mut IdImage::default()),
+            ),
+        ];
+        for (name, result) in results {
+            if triangles <= MAX_SCENE_TRIANGLES {
+                assert_eq!(result.map(|s| s.bucketed), Ok(1), "{name}");
+            } else {
+                assert_eq!(
+                    result,
+                    Err(RenderError::TooManyTriangles { triangles }),
+                    "{name}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn up_to_65535_bucketed_triangles() {
+    // TRIS at its limit: 65,535 visible triangles are filed, the last in bucket entry 65,534,
+    // right below the end-of-list mark, and every entry is reached (activated or, with room for
+    // 8, dropped).
+    let (v, t) = repeated_triangle(MAX_SCENE_TRIANGLES, true);
+    let mesh = Mesh::new(&v, &t, MeshColors::Uniform(Rgb888::new(1, 2, 3)), None).unwrap();
+    let instances = [instance(&mesh)];
+    let mut ws: Box<Workspace<TriangleId, Flat, 8, 8, 65_535, 8>> =
+        Box::new(Workspace::new(TriangleId::NONE));
+    let mut image = IdImage::default();
+    let stats = ws
+        .render(&scene_of(&instances), &RenderOptions::default(), &mut image)
+        .unwrap();
+    assert_eq!(stats.bucketed, 65_535);
+    assert_eq!(stats.activated + stats.dropped, 65_535);
+    assert_eq!(stats.activated, 8);
+    // Coplanar ties go to the triangle activated first: the lowest id.
+    assert_eq!(image.0[4 * 8 + 4], 0);
 }

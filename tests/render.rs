@@ -4,11 +4,15 @@
 mod common;
 
 use common::*;
-use embedded_graphics::pixelcolor::{Rgb565, Rgb888, RgbColor};
+use embedded_graphics::pixelcolor::{BinaryColor, Gray8, Rgb565, Rgb888, RgbColor};
+use scanline3d::cache::{vertex_cache_bytes, CachedVertex};
 use scanline3d::clip::NoClip;
-use scanline3d::render::CapacityKind;
+use scanline3d::depth::Depth16;
+use scanline3d::render::{workspace_bytes, CapacityKind};
 use scanline3d::scene::{Instance, Mesh, MeshColors, Scene, Transform};
+use scanline3d::shading::PerPixel;
 use scanline3d::sink::{FnSink, HashSink, Row, TriangleId};
+use scanline3d::Depth;
 use scanline3d::{Flat, Gouraud, RenderError, RenderOptions, Workspace};
 
 #[test]
@@ -168,6 +172,71 @@ fn icosphere_matches_reference_at_several_sub_pixel_settings() {
     assert_eq!(compare(&[&sphere], &cam, &ids, 64, 64, 8, true).1, 0);
 }
 
+/// Bytes of a workspace by the documented formula (src/render.rs, README), before padding:
+/// `depth·W` depth row, `size_of::<P>()·W` pixel row and one background pixel, `2·H` bucket
+/// heads, `4·TRIS` bucket lists, `ACTIVE · entry` active triangles and the active list's
+/// length (a `usize`).
+fn documented_bytes<P>(
+    depth: usize,
+    w: usize,
+    h: usize,
+    tris: usize,
+    active: usize,
+    entry: usize,
+) -> usize {
+    depth * w
+        + std::mem::size_of::<P>() * (w + 1)
+        + 2 * h
+        + 4 * tris
+        + active * entry
+        + std::mem::size_of::<usize>()
+}
+
+/// Checks `Workspace::BYTES` of each size against the documented formula (`depth` bytes of
+/// depth per column, `entry` bytes per active triangle), padded by less than 8 bytes, and
+/// against `workspace_bytes`.
+macro_rules! check_bytes {
+    ($p:ty, $s:ty, $z:ty, $depth:expr, $entry:expr, [$(($w:literal, $h:literal, $t:literal, $a:literal)),* $(,)?]) => {$({
+        type Ws = Workspace<$p, $s, $w, $h, $t, $a, 8, $z>;
+        let parts = documented_bytes::<$p>($depth, $w, $h, $t, $a, $entry);
+        let what = concat!(stringify!($p), ", ", stringify!($s), ", ", stringify!($z), ", ",
+            stringify!($w), "x", stringify!($h), ", ", stringify!($t), ", ", stringify!($a));
+        assert!(
+            (parts..parts + 8).contains(&Ws::BYTES),
+            "{what}: BYTES {} for documented {parts}",
+            Ws::BYTES
+        );
+        assert_eq!(Ws::BYTES % 8, 0, "{what}");
+        assert_eq!(Ws::BYTES, workspace_bytes::<$p, $s, $z>($w, $h, $t, $a), "{what}");
+    })*};
+}
+
+#[test]
+fn workspace_bytes_follow_the_documented_formula() {
+    // Active triangles (host sizes): 104 bytes with flat shading (as documented), 136 with
+    // affine Gouraud, 200 with perspective-correct Gouraud.
+    check_bytes! { Rgb565, Flat, Depth, 4, 104, [(240, 240, 1280, 64), (1, 1, 1, 1), (17, 3, 5, 2)] }
+    check_bytes! { Rgb565, Flat, Depth, 4, 104, [(7, 9, 0, 0)] }
+    check_bytes! { Rgb888, Flat, Depth, 4, 104, [(320, 240, 1536, 96), (3, 5, 7, 1)] }
+    check_bytes! { Gray8, Flat, Depth16, 2, 104, [(240, 240, 1280, 64), (13, 1, 3, 3)] }
+    check_bytes! { BinaryColor, Flat, Depth, 4, 104, [(128, 64, 256, 16), (1, 2048, 1, 5)] }
+    check_bytes! { TriangleId, Flat, Depth, 4, 104, [(64, 64, 4096, 512), (2048, 1, 9, 1)] }
+    check_bytes! { Rgb565, Gouraud, Depth, 4, 136, [(240, 240, 1280, 64), (5, 5, 5, 5)] }
+    check_bytes! { Rgb888, Gouraud, Depth16, 2, 136, [(31, 17, 100, 3)] }
+    check_bytes! { Rgb565, Gouraud<PerPixel>, Depth, 4, 200, [(240, 240, 1280, 64), (9, 3, 1, 7)] }
+
+    // The vertex cache adds 28 bytes a vertex (README), `vertex_cache_bytes` of them: exactly
+    // when that is a multiple of 8, else the total pads once where the sum pads twice.
+    assert_eq!(CachedVertex::BYTES, 28);
+    let plain = workspace_bytes::<Rgb565, Flat, Depth>(240, 240, 1280, 64);
+    type Cached = Workspace<Rgb565, Flat, 240, 240, 1280, 64, 8, Depth, 700>;
+    assert_eq!(Cached::BYTES, plain + vertex_cache_bytes(700));
+    type Odd = Workspace<Rgb565, Flat, 240, 240, 1280, 64, 8, Depth, 701>;
+    let parts = documented_bytes::<Rgb565>(4, 240, 240, 1280, 64, 104) + 701 * 28;
+    assert!((parts..parts + 8).contains(&Odd::BYTES), "{}", Odd::BYTES);
+    assert!(Odd::BYTES <= plain + vertex_cache_bytes(701));
+}
+
 /// The RAM budget of issue 2: a 240×240 frame of a 1280-triangle, 642-vertex icosphere in at
 /// most 16 KiB of renderer memory (mesh data excluded):
 ///   depth row 4·240 = 960, Rgb565 row 2·240 = 480, background 2, bucket heads 2·240 = 480,
@@ -182,7 +251,10 @@ fn icosphere_frame_fits_16_kib() {
         (Ws::BYTES - fixed_part) / 64
     );
     const { assert!(Ws::BYTES <= 16 * 1024) }
-    assert_eq!(std::mem::size_of::<Ws>(), Ws::BYTES);
+    // The sum above with 104-byte active triangles is 13,706; padding to 8 bytes makes the
+    // README's 13,712.
+    assert_eq!(fixed_part + 2 + 64 * 104 + 8, 13_706);
+    assert_eq!(Ws::BYTES, 13_712);
 
     let sphere = icosphere(3, 1.0);
     assert_eq!((sphere.vertices.len(), sphere.triangles.len()), (642, 1280));

@@ -10,7 +10,10 @@
 //!
 //! `cargo xtask test` builds it for all three targets. It covers what a firmware frame runs:
 //! scene and camera set-up, the vertex stage, clipping, projection, bucketing, the edge walk, the
-//! span z-buffer and the row sink, with the default arithmetic and the fast preset's narrow one.
+//! span z-buffer and the row sink, with the default arithmetic and the fast preset's narrow one,
+//! and every other hidden-surface method (`scanline3d::resolve`: band and full-frame z-buffer,
+//! span sorting, depth sort, Newell's sort, BSP order, Warnock's subdivision) with flat and
+//! perspective-correct Gouraud shading, on a 64×48 target so that their memory stays small.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -22,15 +25,98 @@ fn main() {
 
 #[cfg(target_os = "none")]
 mod firmware {
+    use core::hint::black_box;
     use embedded_graphics::pixelcolor::Rgb565;
     use scanline3d::depth::Depth16;
     use scanline3d::preset::{Fast, Preset};
-    use scanline3d::shading::{Gouraud, PerPixel, PerSegment};
+    use scanline3d::resolve::bsp::{BspNode, BspTree, BspWorkspace, NO_CHILD};
+    use scanline3d::resolve::{
+        BandWorkspace, DepthSortWorkspace, NewellWorkspace, SpanSortWorkspace, WarnockWorkspace,
+        ZBufferWorkspace,
+    };
+    use scanline3d::scene::{Instance, Scene, Transform};
+    use scanline3d::shading::{Gouraud, PerPixel, PerSegment, Shading};
+    use scanline3d::sink::HashSink;
     use scanline3d::{Depth, Flat, RenderOptions, Workspace};
     use scanline3d_demo::{self as demo, PanelWorkspace};
 
     /// The demo's capacities with another shading and depth format.
     type Ws<Sh, Z> = Workspace<Rgb565, Sh, 240, 240, 640, 80, 3, Z>;
+
+    /// The other hidden-surface methods' target: small, as some keep a frame or every piece.
+    const W: usize = 64;
+    const H: usize = 48;
+    /// Triangles (or pieces) and active triangles: room for the demo orbit.
+    const TRIS: usize = 640;
+    const ACTIVE: usize = 80;
+
+    /// A BSP tree over the demo cube's 12 triangles: a root with two children (the planes are
+    /// not the cube's, which only changes the order, not the code that runs).
+    static BSP_NODES: [BspNode; 3] = [
+        BspNode {
+            plane: [1.0, 0.0, 0.0, 0.0],
+            front: 1,
+            back: 2,
+            first: 0,
+            count: 4,
+        },
+        BspNode {
+            plane: [0.0, 1.0, 0.0, 0.0],
+            front: NO_CHILD,
+            back: NO_CHILD,
+            first: 4,
+            count: 4,
+        },
+        BspNode {
+            plane: [0.0, 0.0, 1.0, 0.0],
+            front: NO_CHILD,
+            back: NO_CHILD,
+            first: 8,
+            count: 4,
+        },
+    ];
+
+    /// Renders `scene` with every workspace of `scanline3d::resolve`, one after another (each
+    /// in its own block, so their stack memory can be shared), and `cube`, a one-instance scene
+    /// of the demo cube, in BSP order.
+    #[inline(never)]
+    fn every_method<Sh: Shading>(scene: &Scene<'_>, cube: &Scene<'_>, sink: &mut HashSink) {
+        let options = RenderOptions::default();
+        let background = Rgb565::new(0, 0, 0);
+        {
+            let mut ws = BandWorkspace::<Rgb565, Sh, W, H, 8, TRIS, ACTIVE>::new(background);
+            black_box(ws.render(scene, &options, sink).is_ok());
+        }
+        {
+            let mut ws = ZBufferWorkspace::<Rgb565, Sh, W, H, TRIS>::new(background);
+            black_box(ws.render(scene, &options, sink).is_ok());
+        }
+        {
+            let mut ws = SpanSortWorkspace::<Rgb565, Sh, W, H, TRIS, ACTIVE>::new(background);
+            black_box(ws.render(scene, &options, sink).is_ok());
+        }
+        {
+            let mut ws = DepthSortWorkspace::<Rgb565, Sh, W, H, TRIS, ACTIVE>::new(background);
+            black_box(ws.render(scene, &options, sink).is_ok());
+        }
+        {
+            let mut ws = NewellWorkspace::<Rgb565, Sh, W, H, TRIS, ACTIVE>::new(background);
+            black_box(ws.render(scene, &options, sink).is_ok());
+            black_box(ws.sort_stats());
+        }
+        {
+            let mut ws = WarnockWorkspace::<Rgb565, Sh, W, H, TRIS>::new(background);
+            black_box(ws.render(scene, &options, sink).is_ok());
+            black_box(ws.subdivision());
+        }
+        {
+            // The tree is checked at run time too, from nodes the optimiser cannot see.
+            if let Ok(tree) = BspTree::new(black_box(&BSP_NODES), 12) {
+                let mut ws = BspWorkspace::<Rgb565, Sh, W, H, 16, 16, 8>::new(background);
+                black_box(ws.render(cube, &tree, &options, sink).is_ok());
+            }
+        }
+    }
 
     #[cfg_attr(target_arch = "arm", cortex_m_rt::entry)]
     #[cfg_attr(target_arch = "riscv32", riscv_rt::entry)]
@@ -58,6 +144,16 @@ mod firmware {
                 // With a vertex cache.
                 let c = cached.render(&scene, &options, &mut sink);
                 core::hint::black_box((&c, sink.hash()));
+                // The other hidden-surface methods, with flat and Gouraud shading.
+                let cube = [Instance {
+                    mesh: &demo::CUBE,
+                    transform: Transform::IDENTITY,
+                }];
+                if let Ok(cube) = Scene::new(black_box(&cube), scene.camera, scene.light) {
+                    every_method::<Flat>(&scene, &cube, &mut sink);
+                    every_method::<Gouraud<PerPixel>>(&scene, &cube, &mut sink);
+                    core::hint::black_box(sink.hash());
+                }
             }
             frame = frame.wrapping_add(1);
         }

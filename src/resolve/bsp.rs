@@ -16,8 +16,8 @@
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::render::{
-    drive, viewport, ActiveTri, CapacityKind, Frame, FrameStats, InstanceSetup, RenderError,
-    RenderOptions, TriangleOrder, NO_ENTRY,
+    drive, internal, viewport, ActiveTri, CapacityKind, Frame, FrameStats, InstanceSetup,
+    RenderError, RenderOptions, TriangleOrder, NO_ENTRY,
 };
 use crate::scene::{Scene, Transform};
 use crate::shading::Shading;
@@ -51,10 +51,25 @@ pub struct BspNode {
 pub enum BspError {
     /// The tree has no nodes.
     Empty,
-    /// Node `node` names a child that is not after it in the node list, or out of range (nodes
-    /// are in pre-order, which also rules out cycles).
+    /// Node `node` names a child that is not after it in the node list, or out of range
+    /// (children come after their parents, as in pre-order, which rules out cycles).
     BadChild {
         /// The node.
+        node: usize,
+    },
+    /// Node `node` names `child` (as both of its children, or as one while an earlier node
+    /// names it too), so `child`'s subtree would be drawn twice and, the triangle ranges being
+    /// consecutive, some other triangles never.
+    SharedChild {
+        /// The second node (in node order) naming `child`; the first if it names it twice.
+        node: usize,
+        /// The child named twice.
+        child: usize,
+    },
+    /// No node names node `node` as a child (or, past the 65,535th node, none can: children are
+    /// 16-bit with [`NO_CHILD`] = 65,535 for none), so its triangles would never be drawn.
+    Unreachable {
+        /// The first such node.
         node: usize,
     },
     /// Node `node`'s triangle range is not the next one: ranges must follow each other in node
@@ -75,15 +90,111 @@ const fn child_ok(c: u16, node: usize, len: usize) -> bool {
     c == NO_CHILD || (c as usize > node && (c as usize) < len)
 }
 
-/// A BSP tree over one mesh, validated: node 0 is the root and every child comes after its
-/// parent.
+/// Node `node`'s children in index order, [`NO_CHILD`] for none (so a single child comes
+/// first).
+const fn children(node: &BspNode) -> (u16, u16) {
+    if node.front <= node.back {
+        (node.front, node.back)
+    } else {
+        (node.back, node.front)
+    }
+}
+
+/// The end of the subtree of node `x` if `nodes` are in pre-order below it: one past the leaf
+/// reached by always taking the later child. Counts the steps against `budget` and gives up
+/// (`None`) when it runs out. Children must be known to be after their parents and in range.
+const fn subtree_end(nodes: &[BspNode], mut x: usize, mut budget: usize) -> Option<(usize, usize)> {
+    while x < nodes.len() && budget > 0 {
+        budget -= 1;
+        let (first, last) = children(&nodes[x]);
+        let later = if last != NO_CHILD { last } else { first };
+        if later == NO_CHILD {
+            return Some((x + 1, budget));
+        }
+        x = later as usize;
+    }
+    None
+}
+
+/// Whether `nodes` (children after their parents and in range) are a tree in pre-order: each
+/// node's first child is the node right after it and its second child, if any, the node right
+/// after the first child's subtree, and the root's subtree is every node. Every node is then
+/// reached from the root exactly once (by induction from the last node: each node's subtree
+/// is the run of nodes from it to its end, each reached once).
+///
+/// Linear time: in a tree in pre-order each node lies on the later-child path of exactly one
+/// node whose path is followed (the root, or a node that is the earlier of two children), so
+/// the walks take `nodes.len()` steps in all; a budget of that many stops any other input.
+const fn is_pre_order(nodes: &[BspNode]) -> bool {
+    let mut budget = nodes.len();
+    // Last node first, by slice patterns rather than indexing (no panic path).
+    let mut rest = nodes;
+    while let [before @ .., node] = rest {
+        let i = before.len();
+        rest = before;
+        let (first, second) = children(node);
+        if first == NO_CHILD {
+            continue; // a leaf
+        }
+        if first as usize != i + 1 || first == second {
+            return false;
+        }
+        if second != NO_CHILD {
+            match subtree_end(nodes, first as usize, budget) {
+                Some((end, left)) if end == second as usize => budget = left,
+                _ => return false,
+            }
+        }
+    }
+    matches!(subtree_end(nodes, 0, budget), Some((end, _)) if end == nodes.len())
+}
+
+/// Checks that every node but the root is named as a child exactly once (children are after
+/// their parents and in range, and there are at most 65,535 nodes): then each node is reached
+/// from the root exactly once, by induction over the nodes in order. Quadratic time.
+const fn check_parents(nodes: &[BspNode]) -> Result<(), BspError> {
+    let mut child = 1;
+    while child < nodes.len() {
+        let mut named = false;
+        // Parents come before their children: the nodes before `child`, by slice patterns.
+        let (mut node, mut rest) = (0, nodes);
+        while let [parent, after @ ..] = rest {
+            if node == child {
+                break;
+            }
+            let (a, b) = (parent.front as usize, parent.back as usize);
+            let times = (a == child) as usize + (b == child) as usize;
+            if times > 0 && (named || times > 1) {
+                return Err(BspError::SharedChild { node, child });
+            }
+            named |= times > 0;
+            node += 1;
+            rest = after;
+        }
+        if !named {
+            return Err(BspError::Unreachable { node: child });
+        }
+        child += 1;
+    }
+    Ok(())
+}
+
+/// A BSP tree over one mesh, validated: node 0 is the root, every child comes after its
+/// parent and every other node is the child of exactly one node, so each node (and each
+/// triangle) is reached exactly once.
 #[derive(Clone, Copy, Debug)]
 pub struct BspTree<'a> {
     nodes: &'a [BspNode],
 }
 
 impl<'a> BspTree<'a> {
-    /// Checks `nodes` against a mesh of `triangles` triangles.
+    /// Checks `nodes` against a mesh of `triangles` triangles: children after their parents,
+    /// triangle ranges consecutive in node order and covering the mesh, planes finite, and
+    /// every node but the root named as a child exactly once (so the traversal draws each
+    /// triangle exactly once). A tree in pre-order, as `scanline3d_sim::bsp::build` makes
+    /// it (each node's first child right after it, a second child right after the first
+    /// child's subtree), is checked in time linear in the node count; any other layout in
+    /// quadratic time.
     ///
     /// ```
     /// use scanline3d::resolve::bsp::{BspError, BspNode, BspTree, NO_CHILD};
@@ -92,6 +203,13 @@ impl<'a> BspTree<'a> {
     /// assert_eq!(BspTree::new(&[leaf], 1).unwrap_err(), BspError::BadRange { node: 0 });
     /// let cycle = BspNode { front: 0, ..leaf };
     /// assert_eq!(BspTree::new(&[cycle], 2).unwrap_err(), BspError::BadChild { node: 0 });
+    /// // A root with two leaves; then one leaf named by both sides of the root.
+    /// let one = BspNode { count: 1, ..leaf };
+    /// let root = BspNode { front: 1, back: 2, ..one };
+    /// let tree = [root, BspNode { first: 1, ..one }, BspNode { first: 2, ..one }];
+    /// assert!(BspTree::new(&tree, 3).is_ok());
+    /// let shared = [BspNode { back: 1, ..root }, tree[1], tree[2]];
+    /// assert_eq!(BspTree::new(&shared, 3).unwrap_err(), BspError::SharedChild { node: 0, child: 1 });
     /// ```
     pub const fn new(nodes: &'a [BspNode], triangles: usize) -> Result<Self, BspError> {
         if nodes.is_empty() {
@@ -120,6 +238,17 @@ impl<'a> BspTree<'a> {
             return Err(BspError::BadRange {
                 node: nodes.len() - 1,
             });
+        }
+        if nodes.len() > NO_CHILD as usize {
+            return Err(BspError::Unreachable {
+                node: NO_CHILD as usize,
+            });
+        }
+        if !is_pre_order(nodes) {
+            // Not the builder's layout: it may still be a tree. Check every link.
+            if let Err(e) = check_parents(nodes) {
+                return Err(e);
+            }
         }
         Ok(BspTree { nodes })
     }
@@ -156,8 +285,10 @@ impl<'a> BspTree<'a> {
         push(stack, &mut top, 0)?;
         while top > 0 {
             top -= 1;
-            let entry = stack.get(top).copied().unwrap_or(0);
+            // `top` entries were pushed, and a checked tree names only its own nodes.
+            let entry = internal(stack.get(top).copied(), 0);
             let Some(node) = self.nodes.get((entry & !DRAW) as usize) else {
+                debug_assert!(false, "internal error: node {entry:#x} not in the tree");
                 continue;
             };
             if entry & DRAW != 0 {
@@ -225,6 +356,8 @@ impl TriangleOrder for BspOrder<'_, '_> {
         mut f: impl FnMut(&InstanceSetup<'s, T>, usize, Option<u32>),
     ) -> Result<(), RenderError<E>> {
         let Some(setup) = setups.first() else {
+            // BspWorkspace::render_sized requires exactly one instance.
+            debug_assert!(false, "internal error: a BSP scene without its instance");
             return Ok(());
         };
         let capacity = self.stack.len();
@@ -385,5 +518,154 @@ impl<
             &vp,
             sink,
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::vec;
+    use std::vec::Vec;
+
+    const N: u16 = NO_CHILD;
+
+    /// Nodes with these `(front, back)` links, one triangle each, in node order.
+    fn tree(links: &[(u16, u16)]) -> Vec<BspNode> {
+        let node = |(i, &(front, back)): (usize, &(u16, u16))| BspNode {
+            plane: [0.0, 0.0, 1.0, 0.0],
+            front,
+            back,
+            first: i as u16,
+            count: 1,
+        };
+        links.iter().enumerate().map(node).collect()
+    }
+
+    /// How often the traversal draws each triangle, from in front of and behind the planes.
+    fn draws(tree: &BspTree<'_>) -> [Vec<u32>; 2] {
+        [1.0, -1.0].map(|z| {
+            let mut seen = vec![0u32; tree.triangles()];
+            let mut stack = vec![0u32; 64];
+            tree.back_to_front([0.0, 0.0, z], &mut stack, |first, count| {
+                for t in first..first + count {
+                    seen[t as usize] += 1;
+                }
+            })
+            .unwrap();
+            seen
+        })
+    }
+
+    #[test]
+    fn trees_in_pre_order_are_accepted_and_draw_each_triangle_once() {
+        for links in [
+            &[(N, N)][..],
+            &[(1, N), (N, N)],
+            &[(N, 1), (N, N)],
+            &[(1, 2), (N, N), (N, N)],
+            &[(2, 1), (N, N), (N, N)],
+            &[(1, 4), (2, 3), (N, N), (N, N), (N, N)],
+            &[(1, 5), (N, 2), (3, 4), (N, N), (N, N), (N, 6), (N, N)],
+        ] {
+            let nodes = tree(links);
+            assert!(is_pre_order(&nodes), "{links:?}");
+            let tree = BspTree::new(&nodes, nodes.len()).unwrap();
+            for seen in draws(&tree) {
+                assert!(seen.iter().all(|&n| n == 1), "{links:?}: {seen:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn other_layouts_of_a_tree_are_accepted() {
+        // Breadth first: node 1's children are not right after it.
+        let nodes = tree(&[(1, 2), (3, 4), (N, N), (N, N), (N, N)]);
+        assert!(!is_pre_order(&nodes));
+        let tree = BspTree::new(&nodes, 5).unwrap();
+        for seen in draws(&tree) {
+            assert_eq!(seen, [1; 5]);
+        }
+    }
+
+    #[test]
+    fn a_shared_child_is_rejected() {
+        // The defect: this tree draws triangle 2 twice from either side, so another is never
+        // drawn when the ranges are consecutive.
+        let shared = tree(&[(1, 2), (N, 2), (N, N)]);
+        let unchecked = BspTree { nodes: &shared };
+        assert_eq!(draws(&unchecked), [[1, 1, 2], [1, 1, 2]]);
+        assert_eq!(
+            BspTree::new(&shared, 3).unwrap_err(),
+            BspError::SharedChild { node: 1, child: 2 }
+        );
+        for (links, node, child) in [
+            (&[(1, 1), (N, N)][..], 0, 1),
+            (&[(1, 3), (2, 3), (N, N), (N, N)], 1, 3),
+            (&[(1, 4), (2, 3), (N, N), (N, 4), (N, N)], 3, 4),
+        ] {
+            let nodes = tree(links);
+            assert_eq!(
+                BspTree::new(&nodes, nodes.len()).unwrap_err(),
+                BspError::SharedChild { node, child },
+                "{links:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn an_unreachable_node_is_rejected() {
+        for (links, node) in [
+            (&[(1, N), (N, N), (N, N)][..], 2),
+            (&[(2, N), (N, N), (N, N)], 1),
+            (&[(N, N), (2, N), (N, N)], 1),
+        ] {
+            let nodes = tree(links);
+            assert_eq!(
+                BspTree::new(&nodes, nodes.len()).unwrap_err(),
+                BspError::Unreachable { node },
+                "{links:?}"
+            );
+        }
+    }
+
+    /// A complete binary tree of `depth` levels in pre-order, appended to `nodes`.
+    fn complete(depth: u32, nodes: &mut Vec<BspNode>) -> u16 {
+        let at = nodes.len();
+        nodes.extend(tree(&[(N, N)]).into_iter().map(|n| BspNode {
+            first: at as u16,
+            ..n
+        }));
+        if depth > 1 {
+            let front = complete(depth - 1, nodes);
+            let back = complete(depth - 1, nodes);
+            nodes[at].front = front;
+            nodes[at].back = back;
+        }
+        at as u16
+    }
+
+    #[test]
+    fn up_to_65535_nodes() {
+        // At the limit: a complete tree of 16 levels and a chain, both checked in linear time.
+        let mut full = Vec::new();
+        complete(16, &mut full);
+        assert_eq!(full.len(), 65_535);
+        assert!(is_pre_order(&full));
+        let tree65535 = BspTree::new(&full, 65_535).unwrap();
+        for seen in draws(&tree65535) {
+            assert!(seen.iter().all(|&n| n == 1));
+        }
+        let chain = |n: usize| {
+            let links: Vec<(u16, u16)> = (1..=n)
+                .map(|i| (if i < n { i as u16 } else { N }, N))
+                .collect();
+            tree(&links)
+        };
+        assert!(BspTree::new(&chain(65_535), 65_535).is_ok());
+        // Past it: the last node's index is NO_CHILD, so no node can name it.
+        assert_eq!(
+            BspTree::new(&chain(65_536), 65_536).unwrap_err(),
+            BspError::Unreachable { node: 65_535 }
+        );
     }
 }

@@ -37,8 +37,8 @@ use crate::depth::Depth;
 use crate::depth::{DepthFormat, DepthRow};
 use crate::raster::PixelOrigin;
 use crate::render::{
-    drive, fill_span, viewport, ActiveTri, FinishedRow, Frame, FrameStats, IdOrder, RenderError,
-    RenderOptions, Resolve, MAX_INSTANCES, NO_ENTRY,
+    drive, fill_span, internal, viewport, ActiveTri, FinishedRow, Frame, FrameStats, IdOrder,
+    RenderError, RenderOptions, Resolve, MAX_INSTANCES, NO_ENTRY,
 };
 use crate::scene::Scene;
 use crate::shading::Shading;
@@ -62,7 +62,71 @@ const fn check_sizes(w: usize, h: usize, tris: usize) {
         h >= 1 && h <= crate::project::MAX_SCREEN,
         "height must be 1..=2048"
     );
-    assert!(tris < NO_ENTRY as usize, "TRIS must be below 65535");
+    assert!(
+        tris <= crate::scene::MAX_SCENE_TRIANGLES,
+        "TRIS must be at most 65535"
+    );
+}
+
+/// Swaps `v[a]` and `v[b]`, which the caller knows to be in range (checked again, so that no
+/// panic path remains).
+fn swap_within<T>(v: &mut [T], a: usize, b: usize) {
+    if a < v.len() && b < v.len() {
+        v.swap(a, b);
+    } else {
+        debug_assert!(
+            false,
+            "internal error: swap of {a} and {b} out of {}",
+            v.len()
+        );
+    }
+}
+
+/// Whether `v[a]`'s key is below `v[b]`'s (`false` if either is out of range).
+fn key_below<T, K: Ord>(v: &[T], a: usize, b: usize, key: &mut impl FnMut(&T) -> K) -> bool {
+    match (v.get(a), v.get(b)) {
+        (Some(x), Some(y)) => key(x) < key(y),
+        _ => false,
+    }
+}
+
+/// Sorts `v` by `key`, ascending and unstably, without allocating and without a panic path:
+/// insertion sort for up to 16 entries, heapsort (`O(n log n)`) beyond. (The standard
+/// `sort_unstable_by_key` keeps a panic for inconsistent orders, which firmware must not link.)
+pub(crate) fn sort_by_key<T, K: Ord>(v: &mut [T], mut key: impl FnMut(&T) -> K) {
+    let n = v.len();
+    if n <= 16 {
+        for i in 1..n {
+            let mut j = i;
+            while j > 0 && key_below(v, j, j - 1, &mut key) {
+                swap_within(v, j, j - 1);
+                j -= 1;
+            }
+        }
+        return;
+    }
+    // A max-heap by key, then its top moved to the end of the shrinking heap, `n − 1` times.
+    let mut sift_down = |v: &mut [T], mut root: usize, end: usize| loop {
+        let mut child = 2 * root + 1;
+        if child >= end {
+            break;
+        }
+        if child + 1 < end && key_below(v, child, child + 1, &mut key) {
+            child += 1;
+        }
+        if !key_below(v, root, child, &mut key) {
+            break;
+        }
+        swap_within(v, root, child);
+        root = child;
+    };
+    for root in (0..n / 2).rev() {
+        sift_down(v, root, n);
+    }
+    for end in (1..n).rev() {
+        swap_within(v, 0, end);
+        sift_down(v, 0, end);
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -150,14 +214,18 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for Band<'_, P, Z> {
     }
     #[inline]
     fn span(&mut self, t: &ActiveTri<S::Payload<P>>, _: usize, y: i32, l: i32, r: i32) -> u32 {
+        // The row walker hands over rows of the current band only.
         let at = self.row_start(y);
         if let Some(n) = self.spans.get_mut((y - self.y0) as usize) {
             *n += 1;
+        } else {
+            debug_assert!(false, "internal error: row {y} outside the band");
         }
         let (Some(depth), Some(pixels)) = (
             self.depth.get_mut(at..at + self.width),
             self.pixels.get_mut(at..at + self.width),
         ) else {
+            debug_assert!(false, "internal error: row {y} outside the band");
             return 0;
         };
         fill_span::<P, S, Z, ()>(t, y, l, r, depth, pixels)
@@ -166,9 +234,9 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for Band<'_, P, Z> {
         let at = self.row_start(y);
         let rows = at..at + self.width;
         FinishedRow {
-            pixels: self.pixels.get(rows.clone()).unwrap_or(&[]),
-            depth: Z::row(self.depth.get(rows).unwrap_or(&[])),
-            spans: self.spans.get((y - self.y0) as usize).copied().unwrap_or(0),
+            pixels: internal(self.pixels.get(rows.clone()), &[]),
+            depth: Z::row(internal(self.depth.get(rows), &[])),
+            spans: internal(self.spans.get((y - self.y0) as usize).copied(), 0),
             written: 0,
         }
     }
@@ -354,7 +422,7 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanSort<'_, P, S::Payload<P>> {
     fn span(&mut self, t: &ActiveTri<S::Payload<P>>, order: usize, y: i32, l: i32, r: i32) -> u32 {
         let (q, dq) = t.depth.span_start(l, y);
         // At most one span per active triangle, and the list holds as many as the active list.
-        let _ = self.spans.push(SortSpan {
+        let pushed = self.spans.push(SortSpan {
             l,
             r,
             q: q as i64,
@@ -363,6 +431,10 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanSort<'_, P, S::Payload<P>> {
             payload: t.payload,
             origin: *t.depth.origin(),
         });
+        debug_assert!(
+            pushed.is_ok(),
+            "internal error: more spans than active triangles"
+        );
         0
     }
     fn finish_row(&mut self, y: i32) -> FinishedRow<'_, P> {
@@ -388,7 +460,8 @@ fn sweep<P: RowPixel, S: Shading>(
     y: i32,
     pixels: &mut [P],
 ) -> u32 {
-    spans.sort_unstable_by_key(|s| s.l);
+    // (Ties between spans starting in one column do not matter: `beats` orders any two.)
+    sort_by_key(spans, |s| s.l);
     let width = pixels.len() as i32;
     let mut written = 0u32;
     // spans[..live] are present at x, spans[live..next] have ended, spans[next..] start later.
@@ -396,7 +469,7 @@ fn sweep<P: RowPixel, S: Shading>(
     let mut x = spans.first().map_or(width, |s| s.l);
     while x < width {
         while spans.get(next).is_some_and(|s| s.l <= x) {
-            spans.swap(live, next);
+            swap_within(spans, live, next);
             live += 1;
             next += 1;
         }
@@ -404,12 +477,12 @@ fn sweep<P: RowPixel, S: Shading>(
         while i < live {
             if spans.get(i).is_some_and(|s| s.r <= x) {
                 live -= 1;
-                spans.swap(i, live);
+                swap_within(spans, i, live);
             } else {
                 i += 1;
             }
         }
-        let present = spans.get(..live).unwrap_or(&[]);
+        let present = internal(spans.get(..live), &[]);
         // The end of the segment: the first span end or span start after x.
         let mut end = spans.get(next).map_or(width, |s| s.l.min(width));
         let mut front: Option<usize> = None;
@@ -421,12 +494,14 @@ fn sweep<P: RowPixel, S: Shading>(
         }
         let front = front.filter(|&f| present.get(f).is_some_and(|f| f.depth_at(x) > 0));
         let end = next_change(present, x, end, front);
-        if let (Some(f), Some(out)) = (
-            front.and_then(|f| present.get(f)),
-            pixels.get_mut(x as usize..end as usize),
-        ) {
-            S::paint(&f.payload, &f.origin, x, y, out);
-            written += (end - x) as u32;
+        if let Some(f) = front.and_then(|f| present.get(f)) {
+            if let Some(out) = pixels.get_mut(x as usize..end as usize) {
+                S::paint(&f.payload, &f.origin, x, y, out);
+                written += (end - x) as u32;
+            } else {
+                // Spans are clamped to the row and segments end within it.
+                debug_assert!(false, "internal error: segment {x}..{end} out of the row");
+            }
         }
         // end > x: present spans end after x and the next one starts after it.
         x = end;
@@ -611,7 +686,11 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for Painter<'_, P> {
                 S::paint(&t.payload, t.depth.origin(), l, y, out);
                 (r - l) as u32
             }
-            None => 0,
+            None => {
+                // walk_band clamps spans to the row.
+                debug_assert!(false, "internal error: span {l}..{r} out of the row");
+                0
+            }
         }
     }
     fn finish_row(&mut self, _: i32) -> FinishedRow<'_, P> {
@@ -702,5 +781,41 @@ impl<
             &vp,
             sink,
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::vec::Vec;
+
+    #[test]
+    fn the_panic_free_sort_sorts_like_the_standard_one() {
+        // Lengths on both sides of the switch to heapsort, with and without repeated keys.
+        let mut seed = 0x2545_f491_u32;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed
+        };
+        for len in (0..=40).chain([255, 1000]) {
+            for range in [4, 1 << 20] {
+                let v: Vec<(u32, usize)> = (0..len).map(|i| (next() % range, i)).collect();
+                let mut ours = v.clone();
+                sort_by_key(&mut ours, |p| p.0);
+                let mut theirs = v.clone();
+                theirs.sort_by_key(|p| p.0);
+                // The same keys in order, and the same entries (unstable: ties in any order).
+                assert!(ours.windows(2).all(|w| w[0].0 <= w[1].0), "{len}");
+                assert_eq!(
+                    ours.iter().map(|p| p.0).collect::<Vec<_>>(),
+                    theirs.iter().map(|p| p.0).collect::<Vec<_>>()
+                );
+                ours.sort();
+                theirs.sort();
+                assert_eq!(ours, theirs, "{len}");
+            }
+        }
     }
 }

@@ -83,11 +83,11 @@
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::render::{
-    viewport, walk_rows, ActiveTri, CapacityKind, FrameStats, RenderError, RenderOptions,
+    internal, viewport, walk_rows, ActiveTri, CapacityKind, FrameStats, RenderError, RenderOptions,
     MAX_INSTANCES, NO_ENTRY,
 };
 use crate::resolve::store::{self, StoredPieces, StoredTriangle};
-use crate::resolve::{check_sizes, Painter};
+use crate::resolve::{check_sizes, sort_by_key, Painter};
 use crate::scene::Scene;
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
@@ -189,8 +189,11 @@ impl<
 
     const VALID: () = {
         check_sizes(W, H, 0);
-        // Pieces are named by `u16` indices in the list and the buckets.
-        assert!(PIECES < NO_ENTRY as usize, "PIECES must be below 65535");
+        // Pieces are named by `u16` indices in the list and the buckets, below NO_ENTRY.
+        assert!(
+            PIECES <= crate::scene::MAX_SCENE_TRIANGLES,
+            "PIECES must be at most 65535"
+        );
     };
 
     /// An empty workspace whose background pixels are `background`.
@@ -276,16 +279,19 @@ impl<
         result?;
 
         // Key = position in the final order: the row walker's painter draws ascending keys.
+        // (List entries index the store's first `n` pieces, `n <= PIECES`.)
         for (k, &i) in self.list.iter().take(len).enumerate() {
             if let Some(key) = self.keys.get_mut(i as usize) {
                 *key = k as u32;
+            } else {
+                debug_assert!(false, "internal error: list entry {i} out of the store");
             }
         }
-        let store = self.store.get(..n).unwrap_or(&[]);
+        let store = internal(self.store.get(..n), &[]);
         store::bucket(store, &vp, heads, &mut self.next);
         let pieces = StoredPieces {
             store,
-            keys: self.keys.get(..n).unwrap_or(&[]),
+            keys: internal(self.keys.get(..n), &[]),
         };
         let mut painter = Painter {
             pixels,
@@ -343,10 +349,13 @@ impl PlaneEq {
         })
     }
 
-    /// `s` at vertex `k` of `t`.
+    /// `s` at vertex `k` (0, 1 or 2) of `t`.
     fn at(&self, t: &StoredTriangle, k: usize) -> i128 {
-        self.n[0] * t.x[k] as i128 + self.n[1] * t.y[k] as i128 + self.n[2] * t.q[k] as i128
-            - self.d
+        let (Some(&x), Some(&y), Some(&q)) = (t.x.get(k), t.y.get(k), t.q.get(k)) else {
+            debug_assert!(false, "internal error: no vertex {k}");
+            return 0;
+        };
+        self.n[0] * x as i128 + self.n[1] * y as i128 + self.n[2] * q as i128 - self.d
     }
 
     /// Whether all of `t` is behind this plane or on it.
@@ -410,7 +419,15 @@ enum Order {
 
 /// Rounds `num / den` (with `den > 0`) to the nearest integer, halves up.
 fn div_round(num: i128, den: i128) -> i128 {
-    (2 * num + den).div_euclid(2 * den)
+    // Callers divide by the gap between two plane distances of opposite sign, never 0 and far
+    // below 2^126; 0 is the release fallback for that internal error (no panic path).
+    match (2 * num + den).checked_div_euclid(2 * den) {
+        Some(q) => q,
+        None => {
+            debug_assert!(false, "internal error: {num} / {den}");
+            0
+        }
+    }
 }
 
 /// The search over one frame's pieces.
@@ -435,7 +452,7 @@ impl Sort<'_> {
         let n = self.n;
         let mut start = 0;
         while start < n {
-            let id = self.store.get(start).map_or(0, |t| t.id);
+            let id = internal(self.store.get(start), &StoredTriangle::EMPTY).id;
             let end = (start..n)
                 .find(|&i| self.store.get(i).is_none_or(|t| t.id != id))
                 .unwrap_or(n);
@@ -460,6 +477,9 @@ impl Sort<'_> {
                         *slot = i as u16;
                         *mark = false;
                         self.len += 1;
+                    } else {
+                        // The list and the marks have room for every piece in the store.
+                        debug_assert!(false, "internal error: piece {i} not listed");
                     }
                 } else if let Some(t) = self.store.get_mut(i) {
                     // Not drawn: make sure no bucket picks it up.
@@ -471,20 +491,23 @@ impl Sort<'_> {
         self.stats.pieces_in = self.len as u32;
         let (store, keys) = (&*self.store, &*self.keys);
         if let Some(list) = self.list.get_mut(..self.len) {
-            list.sort_unstable_by_key(|&i| sort_key(store, keys, i));
+            // (Keys are unique: the rank holds the piece's index.)
+            sort_by_key(list, |&i| sort_key(store, keys, i));
         }
     }
 
+    // Pieces are named by list entries, which index the store (and its keys and marks).
+
     fn piece(&self, i: u16) -> &StoredTriangle {
-        self.store.get(i as usize).unwrap_or(&StoredTriangle::EMPTY)
+        internal(self.store.get(i as usize), &StoredTriangle::EMPTY)
     }
 
     fn rank(&self, i: u16) -> u32 {
-        self.keys.get(i as usize).copied().unwrap_or(u32::MAX)
+        internal(self.keys.get(i as usize).copied(), u32::MAX)
     }
 
     fn is_marked(&self, i: u16) -> bool {
-        self.marked.get(i as usize).copied().unwrap_or(false)
+        internal(self.marked.get(i as usize).copied(), false)
     }
 
     /// How head `p` and piece `q` (whose depth ranges overlap) must be ordered.
@@ -517,13 +540,23 @@ impl Sort<'_> {
 
     /// Moves list entry `j` to the head (entry `done`), marking it.
     fn move_to_head(&mut self, done: usize, j: usize, front: &mut usize) {
-        if let Some(run) = self.list.get_mut(done..=j) {
+        // `done <= j < len`, and list entries index the marks.
+        // (Rotating only a non-empty run: no panic path.)
+        if let Some(run @ [_, ..]) = self.list.get_mut(done..=j) {
             run.rotate_right(1);
+        } else {
+            debug_assert!(
+                false,
+                "internal error: list run {done}..={j} out of the list"
+            );
         }
-        if let Some(&q) = self.list.get(done) {
-            if let Some(m) = self.marked.get_mut(q as usize) {
-                *m = true;
-            }
+        match self
+            .list
+            .get(done)
+            .and_then(|&q| self.marked.get_mut(q as usize))
+        {
+            Some(m) => *m = true,
+            None => debug_assert!(false, "internal error: head {done} has no mark"),
         }
         if j >= *front {
             *front += 1;
@@ -545,11 +578,17 @@ impl Sort<'_> {
                     capacity: limit,
                 });
             }
-            let Some(&p) = self.list.get(done) else { break };
+            let Some(&p) = self.list.get(done) else {
+                debug_assert!(false, "internal error: head {done} out of the list");
+                break;
+            };
             let p_max = max_q(self.piece(p));
             let mut found = None;
             for j in done + 1..self.len {
-                let Some(&q) = self.list.get(j) else { break };
+                let Some(&q) = self.list.get(j) else {
+                    debug_assert!(false, "internal error: entry {j} out of the list");
+                    break;
+                };
                 if min_q(self.piece(q)) > p_max {
                     if j >= front {
                         break;
@@ -615,6 +654,7 @@ impl Sort<'_> {
         front: &mut usize,
     ) -> Result<(), RenderError<E>> {
         let Some(&x) = self.list.get(at) else {
+            debug_assert!(false, "internal error: entry {at} out of the list");
             return Ok(());
         };
         let t = *self.piece(x);
@@ -631,8 +671,10 @@ impl Sort<'_> {
         self.stats.splits += 1;
         self.stats.dropped_slivers += (made - count) as u32;
         // Take the piece out of the list.
-        if let Some(rest) = self.list.get_mut(at..self.len) {
+        if let Some(rest @ [_, ..]) = self.list.get_mut(at..self.len) {
             rest.rotate_left(1);
+        } else {
+            debug_assert!(false, "internal error: entry {at} out of the list");
         }
         self.len -= 1;
         if at < *front {
@@ -653,20 +695,30 @@ impl Sort<'_> {
                 *s = part;
                 *k = rank;
                 *m = false;
+            } else {
+                // The store had room: checked above.
+                debug_assert!(false, "internal error: no store entry {i} for a part");
             }
             // File it in the sorted part.
             let (store, keys) = (&*self.store, &*self.keys);
             let key = sort_key(store, keys, i as u16);
             let Some(sorted) = self.list.get(*front..self.len) else {
+                debug_assert!(
+                    false,
+                    "internal error: sorted part {front}.. out of the list"
+                );
                 continue;
             };
             let pos = *front + sorted.partition_point(|&j| sort_key(store, keys, j) <= key);
             self.len += 1;
-            if let Some(run) = self.list.get_mut(pos..self.len) {
+            // The list has room for every piece in the store, and the run is not empty.
+            if let Some(run @ [_, ..]) = self.list.get_mut(pos..self.len) {
                 run.rotate_right(1);
                 if let Some(first) = run.first_mut() {
                     *first = i as u16;
                 }
+            } else {
+                debug_assert!(false, "internal error: no list room for piece {i}");
             }
         }
         if let Some(s) = slot.and_then(|i| self.store.get_mut(i)) {
@@ -679,8 +731,9 @@ impl Sort<'_> {
 
 /// The sorted part's order: farthest point first; on a tie the later-activated piece first.
 fn sort_key(store: &[StoredTriangle], keys: &[u32], i: u16) -> (i32, Reverse<u32>) {
-    let q = store.get(i as usize).map_or(i32::MAX, min_q);
-    (q, Reverse(keys.get(i as usize).copied().unwrap_or(0)))
+    // List entries index the store and its keys.
+    let q = internal(store.get(i as usize).map(min_q), i32::MAX);
+    (q, Reverse(internal(keys.get(i as usize).copied(), 0)))
 }
 
 /// Cuts `t` by `plane` into up to three triangles of the same orientation, each on one side
@@ -693,9 +746,8 @@ fn cut(t: &StoredTriangle, plane: &PlaneEq) -> ([Option<StoredTriangle>; 3], usi
     let lead = if let Some(z) = (0..3).find(|&k| s[k] == 0) {
         z
     } else {
-        (0..3)
-            .find(|&k| s[(k + 1) % 3] == s[(k + 2) % 3])
-            .unwrap_or(0)
+        // The plane straddles `t`: its signs are +1 and −1, and two of the three agree.
+        internal((0..3).find(|&k| s[(k + 1) % 3] == s[(k + 2) % 3]), 0)
     };
     let v = |k: usize| (lead + k) % 3;
     let vertex = |k: usize| Vertex::of(t, v(k));

@@ -12,8 +12,8 @@ use crate::depth::Depth;
 use crate::project::{ScreenVertex, SubPx, Viewport};
 use crate::raster::{channel, color_channels, first_row};
 use crate::render::{
-    for_each_screen_piece, ActivePieces, CapacityKind, FrameStats, RenderError, RenderOptions,
-    NO_ENTRY,
+    for_each_screen_piece, internal, ActivePieces, CapacityKind, FrameStats, RenderError,
+    RenderOptions, NO_ENTRY,
 };
 use crate::scene::Scene;
 use crate::shading::Shading;
@@ -71,12 +71,20 @@ impl StoredTriangle {
 
     /// The screen vertices again, for set-up.
     pub(crate) fn screen<const S: u32>(&self) -> [ScreenVertex<S>; 3] {
-        [0, 1, 2].map(|k| ScreenVertex {
-            x: SubPx(self.x[k]),
-            y: SubPx(self.y[k]),
-            q: Depth::from_bits(self.q[k]),
-            color: color_channels(self.colors[k]),
-        })
+        // Destructured rather than indexed: no bounds check to leave a panic path.
+        let vertex = |x, y, q, c| ScreenVertex {
+            x: SubPx(x),
+            y: SubPx(y),
+            q: Depth::from_bits(q),
+            color: color_channels(c),
+        };
+        let ([x0, x1, x2], [y0, y1, y2], [q0, q1, q2], [c0, c1, c2]) =
+            (self.x, self.y, self.q, self.colors);
+        [
+            vertex(x0, y0, q0, c0),
+            vertex(x1, y1, q1, c1),
+            vertex(x2, y2, q2, c2),
+        ]
     }
 
     /// The face colour (vertex 0's colour).
@@ -141,6 +149,9 @@ pub(crate) fn bucket<const SUB: u32>(
         if let (Some(head), Some(link)) = (heads.get_mut(row as usize), next.get_mut(i)) {
             *link = *head;
             *head = i as u16;
+        } else {
+            // First rows are on screen; there is a link per kept piece.
+            debug_assert!(false, "internal error: piece {i} not filed on row {row}");
         }
     }
 }
@@ -159,9 +170,12 @@ impl<const SUB: u32> ActivePieces<SUB> for StoredPieces<'_> {
         entry: usize,
         mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
+        // Entries index the store, which has a key per piece.
         if let Some(t) = self.store.get(entry) {
-            let key = self.keys.get(entry).copied().unwrap_or(0);
+            let key = internal(self.keys.get(entry).copied(), 0);
             f(t.screen::<SUB>(), t.face(), t.id, key);
+        } else {
+            debug_assert!(false, "internal error: no kept piece {entry}");
         }
     }
 }

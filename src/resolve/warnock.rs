@@ -70,7 +70,7 @@ use crate::depth::DepthRow;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{DepthPlane, PlaneSolver, TriangleWalk};
 use crate::render::{
-    viewport, CapacityKind, FrameStats, RenderError, RenderOptions, MAX_INSTANCES,
+    internal, viewport, CapacityKind, FrameStats, RenderError, RenderOptions, MAX_INSTANCES,
 };
 use crate::resolve::check_sizes;
 use crate::resolve::store::{self, StoredTriangle};
@@ -289,13 +289,16 @@ impl<
         )?;
         stats.activated = n as u32;
         let frame = self.frame.as_flattened_mut();
+        // (`width <= W` and `n <= PIECES`: the viewport and `collect` checked them.)
         for row in frame.chunks_mut(W).take(height) {
             if let Some(row) = row.get_mut(..width) {
                 row.fill(self.background);
+            } else {
+                debug_assert!(false, "internal error: width {width} beyond the frame");
             }
         }
         let mut sub = Subdivision::<P, S, SUB_BITS> {
-            store: self.store.get(..n).unwrap_or(&[]),
+            store: internal(self.store.get(..n), &[]),
             frame,
             stride: W,
             vp: &vp,
@@ -312,7 +315,7 @@ impl<
         for (y, row) in self.frame.iter().take(height).enumerate() {
             sink.write_row(Row {
                 y: y as u16,
-                pixels: row.get(..width).unwrap_or(&[]),
+                pixels: internal(row.get(..width), &[]),
                 depth: DepthRow::NONE,
                 complete: true,
             })
@@ -404,7 +407,10 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Subdivision<'_, P, S, SUB> {
         let mut depth = 1usize;
         while depth > 0 {
             depth -= 1;
-            let Some(&win) = stack.get(depth) else { break };
+            let Some(&win) = stack.get(depth) else {
+                debug_assert!(false, "internal error: window {depth} beyond the stack");
+                break;
+            };
             let Some(children) = self.examine(&win) else {
                 continue;
             };
@@ -465,11 +471,16 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Subdivision<'_, P, S, SUB> {
         let (mut kept, mut full) = (0usize, false);
         let (mut relevant, mut only) = (0u32, 0usize);
         let mut front: Option<(usize, i32)> = None;
+        // Lists name kept pieces and lie within the index buffer (see `entry`).
         for k in 0..win.list.len {
             let Some(i) = self.entry(&win.list, k) else {
+                debug_assert!(false, "internal error: list entry {k} out of the buffer");
                 break;
             };
-            let Some(t) = self.store.get(i) else { continue };
+            let Some(t) = self.store.get(i) else {
+                debug_assert!(false, "internal error: no kept piece {i}");
+                continue;
+            };
             let class = classify::<SUB>(t, win);
             if class == Class::Disjoint {
                 continue;
@@ -555,6 +566,7 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Subdivision<'_, P, S, SUB> {
     /// row of any of its pieces), then the piece's position in the store (id order).
     fn order(&self, i: usize) -> (i32, usize) {
         let Some(id) = self.store.get(i).map(|t| t.id) else {
+            debug_assert!(false, "internal error: no kept piece {i}");
             return (i32::MAX, i);
         };
         let (w, h) = (self.vp.width as i32, self.vp.height as i32);
@@ -583,18 +595,21 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Subdivision<'_, P, S, SUB> {
     /// Whether surrounding piece `c` keeps every pixel of `win` that any other piece of `list`
     /// covers. Both depths are linear along a row, so the two ends of each overlap decide.
     fn in_front_of_all(&self, c: usize, list: &List, win: &Window) -> bool {
-        let Some(ct) = self.store.get(c) else {
-            return false;
-        };
-        let Some(cs) = self.surface(c) else {
+        // Kept pieces have screen area, so each has a surface.
+        let (Some(ct), Some(cs)) = (self.store.get(c), self.surface(c)) else {
+            debug_assert!(false, "internal error: no surface for kept piece {c}");
             return false;
         };
         let (x0, x1, y1) = (win.x0 as i32, win.x1 as i32, win.y1 as i32);
         for k in 0..list.len {
             let Some(i) = self.entry(list, k) else {
+                debug_assert!(false, "internal error: list entry {k} out of the buffer");
                 return false;
             };
-            let Some(t) = self.store.get(i) else { continue };
+            let Some(t) = self.store.get(i) else {
+                debug_assert!(false, "internal error: no kept piece {i}");
+                continue;
+            };
             if i == c {
                 continue;
             }
@@ -604,7 +619,10 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Subdivision<'_, P, S, SUB> {
             let Some(mut cw) = TriangleWalk::new::<SUB>(xy(ct), walk.row(), y1) else {
                 return false;
             };
-            let Some(ts) = self.surface(i) else { continue };
+            let Some(ts) = self.surface(i) else {
+                debug_assert!(false, "internal error: no surface for kept piece {i}");
+                continue;
+            };
             loop {
                 let y = walk.row();
                 let (l, r) = walk.span();
@@ -632,9 +650,15 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Subdivision<'_, P, S, SUB> {
     /// Paints piece `i`'s exact coverage of window `win` (where its depth is above 0).
     fn paint_coverage(&mut self, i: usize, win: &Window) {
         let (Some(t), Some(s)) = (self.store.get(i), self.surface(i)) else {
+            debug_assert!(false, "internal error: no surface for kept piece {i}");
             return;
         };
+        // The piece meets the window, which `classify` found with this very walk.
         let Some(mut walk) = TriangleWalk::new::<SUB>(xy(t), win.y0 as i32, win.y1 as i32) else {
+            debug_assert!(
+                false,
+                "internal error: piece {i} misses the window it meets"
+            );
             return;
         };
         loop {
@@ -679,6 +703,11 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Subdivision<'_, P, S, SUB> {
         if let Some(out) = self.frame.get_mut(at + a as usize..at + b as usize) {
             S::paint(&s.payload, s.plane.origin(), a, y, out);
             self.written += (b - a) as u32;
+        } else {
+            debug_assert!(
+                false,
+                "internal error: run {a}..{b} of row {y} out of the frame"
+            );
         }
     }
 
@@ -686,7 +715,10 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Subdivision<'_, P, S, SUB> {
     fn resolve_pixel(&mut self, list: &List, x: i32, y: i32) {
         let mut best: Option<(usize, i32)> = None;
         for k in 0..list.len {
-            let Some(i) = self.entry(list, k) else { break };
+            let Some(i) = self.entry(list, k) else {
+                debug_assert!(false, "internal error: list entry {k} out of the buffer");
+                break;
+            };
             // A depth of 0 or below never beats the background (a cleared z-buffer).
             let Some(q) = self.depth_at(i, x, y).filter(|&q| q > 0) else {
                 continue;
@@ -695,8 +727,11 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Subdivision<'_, P, S, SUB> {
                 best = Some((i, q));
             }
         }
-        if let Some(s) = best.and_then(|(i, _)| self.surface(i)) {
-            self.paint(&s, y, x, x + 1);
+        if let Some((i, _)) = best {
+            match self.surface(i) {
+                Some(s) => self.paint(&s, y, x, x + 1),
+                None => debug_assert!(false, "internal error: no surface for kept piece {i}"),
+            }
         }
     }
 }
