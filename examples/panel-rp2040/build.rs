@@ -15,16 +15,7 @@ fn main() {
     if env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
         return;
     }
-    // A `.cargo/config.toml` that already passes link.x (as many RP2040 project templates do)
-    // would make the linker read it twice and fail on "region already defined": pass it only
-    // if no rustflag does.
-    let rustflags = env::var("CARGO_ENCODED_RUSTFLAGS").unwrap_or_default();
-    let given = |arg: &str| rustflags.split('\x1f').any(|flag| flag.ends_with(arg));
-    if !given("-Tlink.x") {
-        println!("cargo:rustc-link-arg-bins=-Tlink.x");
-    }
-    if !given("--nmagic") {
-        // Sections packed without page alignment: flash starts right after the boot loader.
-        println!("cargo:rustc-link-arg-bins=--nmagic");
-    }
+    println!("cargo:rustc-link-arg-bins=-Tlink.x");
+    // Sections packed without page alignment: flash starts right after the boot loader.
+    println!("cargo:rustc-link-arg-bins=--nmagic");
 }

@@ -24,15 +24,20 @@ pub(crate) fn package() -> Result<(), String> {
     step(&format!(
         "minimum supported Rust version {MSRV}: the library for thumbv6m-none-eabi"
     ));
-    run(cargo()
+    run(Command::new("rustup")
         .args([
-            &format!("+{MSRV}"),
+            "run",
+            MSRV,
+            "cargo",
             "check",
             "--package",
             "scanline3d",
             "--lib",
         ])
-        .args(["--target", "thumbv6m-none-eabi"]))?;
+        .args(["--target", "thumbv6m-none-eabi"])
+        .env_remove("RUSTUP_TOOLCHAIN")
+        .env_remove("RUSTC")
+        .env_remove("CARGO"))?;
     step("example: RP2040 + ST7789 panel (builds; running needs the board)");
     let panel = root().join("examples/panel-rp2040/Cargo.toml");
     let examples_target = root().join("target/examples");

@@ -45,9 +45,9 @@ use mipidsi::models::ST7789;
 use mipidsi::options::ColorInversion;
 use panic_halt as _;
 use rp2040_hal::{self as hal, fugit::RateExtU32, gpio::FunctionSpi, pac, Clock};
-use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
+use scanline3d::scene::{Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
 use scanline3d::sink::{FnSink, Row};
-use scanline3d::{Flat, RenderOptions, Workspace};
+use scanline3d::{Config, Flat, Settings, Storage};
 use static_cell::ConstStaticCell;
 
 /// The second-stage boot loader for the Pico's W25Q080 flash, placed in the first 256 bytes of
@@ -136,10 +136,13 @@ const BACKGROUND: Rgb565 = Rgb565::new(3, 7, 6);
 
 // ---- The renderer's memory. ----
 
+/// Every precision choice: RGB565 rows, flat shading, the library's reference precision.
+type Cfg = Settings<Rgb565, Flat>;
 /// Room for all 12 triangles (even with culling off) and every one crossing a row.
-type Ws = Workspace<Rgb565, Flat, W, H, 12, 12>;
+type Ws = Storage<Cfg, W, H, 12, 12>;
 
-/// The workspace, in a static, initialised by the `const fn Workspace::new` at compile time.
+/// The renderer's memory, in a static, initialised by the `const fn Storage::new` at compile
+/// time.
 ///
 /// Why `ConstStaticCell`: its value is a constant placed in `.data` by the linker and copied to
 /// RAM by the reset handler, so it is never built on the stack (it costs its size in flash for
@@ -225,11 +228,9 @@ fn run() -> Result<Infallible, Fault> {
     backlight.set_high().map_err(|_| Fault::Pin)?;
 
     let ws = WORKSPACE.try_take().ok_or(Fault::Workspace)?;
-    let camera = Camera::look_at([0.0, 0.0, 5.0], [0.0; 3], [0.0, 1.0, 0.0])
-        .and_then(|view| view.perspective(50.0, 0.5, 20.0))
+    let camera = Cfg::camera([0.0, 0.0, 5.0], [0.0; 3], [0.0, 1.0, 0.0], 50.0, 0.5, 20.0)
         .map_err(|_| Fault::Scene)?;
     let light = Light::new([-0.4, 0.7, 0.6], 0.25, 0.75).map_err(|_| Fault::Scene)?;
-    let options = RenderOptions::default();
 
     loop {
         // The pose follows the clock, not the frame count, so the spin speed does not depend
@@ -241,11 +242,7 @@ fn run() -> Result<Infallible, Fault> {
             mesh: &CUBE,
             transform: spin,
         }];
-        let scene = Scene {
-            instances: &instances,
-            camera,
-            light,
-        };
+        let scene = Scene::new(&instances, camera, light).map_err(|_| Fault::Scene)?;
 
         // Each finished row goes straight into a one-row window of the panel's memory.
         let mut panel = FnSink(|row: Row<'_, Rgb565>| {
@@ -254,7 +251,6 @@ fn run() -> Result<Infallible, Fault> {
         // With this scene and workspace no error can occur (capacities fit, the transform
         // stays in the envelope, and the RP2040's SPI and pins cannot fail): treat one as a
         // fault.
-        ws.render(&scene, &options, &mut panel)
-            .map_err(|_| Fault::Render)?;
+        ws.render(&scene, &mut panel).map_err(|_| Fault::Render)?;
     }
 }

@@ -17,7 +17,7 @@
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use fixed::types::I16F16;
 use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
-use scanline3d::{Flat, Workspace};
+use scanline3d::{Config, Flat, Settings, Storage};
 
 /// Target size (the panel example's ST7789).
 const W: usize = 240;
@@ -89,7 +89,9 @@ static CUBE: Mesh<'static> = match Mesh::new(
 const BACKGROUND: Rgb565 = Rgb565::new(3, 7, 6);
 
 /// Room for all 12 triangles (even with culling off) and every one crossing a row: about 3 KB.
-type Ws = Workspace<Rgb565, Flat, W, H, 12, 12>;
+type Ws = Storage<Cfg, W, H, 12, 12>;
+/// RGB565 rows, flat shading, the library's reference precision.
+type Cfg = Settings<Rgb565, Flat>;
 
 /// Where the animation starts: a pose that shows three faces (the headless frame and the first
 /// window frame).
@@ -103,8 +105,7 @@ fn spin(seconds: f32) -> Transform {
 
 /// Camera and light, fixed for the whole animation.
 fn view() -> Result<(Camera, Light), scanline3d::scene::SceneError> {
-    let camera = Camera::look_at([0.0, 0.0, 5.0], [0.0; 3], [0.0, 1.0, 0.0])?
-        .perspective(50.0, 0.5, 20.0)?;
+    let camera = Cfg::camera([0.0, 0.0, 5.0], [0.0; 3], [0.0, 1.0, 0.0], 50.0, 0.5, 20.0)?;
     Ok((camera, Light::new([-0.4, 0.7, 0.6], 0.25, 0.75)?))
 }
 
@@ -113,18 +114,13 @@ fn view() -> Result<(Camera, Light), scanline3d::scene::SceneError> {
 #[cfg(not(feature = "window"))]
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     use scanline3d::sink::{FnSink, Row};
-    use scanline3d::RenderOptions;
 
     let (camera, light) = view()?;
     let instances = [Instance {
         mesh: &CUBE,
         transform: spin(START_SECONDS),
     }];
-    let scene = Scene {
-        instances: &instances,
-        camera,
-        light,
-    };
+    let scene = Scene::new(&instances, camera, light)?;
     let mut ws = Ws::new(BACKGROUND);
     let (mut rows, mut lit) = (0, 0);
     let mut sink = FnSink(
@@ -134,7 +130,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             Ok(())
         },
     );
-    let stats = ws.render(&scene, &RenderOptions::default(), &mut sink)?;
+    let stats = ws.render(&scene, &mut sink)?;
     println!(
         "rendered one {W}x{H} frame headless: {rows} rows, {lit} cube pixels, {} of 12 triangles drawn",
         stats.activated
@@ -151,11 +147,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         sdl2::Keycode, OutputSettingsBuilder, SimulatorDisplay, SimulatorEvent, Window,
     };
     use scanline3d::sink::DrawTargetSink;
-    use scanline3d::RenderOptions;
     use std::time::Instant;
 
     let (camera, light) = view()?;
-    let options = RenderOptions::default();
     let mut ws = Ws::new(BACKGROUND);
     let mut display = SimulatorDisplay::<Rgb565>::new(Size::new(W as u32, H as u32));
     // Scaled up so the pixels are visible; max_fps paces the loop inside `update`.
@@ -168,13 +162,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             mesh: &CUBE,
             transform: spin(START_SECONDS + start.elapsed().as_secs_f32()),
         }];
-        let scene = Scene {
-            instances: &instances,
-            camera,
-            light,
-        };
+        let scene = Scene::new(&instances, camera, light)?;
         // Every row is sent, background included, so the previous frame needs no clearing.
-        ws.render(&scene, &options, &mut DrawTargetSink::new(&mut display))?;
+        ws.render(&scene, &mut DrawTargetSink::new(&mut display))?;
         window.update(&display);
 
         for event in window.events() {

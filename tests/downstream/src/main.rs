@@ -5,9 +5,11 @@
 use cortex_m_rt::entry;
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use fixed::types::I16F16;
-use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
+use scanline3d::scene::{Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
 use scanline3d::sink::{FnSink, Row};
-use scanline3d::{Flat, RenderOptions, Workspace};
+use scanline3d::{Config, Flat, Settings, Storage};
+
+type Cfg = Settings<Rgb565, Flat>;
 
 const ONE: I16F16 = I16F16::ONE;
 static VERTICES: [Vertex; 3] = [
@@ -33,22 +35,15 @@ fn main() -> ! {
         mesh: &MESH,
         transform: Transform::IDENTITY,
     }];
-    let scene = Camera::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0])
-        .and_then(|c| c.perspective(60.0, 0.1, 50.0))
-        .and_then(|camera| {
-            Ok(Scene {
-                instances: &instances,
-                camera,
-                light: Light::new([0.3, 0.5, 1.0], 0.2, 0.8)?,
-            })
-        });
-    let mut ws: Workspace<Rgb565, Flat, 64, 48, 4, 4> = Workspace::new(Rgb565::new(0, 0, 0));
+    let scene = Cfg::camera([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0], 60.0, 0.1, 50.0)
+        .and_then(|camera| Scene::new(&instances, camera, Light::new([0.3, 0.5, 1.0], 0.2, 0.8)?));
+    let mut ws: Storage<Cfg, 64, 48, 4, 4> = Storage::new(Rgb565::new(0, 0, 0));
     let mut panel = FnSink(|row: Row<'_, Rgb565>| -> Result<(), ()> {
         lit += row.pixels.iter().filter(|p| **p != Rgb565::new(0, 0, 0)).count() as u32;
         Ok(())
     });
     if let Ok(scene) = scene {
-        let _ = ws.render(&scene, &RenderOptions::default(), &mut panel);
+        let _ = ws.render(&scene, &mut panel);
     }
     loop {
         cortex_m::asm::nop();
