@@ -25,7 +25,8 @@ use crate::sink::{RowPixel, RowSink};
 use crate::vertex::TransformPrecision;
 use heapless::Vec;
 
-use super::{check_sizes, Painter};
+use crate::resolve::common::check_sizes;
+use crate::resolve::depth_sort::Painter;
 
 /// No child.
 pub const NO_CHILD: u16 = u16::MAX;

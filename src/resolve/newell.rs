@@ -86,8 +86,9 @@ use crate::render::{
     internal, viewport, walk_rows, ActiveTri, CapacityKind, FrameStats, RenderError, RenderOptions,
     MAX_INSTANCES, NO_ENTRY,
 };
+use crate::resolve::common::{check_sizes, sort_by_key};
+use crate::resolve::depth_sort::Painter;
 use crate::resolve::store::{self, StoredPieces, StoredTriangle};
-use crate::resolve::{check_sizes, sort_by_key, Painter};
 use crate::scene::Scene;
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};

@@ -72,7 +72,7 @@ use crate::raster::{DepthPlane, PlaneSolver, TriangleWalk};
 use crate::render::{
     internal, viewport, CapacityKind, FrameStats, RenderError, RenderOptions, MAX_INSTANCES,
 };
-use crate::resolve::check_sizes;
+use crate::resolve::common::check_sizes;
 use crate::resolve::store::{self, StoredTriangle};
 use crate::scene::Scene;
 use crate::shading::Shading;
