@@ -105,11 +105,11 @@ impl CachedVertex {
 }
 
 /// Bytes of a vertex cache of `vertices` entries (the `VERTS` of a
-/// [`Workspace`](crate::Workspace)), on top of [`crate::render::workspace_bytes`].
+/// [`Workspace`](crate::Workspace)), on top of [`crate::workspace::workspace_bytes`].
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
-/// use scanline3d::{cache::vertex_cache_bytes, render::workspace_bytes, Depth, Flat, Workspace};
+/// use scanline3d::{cache::vertex_cache_bytes, workspace::workspace_bytes, Depth, Flat, Workspace};
 /// type Cached = Workspace<Rgb565, Flat, 240, 240, 1280, 64, 8, Depth, 700>;
 /// let plain = workspace_bytes::<Rgb565, Flat, Depth>(240, 240, 1280, 64);
 /// assert_eq!(Cached::BYTES, plain + vertex_cache_bytes(700));

@@ -39,12 +39,12 @@ pub enum Clipped {
     /// Cut: the remaining convex polygon (at least 3 vertices) is in the output buffer.
     Polygon,
     /// Crosses a plane but clipping is compiled out ([`NoClip`]): not drawn, and counted in
-    /// [`FrameStats::unclipped`](crate::render::FrameStats::unclipped).
+    /// [`FrameStats::unclipped`](crate::stats::FrameStats::unclipped).
     Skipped,
 }
 
 /// The clipping stage, chosen at compile time in
-/// [`RenderOptions`](crate::render::RenderOptions): [`FrustumClip`] (the default) or
+/// [`RenderOptions`](crate::options::RenderOptions): [`FrustumClip`] (the default) or
 /// [`NoClip`] for scenes that provably never cross the near, far or guard-band planes, which
 /// leaves the clipper (and its 128-bit arithmetic) out of the build.
 pub trait Clipping: Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed {

@@ -70,7 +70,7 @@
 //! | near plane | ≥ [`MIN_NEAR`](scene::MIN_NEAR) = 1/256 | `near` keeps 8 significant bits in I16F16 |
 //! | far plane | ≤ [`MAX_EYE_DISTANCE`](scene::MAX_EYE_DISTANCE) = 16384 | eye-space envelope |
 //! | far/near | ≤ [`MAX_FAR_NEAR_RATIO`](scene::MAX_FAR_NEAR_RATIO) = 2^20 | `q = near/w` keeps ≥ 2^10 steps of I2F30 at the far plane: relative depth resolution 2^-30 · far/near ≤ 2^-10 there |
-//! | instances | `INSTANCES` of the [`Workspace`], default [`MAX_INSTANCES`](render::MAX_INSTANCES) = 8 | per-frame set-up on the stack, about 120 B each |
+//! | instances | `INSTANCES` of the [`Workspace`], default [`MAX_INSTANCES`](options::MAX_INSTANCES) = 8 | per-frame set-up on the stack, about 120 B each |
 //! | triangles per frame | [`MAX_SCENE_TRIANGLES`](scene::MAX_SCENE_TRIANGLES) = 65535 over all instances, checked by [`Scene::new`](scene::Scene::new) and per frame; `TRIS` (and `PIECES`) ≤ 65535 | 16-bit triangle ids and bucket links, `u16::MAX` ends a list |
 //!
 //! Any triangle size works: triangles far larger than the screen are clipped to a guard band of
@@ -92,6 +92,7 @@ pub mod config;
 pub mod depth;
 pub mod math;
 pub mod method;
+pub mod options;
 pub mod preset;
 pub mod project;
 pub mod raster;
@@ -101,7 +102,9 @@ pub mod resolve;
 pub mod scene;
 pub mod shading;
 pub mod sink;
+pub mod stats;
 pub mod vertex;
+pub mod workspace;
 
 pub use config::{Config, Settings};
 
@@ -111,6 +114,8 @@ pub use config::{Config, Settings};
 struct ReadmeDoctests;
 
 pub use depth::Depth;
-pub use render::{FrameStats, RenderError, RenderOptions, Workspace};
+pub use options::RenderOptions;
 pub use renderer::{Renderer, Storage, View};
 pub use shading::{Flat, Gouraud, Shading};
+pub use stats::{FrameStats, RenderError};
+pub use workspace::Workspace;

@@ -6,13 +6,15 @@
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::depth::DepthFormat;
-use crate::render::{FrameStats, RenderError, RenderOptions, SpanView, Workspace};
+use crate::options::RenderOptions;
 use crate::resolve::{
     BandWorkspace, DepthSortWorkspace, NewellWorkspace, SpanSortWorkspace, WarnockWorkspace,
 };
 use crate::scene::Scene;
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
+use crate::stats::{FrameStats, RenderError};
+use crate::workspace::{SpanView, Workspace};
 
 /// A hidden-surface method with its memory: renders a scene with given options, every row to
 /// a sink once, top to bottom.

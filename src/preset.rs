@@ -42,7 +42,7 @@ use crate::clip::FrustumClip;
 use crate::math::Micromath;
 use crate::math::{Libm, MathBackend};
 use crate::method::Options;
-use crate::render::RenderOptions;
+use crate::options::RenderOptions;
 use crate::scene::{Camera, SceneError};
 use crate::shading::{Affine, Interpolation, PerPixel, PerSegment};
 

@@ -37,9 +37,11 @@
 
 use crate::config::Config;
 use crate::method::{Method, Options};
-use crate::render::{FrameStats, RenderError, SpanView, Workspace, MAX_INSTANCES};
+use crate::options::MAX_INSTANCES;
 use crate::scene::Scene;
 use crate::sink::RowSink;
+use crate::stats::{FrameStats, RenderError};
+use crate::workspace::{SpanView, Workspace};
 use core::marker::PhantomData;
 
 /// A configuration `C` with the memory of hidden-surface method `M` (a workspace type of

@@ -90,14 +90,14 @@ pub struct Row<'a, P> {
     /// empty for methods that keep no depth.
     pub depth: DepthRow<'a>,
     /// `false` if a triangle piece that spans this row was dropped because the active list was
-    /// full (see [`FrameStats::dropped_pieces`](crate::render::FrameStats::dropped_pieces)).
+    /// full (see [`FrameStats::dropped_pieces`](crate::stats::FrameStats::dropped_pieces)).
     pub complete: bool,
 }
 
 /// Receives finished rows, each exactly once, top to bottom.
 ///
 /// If `write_row` fails, rendering stops and the error is returned as
-/// [`RenderError::Sink`](crate::render::RenderError::Sink); rows after it are never sent.
+/// [`RenderError::Sink`](crate::stats::RenderError::Sink); rows after it are never sent.
 pub trait RowSink<P> {
     /// The sink's error type.
     type Error;

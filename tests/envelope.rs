@@ -7,11 +7,12 @@ mod common;
 use common::*;
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use fixed::types::I16F16;
+use scanline3d::options::MAX_INSTANCES;
 use scanline3d::project::{Viewport, MAX_SCREEN};
-use scanline3d::render::{CapacityKind, MAX_INSTANCES};
 use scanline3d::resolve::{DepthSortWorkspace, NewellWorkspace, WarnockWorkspace};
 use scanline3d::scene::*;
 use scanline3d::sink::{FnSink, Row, RowSink, TriangleId};
+use scanline3d::stats::CapacityKind;
 use scanline3d::vertex::{ModelView, TransformError};
 use scanline3d::{Flat, RenderError, RenderOptions, Workspace};
 

@@ -5,9 +5,9 @@ mod common;
 use common::*;
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use scanline3d::math::Micromath;
-use scanline3d::render::CapacityKind;
 use scanline3d::scene::{Camera, Instance, Mesh, MeshColors, Scene, SceneError, Transform};
 use scanline3d::sink::{FnSink, Row};
+use scanline3d::stats::CapacityKind;
 use scanline3d::{Flat, RenderError, RenderOptions, Workspace};
 
 #[test]

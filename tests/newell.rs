@@ -3,9 +3,9 @@
 //! interpenetration), the tie rule for coplanar pieces, and capacity errors.
 
 use embedded_graphics::pixelcolor::Rgb565;
-use scanline3d::render::CapacityKind;
 use scanline3d::resolve::NewellWorkspace;
 use scanline3d::sink::{FnSink, HashSink, Row, RowPixel, TriangleId};
+use scanline3d::stats::CapacityKind;
 use scanline3d::{Flat, RenderError, RenderOptions, Workspace};
 use scanline3d_demo as demo;
 use scanline3d_sim::corpus;

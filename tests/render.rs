@@ -8,10 +8,11 @@ use embedded_graphics::pixelcolor::{BinaryColor, Gray8, Rgb565, Rgb888, RgbColor
 use scanline3d::cache::{vertex_cache_bytes, CachedVertex};
 use scanline3d::clip::NoClip;
 use scanline3d::depth::Depth16;
-use scanline3d::render::{workspace_bytes, CapacityKind};
 use scanline3d::scene::{Instance, Mesh, MeshColors, Scene, Transform};
 use scanline3d::shading::PerPixel;
 use scanline3d::sink::{FnSink, HashSink, Row, TriangleId};
+use scanline3d::stats::CapacityKind;
+use scanline3d::workspace::workspace_bytes;
 use scanline3d::Depth;
 use scanline3d::{Flat, Gouraud, RenderError, RenderOptions, Workspace};
 
@@ -397,7 +398,7 @@ fn check_degraded(
     let logged: Vec<_> = s.dropped_pieces.iter().flatten().collect();
     assert_eq!(
         logged.len(),
-        (s.dropped as usize).min(scanline3d::render::DROP_LOG)
+        (s.dropped as usize).min(scanline3d::stats::DROP_LOG)
     );
     assert_eq!(s.first_incomplete_row(), Some(logged[0].first_row));
     assert_eq!(
@@ -419,7 +420,7 @@ fn check_degraded(
         if a != b {
             differing += 1;
             assert!(!complete[i / 64], "pixel {i} differs in a complete row");
-            if s.dropped as usize <= scanline3d::render::DROP_LOG {
+            if s.dropped as usize <= scanline3d::stats::DROP_LOG {
                 assert!(
                     logged.iter().any(|d| d.triangle as i32 == a),
                     "pixel {i}: triangle {a} was not dropped"
@@ -445,14 +446,14 @@ fn full_active_list_degrades_deterministically_and_reports_what_was_lost() {
     // One entry short of the peak: a few pieces are lost, each one logged.
     let few = render_with_active::<17>(&scene);
     assert!(
-        few.2.dropped as usize <= scanline3d::render::DROP_LOG,
+        few.2.dropped as usize <= scanline3d::stats::DROP_LOG,
         "{:?}",
         few.2
     );
     check_degraded(&full, &few);
     // Far too small: many pieces are lost; counts stay exact, the log keeps the first ones.
     let many = render_with_active::<6>(&scene);
-    assert!(many.2.dropped as usize > scanline3d::render::DROP_LOG);
+    assert!(many.2.dropped as usize > scanline3d::stats::DROP_LOG);
     check_degraded(&full, &many);
     assert_eq!(many, render_with_active::<6>(&scene), "deterministic");
 }
@@ -625,7 +626,8 @@ fn micromath_backend_renders_nearly_the_same_image() {
 #[test]
 fn workspace_bytes_matches_the_compiled_layout() {
     use scanline3d::depth::Depth16;
-    use scanline3d::render::{workspace_bytes, MAX_INSTANCES};
+    use scanline3d::options::MAX_INSTANCES;
+    use scanline3d::workspace::workspace_bytes;
     use scanline3d::Depth;
     macro_rules! check {
         ($p:ty, $s:ty, $w:literal, $h:literal, $t:literal, $a:literal) => {
@@ -686,7 +688,7 @@ fn ids_and_depth<Z: scanline3d::depth::DepthFormat>(
     scene: &Scene<'_>,
     full: bool,
 ) -> (Vec<i32>, Vec<i32>) {
-    use scanline3d::render::MAX_INSTANCES;
+    use scanline3d::options::MAX_INSTANCES;
     use scanline3d::resolve::ZBufferWorkspace;
     let (mut ids, mut depth) = (Vec::new(), Vec::new());
     let mut sink = FnSink(|row: Row<'_, TriangleId>| -> Result<(), ()> {

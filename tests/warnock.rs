@@ -4,11 +4,11 @@
 
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888, RgbColor};
 use scanline3d::clip::NoClip;
-use scanline3d::render::CapacityKind;
 use scanline3d::resolve::warnock::stack_needed;
 use scanline3d::resolve::WarnockWorkspace;
 use scanline3d::scene::Scene;
 use scanline3d::sink::{FnSink, HashSink, Row, RowPixel, TriangleId};
+use scanline3d::stats::CapacityKind;
 use scanline3d::{Flat, Gouraud, RenderError, RenderOptions, Shading, Workspace};
 use scanline3d_demo as demo;
 use scanline3d_sim::corpus;

@@ -6,8 +6,8 @@ use crate::metrics::Metrics;
 use crate::reference::V3;
 use crate::scene::{CameraSpec, SceneSpec, SUB_PIXEL_CHOICES};
 use embedded_graphics::pixelcolor::Rgb565;
-use scanline3d::render::workspace_bytes;
 use scanline3d::scene::MAX_EYE_DISTANCE;
+use scanline3d::workspace::workspace_bytes;
 use scanline3d::{Depth, Flat};
 use std::fmt;
 

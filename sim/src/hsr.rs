@@ -10,9 +10,10 @@
 //! Adding a method takes two lines here: a `method!` declaration and a line in
 //! [`for_each`].
 
-use scanline3d::render::{FrameStats, RenderError, RenderOptions};
+use scanline3d::options::RenderOptions;
 use scanline3d::scene::{Camera, Instance, Light, Mesh, Scene, SceneError, Transform};
 use scanline3d::sink::{RowPixel, RowSink};
+use scanline3d::stats::{FrameStats, RenderError};
 use scanline3d::Flat;
 
 /// Target width.

@@ -10,9 +10,9 @@ use scanline3d::arithmetic::{Arithmetic, Precise, Setup};
 use scanline3d::clip::FrustumClip;
 use scanline3d::depth::{Depth16, DepthFormat};
 use scanline3d::math::{Libm, MathBackend, Micromath, NarrowNormals, WideNormals};
+use scanline3d::options::MAX_INSTANCES;
 use scanline3d::preset::{self, Preset};
 use scanline3d::project::{ExactDivision, Reciprocal};
-use scanline3d::render::MAX_INSTANCES;
 use scanline3d::resolve::bsp::{BspTree, BspWorkspace};
 use scanline3d::resolve::{
     warnock, BandWorkspace, DepthSortWorkspace, NewellWorkspace, SpanSortWorkspace,

@@ -4,14 +4,15 @@ use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::depth::Depth;
 use crate::depth::DepthFormat;
+use crate::options::{RenderOptions, MAX_INSTANCES};
 use crate::render::{
-    drive, fill_span, internal, viewport, ActiveTri, FinishedRow, Frame, FrameStats, IdOrder,
-    RenderError, RenderOptions, Resolve, MAX_INSTANCES, NO_ENTRY,
+    drive, fill_span, internal, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve, NO_ENTRY,
 };
 use crate::resolve::common::check_sizes;
 use crate::scene::Scene;
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
+use crate::stats::{FrameStats, RenderError};
 use heapless::Vec;
 
 /// A z-buffer over bands of `B` rows: per band, each triangle is walked through the band and

@@ -15,13 +15,14 @@
 
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
+use crate::options::RenderOptions;
 use crate::render::{
-    drive, internal, viewport, ActiveTri, CapacityKind, Frame, FrameStats, InstanceSetup,
-    RenderError, RenderOptions, TriangleOrder, NO_ENTRY,
+    drive, internal, viewport, ActiveTri, Frame, InstanceSetup, TriangleOrder, NO_ENTRY,
 };
 use crate::scene::{Scene, Transform};
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
+use crate::stats::{CapacityKind, FrameStats, RenderError};
 use crate::vertex::TransformPrecision;
 use heapless::Vec;
 

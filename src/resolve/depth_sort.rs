@@ -3,14 +3,13 @@
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::depth::DepthRow;
-use crate::render::{
-    drive, viewport, ActiveTri, FinishedRow, Frame, FrameStats, IdOrder, RenderError,
-    RenderOptions, Resolve, MAX_INSTANCES, NO_ENTRY,
-};
+use crate::options::{RenderOptions, MAX_INSTANCES};
+use crate::render::{drive, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve, NO_ENTRY};
 use crate::resolve::common::check_sizes;
 use crate::scene::Scene;
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
+use crate::stats::{FrameStats, RenderError};
 use heapless::Vec;
 
 /// Depth sort, the painter's algorithm: triangles are ordered far to near by the mean depth

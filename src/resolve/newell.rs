@@ -82,16 +82,15 @@
 
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
-use crate::render::{
-    internal, viewport, walk_rows, ActiveTri, CapacityKind, FrameStats, RenderError, RenderOptions,
-    MAX_INSTANCES, NO_ENTRY,
-};
+use crate::options::{RenderOptions, MAX_INSTANCES};
+use crate::render::{internal, viewport, walk_rows, ActiveTri, NO_ENTRY};
 use crate::resolve::common::{check_sizes, sort_by_key};
 use crate::resolve::depth_sort::Painter;
 use crate::resolve::store::{self, StoredPieces, StoredTriangle};
 use crate::scene::Scene;
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
+use crate::stats::{CapacityKind, FrameStats, RenderError};
 use core::cmp::Reverse;
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use heapless::Vec;

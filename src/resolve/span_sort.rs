@@ -3,15 +3,16 @@
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::depth::DepthRow;
+use crate::options::{RenderOptions, MAX_INSTANCES};
 use crate::raster::PixelOrigin;
 use crate::render::{
-    drive, internal, viewport, ActiveTri, FinishedRow, Frame, FrameStats, IdOrder, RenderError,
-    RenderOptions, Resolve, MAX_INSTANCES, NO_ENTRY,
+    drive, internal, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve, NO_ENTRY,
 };
 use crate::resolve::common::{check_sizes, sort_by_key, swap_within};
 use crate::scene::Scene;
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
+use crate::stats::{FrameStats, RenderError};
 use heapless::{Vec, VecView};
 
 /// One span on the current row, for span sorting.

@@ -9,14 +9,13 @@
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::depth::Depth;
+use crate::options::RenderOptions;
 use crate::project::{ScreenVertex, SubPx, Viewport};
 use crate::raster::{channel, color_channels, first_row};
-use crate::render::{
-    for_each_screen_piece, internal, ActivePieces, CapacityKind, FrameStats, RenderError,
-    RenderOptions, NO_ENTRY,
-};
+use crate::render::{for_each_screen_piece, internal, ActivePieces, NO_ENTRY};
 use crate::scene::Scene;
 use crate::shading::Shading;
+use crate::stats::{CapacityKind, FrameStats, RenderError};
 use embedded_graphics::pixelcolor::Rgb888;
 
 /// A visible screen triangle (or clipped piece), as whole-frame methods keep it.

@@ -67,16 +67,16 @@
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::depth::DepthRow;
+use crate::options::{RenderOptions, MAX_INSTANCES};
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{DepthPlane, PlaneSolver, TriangleWalk};
-use crate::render::{
-    internal, viewport, CapacityKind, FrameStats, RenderError, RenderOptions, MAX_INSTANCES,
-};
+use crate::render::{internal, viewport};
 use crate::resolve::common::check_sizes;
 use crate::resolve::store::{self, StoredTriangle};
 use crate::scene::Scene;
 use crate::shading::Shading;
 use crate::sink::{Row, RowPixel, RowSink};
+use crate::stats::{CapacityKind, FrameStats, RenderError};
 use core::marker::PhantomData;
 
 /// Entries of the window stack a `width × height` target needs: `3 · ⌈log2 max(w, h)⌉ + 1`
