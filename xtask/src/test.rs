@@ -46,6 +46,10 @@ pub(crate) fn test() -> Result<(), String> {
     install()?;
     step("format");
     run(cargo().args(["fmt", "--all", "--", "--check"]))?;
+    step("rustdoc (warnings denied: broken links, missing docs)");
+    run(cargo()
+        .args(["doc", "--package", "scanline3d", "--no-deps"])
+        .env("RUSTDOCFLAGS", "-D warnings"))?;
     step("clippy (warnings denied)");
     run(cargo().args([
         "clippy",
@@ -58,27 +62,26 @@ pub(crate) fn test() -> Result<(), String> {
     let mut totals = (0, 0);
     step("tests, debug (overflow checks on)");
     cargo_test(&[], &mut totals)?;
-    step("tests, release (with the peer renderers: sim/tests/peers.rs)");
+    // Doctests ran above; in release they would only be compiled again, one binary each.
+    step("tests, release, without doctests (with the peer renderers: sim/tests/peers.rs)");
     cargo_test(
-        &["--release", "--features", "scanline3d-sim/peers"],
+        &[
+            "--release",
+            "--lib",
+            "--bins",
+            "--tests",
+            "--features",
+            "scanline3d-sim/peers",
+        ],
         &mut totals,
     )?;
     for target in TARGETS {
-        step(&format!("library for {target} (no_std, no allocator)"));
-        run(cargo().args([
-            "build",
-            "--release",
-            "--package",
-            "scanline3d",
-            "--lib",
-            "--target",
-            target,
-        ]))?;
-    }
-    for target in TARGETS {
         // Link-time proof that the render path cannot panic: the example's panic handler calls
-        // an undefined symbol, so the link fails if any panic is reachable.
-        step(&format!("panic-never link check for {target}"));
+        // an undefined symbol, so the link fails if any panic is reachable. It also builds the
+        // library for the target: no_std, no allocator.
+        step(&format!(
+            "library for {target}: no_std, and the panic-never link check"
+        ));
         run(cargo().args([
             "build",
             "--package",
