@@ -97,6 +97,19 @@ pub enum CapacityKind {
     SortSteps,
 }
 
+impl core::fmt::Display for CapacityKind {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::Triangles => "triangles after culling (TRIS)",
+            Self::Instances => "mesh instances (INSTANCES)",
+            Self::Pieces => "screen pieces (PIECES)",
+            Self::BspStack => "BSP traversal stack (STACK)",
+            Self::WindowStack => "Warnock window stack (STACK)",
+            Self::SortSteps => "Newell sort steps",
+        })
+    }
+}
+
 /// Why a frame could not be rendered.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RenderError<E> {
@@ -145,7 +158,7 @@ impl<E: core::fmt::Debug> core::fmt::Display for RenderError<E> {
                 write!(f, "render target size or projection outside the envelope")
             }
             Self::Transform { instance, error } => {
-                write!(f, "instance {instance}: transform rejected ({error:?})")
+                write!(f, "instance {instance}: {error}")
             }
             Self::Capacity {
                 what,
@@ -154,7 +167,7 @@ impl<E: core::fmt::Debug> core::fmt::Display for RenderError<E> {
             } => {
                 write!(
                     f,
-                    "capacity exceeded: {what:?} needs {needed}, holds {capacity}"
+                    "capacity exceeded: {what} needs {needed}, holds {capacity}"
                 )
             }
             Self::Sink { row, error } => write!(f, "sink failed on row {row}: {error:?}"),

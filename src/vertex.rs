@@ -41,6 +41,18 @@ pub enum TransformError {
     OutOfEnvelope,
 }
 
+impl core::fmt::Display for TransformError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::NonFinite => "the model-view transform is not finite (NaN or infinity)",
+            Self::OutOfEnvelope => {
+                "a vertex would land beyond the eye-space envelope of ±16384 units (move the \
+                 camera closer, or scale or split the model)"
+            }
+        })
+    }
+}
+
 /// How precisely vertices are transformed, chosen at compile time (see
 /// [`crate::arithmetic::Arithmetic`]).
 pub trait TransformPrecision:

@@ -184,11 +184,15 @@ impl Export<'_> {
                 b.origin.iter().max().map_or(0, |&o| o as usize + 1)
             );
         }
-        s += "\n";
+        let _ = writeln!(
+            s,
+            "//!\n//! Include it as a module (`mod scene;`); the firmware crate needs `scanline3d`, `fixed` and\n//! `embedded-graphics` as dependencies. Render with `SceneStorage<YourConfig>`."
+        );
+        s += "#![allow(dead_code)] // a firmware uses what its views need of this file\n\n";
         let mut uses = vec!["embedded_graphics::pixelcolor::Rgb888"];
         uses.push("fixed::types::I16F16");
         uses.push("scanline3d::scene::{Mesh, MeshColors, SceneError, Vertex}");
-        uses.push("scanline3d::Workspace");
+        uses.push("scanline3d::{Storage, Workspace}");
         if self.bsp.is_some() {
             uses.push("scanline3d::resolve::bsp::{BspNode, BspTree, BspWorkspace, NO_CHILD}");
         }
@@ -293,7 +297,9 @@ impl Export<'_> {
         let _ = writeln!(s, "/// Mesh instances: this file holds one mesh.");
         let _ = writeln!(s, "pub const INSTANCES: usize = 1;");
         let _ = writeln!(s, "/// The workspace this budget asks for.");
-        s += "pub type SceneWorkspace<P, S> =\n    Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE, INSTANCES>;\n\n";
+        s += "pub type SceneWorkspace<P, S> =\n    Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE, INSTANCES>;\n";
+        s += "/// The renderer this budget asks for, for configuration `C` (a `scanline3d::Config`).\n";
+        s += "pub type SceneStorage<C> = Storage<C, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE>;\n\n";
         if self.bsp.is_some() {
             let _ = writeln!(
                 s,

@@ -147,7 +147,7 @@ struct View {
     #[arg(long)]
     no_cull: bool,
     /// Hidden-surface method: span-zbuffer (default), zbuffer, band:N (N = 1, 2, 4, ..., 128),
-    /// depth-sort, span-sort, or raycast (the f64 reference ray caster).
+    /// depth-sort, newell, bsp, span-sort, warnock, or raycast (the f64 reference ray caster).
     #[arg(long, value_parser = method, default_value = "span-zbuffer")]
     algorithm: Method,
 }
@@ -188,7 +188,7 @@ struct RenderArgs {
     /// Depth image (W×H little-endian f32 eye depth, +inf = background).
     #[arg(long)]
     depth: Option<PathBuf>,
-    /// Statistics as JSON.
+    /// Statistics as JSON, to this file (`-` for standard output).
     #[arg(long)]
     stats: Option<PathBuf>,
     /// Which renderer.
@@ -249,8 +249,9 @@ struct Views {
     /// Draw back faces too (open surfaces).
     #[arg(long)]
     no_cull: bool,
-    /// Safety margin on the capacities, in percent.
-    #[arg(long, default_value_t = 0)]
+    /// Safety margin on the capacities, in percent: room for views between the analysed ones
+    /// (an overfull frame is still reported in its statistics, never silent).
+    #[arg(long, default_value_t = 25)]
     margin: u32,
 }
 
@@ -490,11 +491,16 @@ fn render(a: RenderArgs) -> Result<(), String> {
         scene::write_depth(p, &image.depth)?;
         say!("wrote {}", p.display());
     }
-    if let Some(p) = &a.stats {
-        std::fs::write(p, &stats_json).map_err(|e| format!("{}: {e}", p.display()))?;
-        say!("wrote {}", p.display());
+    match &a.stats {
+        Some(p) if p.as_os_str() == "-" => {
+            let _ = std::io::stdout().write_all(stats_json.as_bytes());
+        }
+        Some(p) => {
+            std::fs::write(p, &stats_json).map_err(|e| format!("{}: {e}", p.display()))?;
+            say!("wrote {}", p.display());
+        }
+        None => {}
     }
-    let _ = std::io::stdout().write_all(stats_json.as_bytes());
     Ok(())
 }
 

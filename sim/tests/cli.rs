@@ -50,7 +50,10 @@ fn render_writes_png_ids_depth_and_stats_in_the_documented_formats() {
         &dir,
     );
     assert_eq!(code, 0, "{stderr}");
-    assert!(stdout.contains("\"triangles_in\": 12"), "{stdout}");
+    // Statistics go where asked, not to standard output unasked.
+    assert!(!stdout.contains("triangles_in"), "{stdout}");
+    let stats = std::fs::read_to_string(dir.join("c.json")).unwrap();
+    assert!(stats.contains("\"triangles_in\": 12"), "{stats}");
     let ids = std::fs::read(dir.join("c.ids")).unwrap();
     let depth = std::fs::read(dir.join("c.depth")).unwrap();
     assert_eq!((ids.len(), depth.len()), (64 * 48 * 4, 64 * 48 * 4));
@@ -191,6 +194,8 @@ fn every_algorithm_renders_the_same_ids_where_it_is_exact() {
             &file,
             "--algorithm",
             algorithm,
+            "--stats",
+            "-",
         ];
         let (code, stdout, stderr) = sim(&args, &dir);
         assert_eq!(code, 0, "{algorithm}: {stderr}");

@@ -15,7 +15,8 @@ fn root() -> PathBuf {
 const LEAN_OBJ: &str = "firmware/examples/lean/icosphere80.obj";
 const LEAN_RS: &str = "firmware/examples/lean/scene.rs";
 /// The export command for it (run from the repository root).
-const LEAN_EXPORT: &[&str] = &["export", LEAN_OBJ, "--views", "8"];
+/// Margin 0: the lean builds measure the smallest workspace that renders these views.
+const LEAN_EXPORT: &[&str] = &["export", LEAN_OBJ, "--views", "8", "--margin", "0"];
 /// The lean BSP firmware's scene: the cyclic-overlap corpus scene with its BSP tree.
 const BSP_RS: &str = "firmware/examples/lean/cyclic_bsp.rs";
 const BSP_EXPORT: &[&str] = &[
@@ -25,6 +26,8 @@ const BSP_EXPORT: &[&str] = &[
     "8",
     "--no-cull",
     "--bsp",
+    "--margin",
+    "0",
 ];
 
 #[test]
