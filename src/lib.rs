@@ -11,42 +11,57 @@
 //! (band and full-frame z-buffer, span sorting, depth sort, Newell–Newell–Sancha, BSP order,
 //! Warnock) run on the same pipeline: see [`resolve`].
 //!
+//! A user names every precision choice once (a [`Config`]: [`Settings`] with a
+//! [`preset`], or a type of their own), all memory once (a [`Storage`], whose
+//! `const fn new` lets it live in a `static`), and renders with `render(&scene, &mut sink)`:
+//!
 //! ```
 //! use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 //! use fixed::types::I16F16;
-//! use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform};
-//! use scanline3d::sink::FnSink;
-//! use scanline3d::{Flat, RenderOptions, Workspace};
+//! use scanline3d::scene::{Instance, Light, Mesh, MeshColors, Scene, Transform};
+//! use scanline3d::sink::{FnSink, Row};
+//! use scanline3d::{preset, Config, Flat, Settings, Storage};
+//!
+//! type Cfg = Settings<Rgb565, Flat, preset::Balanced>;
 //!
 //! let c = |v: f32| I16F16::from_num(v);
 //! let vertices = [[c(-1.0), c(-1.0), c(0.0)], [c(1.0), c(-1.0), c(0.0)], [c(0.0), c(1.0), c(0.0)]];
 //! let triangles = [[0, 1, 2]];
 //! let mesh = Mesh::new(&vertices, &triangles, MeshColors::Uniform(Rgb888::new(255, 128, 0)), None)?;
 //! let instances = [Instance { mesh: &mesh, transform: Transform::rotation_y(0.3) }];
-//! let scene = Scene {
-//!     instances: &instances,
-//!     camera: Camera::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0])?.perspective(60.0, 0.1, 50.0)?,
-//!     light: Light::new([0.3, 0.5, 1.0], 0.2, 0.8)?,
-//! };
+//! let camera = Cfg::camera([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0], 60.0, 0.1, 50.0)?;
+//! let scene = Scene::new(&instances, camera, Light::new([0.3, 0.5, 1.0], 0.2, 0.8)?)?;
 //!
 //! // 64×48 pixels, room for 16 triangles, 8 active per row: under 2 KiB of RAM.
-//! let mut ws: Workspace<Rgb565, Flat, 64, 48, 16, 8> = Workspace::new(Rgb565::new(0, 0, 0));
+//! let mut renderer: Storage<Cfg, 64, 48, 16, 8> = Storage::new(Rgb565::new(0, 0, 0));
 //! let mut lit = 0;
-//! let mut panel = FnSink(|row: scanline3d::sink::Row<'_, Rgb565>| -> Result<(), ()> {
+//! let mut panel = FnSink(|row: Row<'_, Rgb565>| -> Result<(), ()> {
 //!     lit += row.pixels.iter().filter(|p| **p != Rgb565::new(0, 0, 0)).count();
 //!     Ok(()) // here a driver would send the row over SPI
 //! });
-//! let stats = ws.render(&scene, &RenderOptions::default(), &mut panel).unwrap();
+//! let stats = renderer.render(&scene, &mut panel).unwrap();
 //! assert_eq!(stats.rows, 48);
 //! assert_eq!(stats.pixels_written as usize, lit);
 //! # Ok::<(), scanline3d::scene::SceneError>(())
 //! ```
 //!
+//! ## From an OBJ file to firmware
+//!
+//! `sim analyze model.obj` (in this repository's `sim/`) measures what the model needs over a
+//! set of views: sub-pixel bits for an accuracy goal, capacities, whether clipping or culling
+//! can change the image. `sim export model.obj --out scene.rs` writes it as `static` I16F16
+//! data with `VIEWS`, `PROJECTION`, `LIGHT` and a `SceneStorage<C>` sized for those views;
+//! include it with `mod scene;` and build each frame as `Scene::new(&[Instance { mesh:
+//! &scene::MESH, .. }], C::camera(eye, target, up, fovy, near, far)?, light)`. The
+//! repository's `docs/export.md` walks through it.
+//!
 //! ## Pipeline (one module per stage)
 //!
 //! [`scene`] → [`vertex`] (transform, lighting) → [`clip`] → [`project`] → [`raster`] (setup,
-//! edge walk) → [`render`] (buckets, active list, span z-buffer in a [`depth`] format) with
-//! [`shading`] → [`sink`]. An optional [`cache`] keeps each vertex's transform and projection
+//! edge walk) → [`render`] (buckets, active list) → [`workspace`] (the span z-buffer in a
+//! [`depth`] format) or a [`resolve`] method, with [`shading`] → [`sink`]. [`options`] and
+//! [`stats`] are what a frame takes and reports; [`config`], [`method`] and [`renderer`] put
+//! them behind one call. An optional [`cache`] keeps each vertex's transform and projection
 //! for the frame, trading RAM for set-up time.
 //!
 //! ## Rules
