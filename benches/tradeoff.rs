@@ -8,14 +8,14 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
 use scanline3d::arithmetic::{Arithmetic, Frugal, Precise, Quick, Setup};
+use scanline3d::arithmetic::{ExactDivision, Reciprocal};
+use scanline3d::arithmetic::{NarrowTransform, WideTransform};
 use scanline3d::depth::{Depth16, DepthFormat};
 use scanline3d::math::{NarrowNormals, WideNormals};
 use scanline3d::options::MAX_INSTANCES;
-use scanline3d::project::{ExactDivision, Reciprocal};
 use scanline3d::scene::Scene;
 use scanline3d::shading::{Affine, Interpolation, PerPixel, PerSegment};
 use scanline3d::sink::HashSink;
-use scanline3d::vertex::{NarrowTransform, WideTransform};
 use scanline3d::{Depth, Flat, Gouraud, RenderOptions, Workspace};
 use scanline3d_demo as demo;
 use scanline3d_sim::corpus;

@@ -3,8 +3,8 @@
 //! ([`crate::preset`]) pick one of these.
 
 use crate::math::{NarrowNormals, NormalPrecision, WideNormals};
-use crate::project::{ExactDivision, ProjectionPrecision, Reciprocal};
-use crate::vertex::{NarrowTransform, TransformPrecision, WideTransform};
+pub use crate::project::{ExactDivision, ProjectionPrecision, Reciprocal};
+pub use crate::vertex::{NarrowTransform, TransformPrecision, WideTransform};
 use core::marker::PhantomData;
 
 /// The integer arithmetic of the per-vertex and per-triangle set-up, one compile-time choice

@@ -2,7 +2,7 @@
 //!
 //! Without it the renderer keeps nothing per vertex: a vertex shared by six triangles is
 //! transformed, clip-tested and projected six times in pass 1 and again in pass 2 (see
-//! [`crate::render`]). A [`Workspace`](crate::Workspace) with `VERTS > 0` instead does that
+//! `crate::render`). A [`Workspace`](crate::Workspace) with `VERTS > 0` instead does that
 //! once per vertex at the start of the frame, when the scene's vertices (all instances
 //! together) fit; triangles whose three vertices are inside every clip plane then take their
 //! screen vertices from the cache, and the others are clipped from the cached eye-space points.

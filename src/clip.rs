@@ -1,7 +1,7 @@
 //! Clipping in eye space against the near and far planes and a guard band.
 //!
 //! Near/far clipping makes triangles with vertices behind the eye render correctly. The guard
-//! band (8 half-screens around the centre, see [`crate::project`]) exists only for the bit
+//! band (8 half-screens around the centre, see `crate::project`) exists only for the bit
 //! budget: it keeps projected coordinates below 2^22 sub-pixels, so the edge walk never
 //! overflows. Its clip edges lie far off-screen and are never visible.
 //!

@@ -57,8 +57,8 @@
 //!
 //! ## Pipeline (one module per stage)
 //!
-//! [`scene`] → [`vertex`] (transform, lighting) → [`clip`] → [`project`] → [`raster`] (setup,
-//! edge walk) → [`render`] (buckets, active list) → [`workspace`] (the span z-buffer in a
+//! [`scene`] → `vertex` (transform, lighting) → [`clip`] → `project` → `raster` (setup,
+//! edge walk) → `render` (buckets, active list) → [`workspace`] (the span z-buffer in a
 //! [`depth`] format) or a [`resolve`] method, with [`shading`] → [`sink`]. [`options`] and
 //! [`stats`] are what a frame takes and reports; [`config`], [`method`] and [`renderer`] put
 //! them behind one call. An optional [`cache`] keeps each vertex's transform and projection
@@ -66,7 +66,7 @@
 //!
 //! ## Rules
 //!
-//! Pixel centres at `(c + ½, r + ½)`, top-left fill rule, exact edge walking: see [`raster`].
+//! Pixel centres at `(c + ½, r + ½)`, top-left fill rule, exact edge walking: see `raster`.
 //! Every fixed-point format is named in its type and each stage documents its bit budget.
 //! Nothing on the render path allocates, panics or uses `unsafe`: `examples/panic_never.rs`
 //! links only if no panic is reachable from it.
@@ -78,9 +78,9 @@
 //!
 //! | limit | value | reason (bit budget) |
 //! |---|---|---|
-//! | model coordinates | ±[`MAX_MODEL_COORD`](scene::MAX_MODEL_COORD) = 4096 | I16F16 products stay far below the eye-space limit ([`vertex`]) |
-//! | eye coordinates | ±2^14, checked per instance and frame | I16F16 with 2× headroom for clip interpolation ([`vertex`]) |
-//! | target size | 1 to [`MAX_SCREEN`](project::MAX_SCREEN) = 2048 per side | with the guard band, sub-pixel coordinates stay below 2^22 ([`project`], [`raster`]) |
+//! | model coordinates | ±[`MAX_MODEL_COORD`](scene::MAX_MODEL_COORD) = 4096 | I16F16 products stay far below the eye-space limit (`vertex`) |
+//! | eye coordinates | ±2^14, checked per instance and frame | I16F16 with 2× headroom for clip interpolation (`vertex`) |
+//! | target size | 1 to [`MAX_SCREEN`](project::MAX_SCREEN) = 2048 per side | with the guard band, sub-pixel coordinates stay below 2^22 (`project`, `raster`) |
 //! | sub-pixel bits | 0 to 8 | same |
 //! | near plane | ≥ [`MIN_NEAR`](scene::MIN_NEAR) = 1/256 | `near` keeps 8 significant bits in I16F16 |
 //! | far plane | ≤ [`MAX_EYE_DISTANCE`](scene::MAX_EYE_DISTANCE) = 16384 | eye-space envelope |
@@ -109,16 +109,32 @@ pub mod math;
 pub mod method;
 pub mod options;
 pub mod preset;
+// A pipeline stage: public only with the feature `internals` (measurement firmware, tests).
+#[cfg(feature = "internals")]
 pub mod project;
+#[cfg(not(feature = "internals"))]
+mod project;
+// A pipeline stage: public only with the feature `internals` (measurement firmware, tests).
+#[cfg(feature = "internals")]
 pub mod raster;
+#[cfg(not(feature = "internals"))]
+mod raster;
+// A pipeline stage: public only with the feature `internals` (measurement firmware, tests).
+#[cfg(feature = "internals")]
 pub mod render;
+#[cfg(not(feature = "internals"))]
+mod render;
 pub mod renderer;
 pub mod resolve;
 pub mod scene;
 pub mod shading;
 pub mod sink;
 pub mod stats;
+// A pipeline stage: public only with the feature `internals` (measurement firmware, tests).
+#[cfg(feature = "internals")]
 pub mod vertex;
+#[cfg(not(feature = "internals"))]
+mod vertex;
 pub mod workspace;
 
 pub use config::{Config, Settings};

@@ -1,5 +1,5 @@
 //! Every hidden-surface method behind one call. A [`Method`] is the memory of one method (a
-//! workspace type of [`crate::render`] or [`crate::resolve`]); [`Options`] are the per-frame
+//! workspace type of `crate::render` or [`crate::resolve`]); [`Options`] are the per-frame
 //! precision choices a [`Config`](crate::Config) hands it. Together they give every method the
 //! same `render(&scene, &mut sink)` call ([`crate::Renderer`]).
 

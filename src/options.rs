@@ -3,6 +3,7 @@
 
 use crate::arithmetic::{Arithmetic, Precise};
 use crate::clip::{Clipping, FrustumClip};
+pub use crate::project::{MAX_SCREEN, MAX_SUB_PIXEL_BITS};
 
 /// Default for a [`Workspace`](crate::Workspace)'s `INSTANCES`: most mesh instances in one scene. Each costs
 /// about 120 bytes of stack during a render (its transform and lighting set-up).
@@ -84,7 +85,7 @@ impl<const SUB_BITS: u32, C: Clipping, A: Arithmetic> RenderOptions<SUB_BITS, C,
     ///
     /// ```
     /// use scanline3d::arithmetic::{Quick, Setup};
-    /// use scanline3d::{project::Reciprocal, vertex::WideTransform, math::WideNormals};
+    /// use scanline3d::{arithmetic::{Reciprocal, WideTransform}, math::WideNormals};
     /// let quick = scanline3d::RenderOptions::default().with_arithmetic(Quick::default());
     /// // One knob alone: reciprocal projection, the rest precise.
     /// let one = quick.with_arithmetic(Setup::<WideTransform, Reciprocal, WideNormals>::default());

@@ -242,7 +242,7 @@ fn screen_vertex<const S: u32>(x: i64, y: i64, q: i64, color: [I16F16; 3]) -> Sc
 }
 
 /// How vertices are divided by `w`, chosen at compile time (see
-/// [`crate::arithmetic::Arithmetic`]); [`Viewport::project_as`] projects with it.
+/// [`crate::arithmetic::Arithmetic`]); `Viewport::project_as` projects with it.
 pub trait ProjectionPrecision:
     Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed + 'static
 {
@@ -257,11 +257,11 @@ mod sealed {
 }
 
 /// A 64-bit division per coordinate and for the depth, each rounded exactly
-/// ([`Viewport::project_with`]): the default.
+/// (`Viewport::project_with`): the default.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ExactDivision;
 
-/// One 32-bit reciprocal per vertex and multiplications ([`Viewport::project_reciprocal`]):
+/// One 32-bit reciprocal per vertex and multiplications (`Viewport::project_reciprocal`):
 /// positions within `2^-14` of their offset from the screen centre, for a fraction of the cost
 /// on cores without a divider.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -235,6 +235,7 @@ impl TriangleWalk {
 /// // The hypotenuse is a right edge: centres on it, like (3.5, 0.5), are not covered.
 /// assert_eq!(spans, [(0, 0, 3), (1, 0, 2), (2, 0, 1)]);
 /// ```
+#[cfg_attr(not(feature = "internals"), allow(dead_code))] // used by the tests and tools
 pub fn for_each_span<const S: u32>(
     v: [(i32, i32); 3],
     width: i32,
@@ -444,6 +445,7 @@ impl DepthPlane {
     }
 
     /// Depth at pixel centre `(c, r)` in I2F30, unclamped (for tests).
+    #[cfg_attr(not(feature = "internals"), allow(dead_code))] // used by the tests and tools
     pub fn depth_at(&self, c: i32, r: i32) -> Depth {
         let q = self.origin.at(&self.q, c, r) >> DEPTH_PLANE_EXTRA_BITS;
         Depth::from_bits(q.clamp(i32::MIN as i64, i32::MAX as i64) as i32)

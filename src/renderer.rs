@@ -45,7 +45,7 @@ use crate::workspace::{SpanView, Workspace};
 use core::marker::PhantomData;
 
 /// A configuration `C` with the memory of hidden-surface method `M` (a workspace type of
-/// [`crate::render`] or [`crate::resolve`] whose pixel and shading are `C`'s).
+/// `crate::render` or [`crate::resolve`] whose pixel and shading are `C`'s).
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;

@@ -20,7 +20,7 @@ pub type Vertex = [Coord; 3];
 /// Largest |coordinate| a mesh vertex may have: 2^12 = 4096 model units.
 ///
 /// Keeps `|matrix entry| * |coordinate|` sums far from the I16F16 eye-space limit (see
-/// [`crate::vertex`] for the full bit budget).
+/// `crate::vertex` for the full bit budget).
 pub const MAX_MODEL_COORD: i32 = 1 << 12;
 
 /// Largest number of triangles in one frame, all instances together: 65,535.

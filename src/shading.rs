@@ -10,7 +10,7 @@
 //! | interpolation | per pixel | per segment of `N` pixels | error |
 //! |---|---|---|---|
 //! | [`Affine`] (default) | 3 adds | — | grows with how steeply the triangle recedes |
-//! | [`PerSegment<N>`] | 3 adds | 3 divisions (one evaluation of [`PerspectivePlanes`]), and one more evaluation at each span's start | affine within each segment of `N` pixels |
+//! | [`PerSegment<N>`] | 3 adds | 3 divisions (one evaluation of `PerspectivePlanes`), and one more evaluation at each span's start | affine within each segment of `N` pixels |
 //! | [`PerPixel`] | 4 64-bit adds, 3 divisions where a pixel is written | — | rounding only |
 
 use crate::depth::DepthFormat;

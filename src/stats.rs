@@ -1,7 +1,7 @@
 //! What a frame reports: its statistics (what was drawn, what capacity dropped) and its errors.
 
 use crate::scene::MAX_SCENE_TRIANGLES;
-use crate::vertex::TransformError;
+pub use crate::vertex::TransformError;
 
 /// What one frame did. Counts are of triangles unless named otherwise.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

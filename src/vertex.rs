@@ -73,15 +73,15 @@ mod sealed {
     impl Sealed for super::NarrowTransform {}
 }
 
-/// I16F16 × I16F16 products summed in `i64` and rounded once ([`ModelView::apply`]): eye
+/// I16F16 × I16F16 products summed in `i64` and rounded once (`ModelView::apply`): eye
 /// coordinates within 2^-17 units of the exact product of the I16F16 matrix and vertex. The
 /// default.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct WideTransform;
 
-/// 15-bit × 16-bit products summed in `i32` ([`NarrowModelView`]): one 32-bit multiply
+/// 15-bit × 16-bit products summed in `i32` (`NarrowModelView`): one 32-bit multiply
 /// per product instead of a 64-bit one, for an eye-space error of about 2^-14 of the mesh's
-/// extent times the matrix's largest entry (see [`NarrowModelView`]).
+/// extent times the matrix's largest entry (see `NarrowModelView`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct NarrowTransform;
 

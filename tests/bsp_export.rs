@@ -2,7 +2,6 @@
 //! lecture's cyclic-overlap case) renders on the host exactly as `sim`'s BSP method renders the
 //! OBJ it came from: the same frames the lean BSP firmware must print under QEMU.
 
-#[allow(dead_code)]
 #[path = "../firmware/examples/lean/cyclic_bsp.rs"]
 mod scene;
 

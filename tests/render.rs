@@ -560,7 +560,7 @@ fn bad_transforms_are_reported() {
         )
         .map(|_| ())
     };
-    use scanline3d::vertex::TransformError;
+    use scanline3d::stats::TransformError;
     assert_eq!(
         scene_with(Transform::translation([f32::NAN, 0.0, 0.0])),
         Err(RenderError::Transform {

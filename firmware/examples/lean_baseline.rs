@@ -9,8 +9,7 @@
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
-// The exported scene (`sim export`); not every constant is used by every variant.
-#[allow(dead_code)]
+// The exported scene (`sim export`).
 #[path = "lean/scene.rs"]
 mod scene;
 

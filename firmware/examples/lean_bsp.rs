@@ -12,8 +12,7 @@
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
-// The exported scene and tree (`sim export --bsp`); not every constant is used.
-#[allow(dead_code)]
+// The exported scene and tree (`sim export --bsp`).
 #[path = "lean/cyclic_bsp.rs"]
 mod scene;
 

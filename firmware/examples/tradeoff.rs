@@ -181,9 +181,9 @@ const fn renders(name: &str) -> bool {
 fn variants(r: &mut impl Renders) -> Result<(), &'static str> {
     use preset::{Balanced, Exact, Fast};
     use scanline3d::arithmetic::Setup;
+    use scanline3d::arithmetic::{ExactDivision, Reciprocal};
+    use scanline3d::arithmetic::{NarrowTransform, WideTransform};
     use scanline3d::math::{Libm, Micromath, NarrowNormals, WideNormals};
-    use scanline3d::project::{ExactDivision, Reciprocal};
-    use scanline3d::vertex::{NarrowTransform, WideTransform};
     type Math<P> = <P as Preset>::Math;
     type Arith<P> = <P as Preset>::Arithmetic;
     let default = RenderOptions::default();

@@ -7,12 +7,13 @@ use crate::reference::{self, Image};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::I16F16;
 use scanline3d::arithmetic::{Arithmetic, Precise, Setup};
+use scanline3d::arithmetic::{ExactDivision, Reciprocal};
+use scanline3d::arithmetic::{NarrowTransform, WideTransform};
 use scanline3d::clip::FrustumClip;
 use scanline3d::depth::{Depth16, DepthFormat};
 use scanline3d::math::{Libm, MathBackend, Micromath, NarrowNormals, WideNormals};
 use scanline3d::options::MAX_INSTANCES;
 use scanline3d::preset::{self, Preset};
-use scanline3d::project::{ExactDivision, Reciprocal};
 use scanline3d::resolve::bsp::{BspTree, BspWorkspace};
 use scanline3d::resolve::{
     warnock, BandWorkspace, DepthSortWorkspace, NewellWorkspace, SpanSortWorkspace,
@@ -20,7 +21,6 @@ use scanline3d::resolve::{
 };
 use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
 use scanline3d::sink::{FnSink, Row, RowPixel, RowSink, TriangleId};
-use scanline3d::vertex::{NarrowTransform, WideTransform};
 use scanline3d::{Depth, Flat, FrameStats, RenderOptions, Workspace};
 use std::convert::Infallible;
 use std::fmt::Debug;

@@ -1,7 +1,7 @@
 //! The classic hidden-surface methods on the shared pipeline.
 //!
 //! Transform, clipping, projection, bucketing by first row and the exact edge walk are the
-//! same for every method (see [`crate::render`]); only the step that turns the active
+//! same for every method (see `crate::render`); only the step that turns the active
 //! triangles' spans into visible pixels differs. [`Workspace`](crate::Workspace) is the span
 //! z-buffer (one row of depth). This module adds:
 //!

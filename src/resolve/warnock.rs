@@ -18,9 +18,9 @@
 //!
 //! # Exactly the span z-buffer's frame
 //!
-//! Coverage is the exact edge walk ([`TriangleWalk`]) restricted to the window, so the
+//! Coverage is the exact edge walk (`TriangleWalk`) restricted to the window, so the
 //! top-left rule and the snapped vertices are those of every other method. Depth is evaluated
-//! exactly as the span z-buffer steps it along a row: from [`DepthPlane::span_start`] at the
+//! exactly as the span z-buffer steps it along a row: from `DepthPlane::span_start` at the
 //! left end of the piece's span on that row, plus `dq` per pixel (wrapping `i32`). That value
 //! is linear in the column along a row, so "in front over the whole window" is decided row by
 //! row from the two ends of each overlap, without sampling every pixel; where the linear value
