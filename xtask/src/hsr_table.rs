@@ -329,7 +329,8 @@ pub(crate) fn hsr_table() -> Result<(), String> {
         &ray_ns,
     )?;
     let path = root().join("docs/hsr-table.md");
-    std::fs::write(&path, md).map_err(|e| format!("{}: {e}", path.display()))?;
+    std::fs::write(&path, stamp("cargo xtask hsr-table") + &md)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     println!("\nwrote {}", path.display());
     Ok(())
 }

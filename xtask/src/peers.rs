@@ -193,7 +193,8 @@ pub(crate) fn peers() -> Result<(), String> {
         ));
     }
     let path = root().join("docs/peers.md");
-    std::fs::write(&path, md).map_err(|e| format!("{}: {e}", path.display()))?;
+    std::fs::write(&path, stamp("cargo xtask peers") + &md)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     println!("wrote {}", path.display());
     Ok(())
 }

@@ -563,7 +563,8 @@ pub fn tradeoff() -> Result<(), String> {
         line(format!("| {scene} | {} |", cells.join(" | ")));
     }
     let path = root().join("docs/tradeoff.md");
-    std::fs::write(&path, md).map_err(|e| format!("{}: {e}", path.display()))?;
+    std::fs::write(&path, crate::stamp("cargo xtask tradeoff") + &md)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     println!("wrote {}", path.display());
     plot(&rows, &front)?;
     Ok(())
