@@ -70,11 +70,7 @@ pub trait Config: 'static {
         near: f32,
         far: f32,
     ) -> Result<Camera, SceneError> {
-        Camera::look_at_with::<Self::Math>(eye, target, up)?.perspective_with::<Self::Math>(
-            fovy_degrees,
-            near,
-            far,
-        )
+        Camera::look_at_perspective_with::<Self::Math>(eye, target, up, fovy_degrees, near, far)
     }
 }
 

@@ -103,17 +103,7 @@ method!(
     WarnockWorkspace<P, S, W, H, PIECES, LIST, STACK, INSTANCES>,
     [const W: usize, const H: usize, const PIECES: usize, const LIST: usize, const STACK: usize, const INSTANCES: usize]
 );
-
-impl<P: RowPixel, S: Shading, Z: DepthFormat, const INSTANCES: usize> Method<P>
-    for SpanView<'_, P, S, Z, INSTANCES>
-{
-    type Shading = S;
-    fn render_with<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
-        &mut self,
-        scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C, A>,
-        sink: &mut K,
-    ) -> Result<FrameStats, RenderError<K::Error>> {
-        self.render(scene, options, sink)
-    }
-}
+method!(
+    SpanView<'_, P, S, Z, INSTANCES>,
+    [Z: DepthFormat, const INSTANCES: usize]
+);

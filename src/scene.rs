@@ -546,6 +546,18 @@ impl Camera {
         Self::look_at_with::<Libm>(eye, target, up)
     }
 
+    /// `gluLookAt` · `gluPerspective` in one call, computed with math backend `M`.
+    pub fn look_at_perspective_with<M: MathBackend>(
+        eye: [f32; 3],
+        target: [f32; 3],
+        up: [f32; 3],
+        fovy_degrees: f32,
+        near: f32,
+        far: f32,
+    ) -> Result<Camera, SceneError> {
+        Camera::look_at_with::<M>(eye, target, up)?.perspective_with::<M>(fovy_degrees, near, far)
+    }
+
     /// [`Camera::look_at`] with a chosen math backend.
     pub fn look_at_with<M: MathBackend>(
         eye: [f32; 3],

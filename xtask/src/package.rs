@@ -39,6 +39,12 @@ pub(crate) fn package() -> Result<(), String> {
         .env_remove("RUSTC")
         .env_remove("CARGO"))?;
     step("example: RP2040 + ST7789 panel (builds; running needs the board)");
+    for example in ["panel-rp2040", "window"] {
+        let manifest = root().join(format!("examples/{example}/Cargo.toml"));
+        run(cargo()
+            .args(["fmt", "--check", "--manifest-path"])
+            .arg(manifest))?;
+    }
     let panel = root().join("examples/panel-rp2040/Cargo.toml");
     let examples_target = root().join("target/examples");
     run(cargo()

@@ -14,77 +14,18 @@
 //! The `window` feature is off by default so that building this crate, like the repository's
 //! tests, never needs SDL.
 
-use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
-use fixed::types::I16F16;
-use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
+use embedded_graphics::pixelcolor::Rgb565;
+use scanline3d::scene::{Camera, Instance, Light, Scene, Transform};
 use scanline3d::{Config, Flat, Settings, Storage};
 
 /// Target size (the panel example's ST7789).
 const W: usize = 240;
 const H: usize = 240;
 
-// ---- The scene: a cube of half-size 1 as static I16F16 data, as a firmware would keep it. ----
-
-const P: I16F16 = I16F16::ONE;
-const N: I16F16 = I16F16::NEG_ONE;
-
-/// Corner `i` has x, y, z negative or positive by bits 0, 1, 2 of `i`.
-static CUBE_VERTICES: [Vertex; 8] = [
-    [N, N, N],
-    [P, N, N],
-    [N, P, N],
-    [P, P, N],
-    [N, N, P],
-    [P, N, P],
-    [N, P, P],
-    [P, P, P],
-];
-
-/// Two triangles per face, counter-clockwise seen from outside (back faces are culled).
-static CUBE_TRIANGLES: [[u16; 3]; 12] = [
-    [4, 5, 7], // +z
-    [4, 7, 6],
-    [0, 2, 3], // -z
-    [0, 3, 1],
-    [1, 3, 7], // +x
-    [1, 7, 5],
-    [0, 4, 6], // -x
-    [0, 6, 2],
-    [2, 6, 7], // +y
-    [2, 7, 3],
-    [0, 1, 5], // -y
-    [0, 5, 4],
-];
-
-/// One colour per face, given for both of its triangles.
-static CUBE_COLORS: [Rgb888; 12] = {
-    let faces = [
-        Rgb888::new(230, 200, 60),
-        Rgb888::new(60, 170, 220),
-        Rgb888::new(220, 90, 120),
-        Rgb888::new(120, 210, 110),
-        Rgb888::new(240, 240, 235),
-        Rgb888::new(150, 110, 220),
-    ];
-    let mut out = [Rgb888::new(0, 0, 0); 12];
-    let mut i = 0;
-    while i < 12 {
-        out[i] = faces[i / 2];
-        i += 1;
-    }
-    out
-};
-
-/// Validated at compile time: a bad index or colour count fails the build.
-static CUBE: Mesh<'static> = match Mesh::new(
-    &CUBE_VERTICES,
-    &CUBE_TRIANGLES,
-    MeshColors::PerFace(&CUBE_COLORS),
-    None,
-) {
-    Ok(mesh) => mesh,
-    Err(_) => panic!("invalid cube mesh"),
-};
+// The scene: a cube (shared with the panel example).
+#[path = "../../shared/cube.rs"]
+mod cube;
+use cube::CUBE;
 
 const BACKGROUND: Rgb565 = Rgb565::new(3, 7, 6);
 
