@@ -8,23 +8,48 @@ pub(crate) const FUZZ_SECONDS_IN_TEST: u32 = 60;
 /// Coverage-guided fuzzing of scene/OBJ input with AFL++ (`cargo afl`, stable Rust) for
 /// `seconds`, seeded with the corpus. Fails on any crash or hang.
 pub(crate) fn fuzz(seconds: u32) -> Result<(), String> {
-    step(&format!(
-        "fuzz scene input for {seconds} s (AFL++ via cargo afl)"
-    ));
+    fuzz_with(start_fuzz_build()?, seconds)
+}
+
+/// Starts building the AFL-instrumented fuzz target in the background (its own workspace and
+/// target directory, so it runs beside other builds; output in `target/fuzz-build.log`).
+pub(crate) fn start_fuzz_build() -> Result<std::process::Child, String> {
     // Builds AFL++'s runtime for this rustc once; it refuses (harmlessly) when already built.
     let _ = cargo()
         .args(["afl", "config", "--build"])
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .status();
-    run(cargo().args([
-        "afl",
-        "build",
-        "--release",
-        "--locked",
-        "--manifest-path",
-        "fuzz/Cargo.toml",
-    ]))?;
+    std::fs::create_dir_all(root().join("target")).map_err(|e| e.to_string())?;
+    let log = std::fs::File::create(root().join("target/fuzz-build.log"))
+        .map_err(|e| format!("target/fuzz-build.log: {e}"))?;
+    let err = log.try_clone().map_err(|e| e.to_string())?;
+    cargo()
+        .args([
+            "afl",
+            "build",
+            "--release",
+            "--locked",
+            "--manifest-path",
+            "fuzz/Cargo.toml",
+        ])
+        .current_dir(root())
+        .stdout(log)
+        .stderr(err)
+        .spawn()
+        .map_err(|e| format!("cargo afl build: {e}"))
+}
+
+/// Waits for the fuzz target `build` started, then fuzzes for `seconds`.
+pub(crate) fn fuzz_with(mut build: std::process::Child, seconds: u32) -> Result<(), String> {
+    step(&format!(
+        "fuzz scene input for {seconds} s (AFL++ via cargo afl)"
+    ));
+    let status = build.wait().map_err(|e| format!("cargo afl build: {e}"))?;
+    if !status.success() {
+        let log = std::fs::read_to_string(root().join("target/fuzz-build.log")).unwrap_or_default();
+        return Err(format!("cargo afl build failed ({status}):\n{log}"));
+    }
     let dir = root().join("target/fuzz");
     let _ = std::fs::remove_dir_all(&dir);
     let seeds = dir.join("seeds");

@@ -94,10 +94,14 @@ pub(crate) fn test() -> Result<(), String> {
             target,
         ]))?;
     }
+    // The instrumented fuzz build runs beside the package checks and the firmware, whose QEMU
+    // runs leave a core free.
+    step("fuzz target: AFL-instrumented build started in the background");
+    let fuzz_build = start_fuzz_build()?;
     package()?;
     firmware()?;
     lean()?;
-    fuzz(FUZZ_SECONDS_IN_TEST)?;
+    fuzz_with(fuzz_build, FUZZ_SECONDS_IN_TEST)?;
     println!("\nxtask: {} passed, {} failed", totals.0, totals.1);
     Ok(())
 }
