@@ -23,6 +23,7 @@ pub(crate) fn run_example(target: &str, profile: &str, example: &str) -> Result<
         .args(["run", "--package", FIRMWARE_PACKAGE, "--profile", profile])
         .args(["--example", example])
         .args(["--target", target])
+        .env("CARGO_TARGET_DIR", firmware_target_dir(target))
         .current_dir(root())
         .stderr(Stdio::inherit())
         .output()
@@ -53,8 +54,74 @@ pub(crate) fn host_hashes() -> Result<Vec<u32>, String> {
         .collect()
 }
 
+/// The cargo target directory of the `cargo xtask test` firmware builds for `target`: one per
+/// target, so that the three targets build side by side. (One cargo invocation for several
+/// targets would unify the features of their target-specific dependencies, such as
+/// critical-section's restore state.)
+pub(crate) fn firmware_target_dir(target: &str) -> std::path::PathBuf {
+    root().join("target/firmware-builds").join(target)
+}
+
+/// The ELF of firmware example `example` built with `profile` for `target`.
+pub(crate) fn firmware_elf(target: &str, profile: &str, example: &str) -> std::path::PathBuf {
+    firmware_target_dir(target)
+        .join(target)
+        .join(profile)
+        .join("examples")
+        .join(example)
+}
+
+/// Builds firmware examples with `profile` for every target, the targets in parallel: each
+/// build ends in a single-threaded link-time optimisation, so one cargo per target keeps both
+/// cores busy. Each build's output goes to a log beside its target directory, shown if it fails.
+pub(crate) fn build_firmware_examples(profile: &str, examples: &[&str]) -> Result<(), String> {
+    let started = std::time::Instant::now();
+    let mut builds = Vec::new();
+    for (target, _) in FIRMWARE {
+        let dir = firmware_target_dir(target);
+        std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let log_path = dir.with_extension("log");
+        let log =
+            std::fs::File::create(&log_path).map_err(|e| format!("{}: {e}", log_path.display()))?;
+        let err = log.try_clone().map_err(|e| e.to_string())?;
+        let mut cmd = cargo();
+        cmd.args(["build", "--package", FIRMWARE_PACKAGE, "--profile", profile]);
+        for example in examples {
+            cmd.args(["--example", example]);
+        }
+        cmd.args(["--target", target])
+            .env("CARGO_TARGET_DIR", &dir)
+            .current_dir(root())
+            .stdout(log)
+            .stderr(err);
+        let child = cmd.spawn().map_err(|e| format!("cargo build: {e}"))?;
+        builds.push((target, log_path, child));
+    }
+    let mut failed = Vec::new();
+    for (target, log_path, mut child) in builds {
+        let status = child.wait().map_err(|e| format!("cargo build: {e}"))?;
+        println!(
+            "{target}: {} built with profile {profile} ({status}) after {} s",
+            examples.join(", "),
+            started.elapsed().as_secs()
+        );
+        if !status.success() {
+            let log = std::fs::read_to_string(&log_path).unwrap_or_default();
+            println!("{log}");
+            failed.push(target);
+        }
+    }
+    if failed.is_empty() {
+        Ok(())
+    } else {
+        Err(format!("firmware build failed for {}", failed.join(", ")))
+    }
+}
+
 pub(crate) fn firmware() -> Result<(), String> {
     let expected = host_hashes()?;
+    step("demo firmware for every target (a no-op when built)");
+    build_firmware_examples("firmware", &["firmware"])?;
     for (target, machine) in FIRMWARE {
         step(&format!("firmware on QEMU {machine}, {target}"));
         let first = run_example(target, "firmware", "firmware")?;
@@ -123,11 +190,9 @@ pub(crate) fn vertex_cache_on_target(
             "firmware",
         ])
         .args(["--example", "firmware"])
-        .args(["--target", target, "--", "--cfg", "scanline3d_vertex_cache"]))?;
-    let elf = root()
-        .join("target")
-        .join(target)
-        .join("firmware/examples/firmware");
+        .args(["--target", target, "--", "--cfg", "scanline3d_vertex_cache"])
+        .env("CARGO_TARGET_DIR", firmware_target_dir(target)))?;
+    let elf = firmware_elf(target, "firmware", "firmware");
     let out = tradeoff::run_on_qemu_with(target, &elf, &[])?;
     let hashes = frame_hashes(&out);
     if hashes != expected {
@@ -222,10 +287,7 @@ pub(crate) fn elf(path: &std::path::Path) -> Result<Elf, String> {
 
 /// Prints flash and RAM of the firmware for `target`, and how much of the flash is the library.
 pub(crate) fn sizes(target: &str, firmware_output: &str) -> Result<(), String> {
-    let path = root()
-        .join("target")
-        .join(target)
-        .join("firmware/examples/firmware");
+    let path = firmware_elf(target, "firmware", "firmware");
     let e = elf(&path)?;
     let size = |n: &str| {
         e.sections

@@ -77,6 +77,16 @@ pub(crate) fn lean() -> Result<(), String> {
             .panel_hash_with(240, 240, scanline3d_sim::scene::Algorithm::Bsp)
         })
         .collect::<Result<Vec<u32>, String>>()?;
+    step("lean firmware for every target");
+    let examples: Vec<String> = ["bsp"]
+        .into_iter()
+        .chain(LEAN_VARIANTS)
+        .map(|v| format!("lean_{v}"))
+        .collect();
+    build_firmware_examples(
+        "lean",
+        &examples.iter().map(String::as_str).collect::<Vec<_>>(),
+    )?;
     let mut table = Vec::new();
     let mut bsp_table = Vec::new();
     for (target, machine) in FIRMWARE {
@@ -90,10 +100,7 @@ pub(crate) fn lean() -> Result<(), String> {
             ));
         }
         println!("view hashes equal the host's BSP render of {LEAN_BSP_OBJ}");
-        let elf_path = root()
-            .join("target")
-            .join(target)
-            .join("lean/examples/lean_bsp");
+        let elf_path = firmware_elf(target, "lean", "lean_bsp");
         bsp_table.push(format!(
             "| {target} | {} | {} | {} |",
             flash_bytes(&elf_path)?,
@@ -114,10 +121,7 @@ pub(crate) fn lean() -> Result<(), String> {
                 }
                 println!("view hashes equal the host render of {LEAN_OBJ}");
             }
-            let elf_path = root()
-                .join("target")
-                .join(target)
-                .join(format!("lean/examples/lean_{variant}"));
+            let elf_path = firmware_elf(target, "lean", &format!("lean_{variant}"));
             flash.insert(variant, (flash_bytes(&elf_path)?, out));
         }
         let (base_flash, base_out) = &flash["baseline"];
