@@ -362,7 +362,9 @@ mod tests {
     fn each_shape_from_outside_and_inside() {
         let down = [0.0, 0.0, -1.0];
         let from = [0.0, 0.0, 10.0];
-        let cases: Vec<(Shape, (f64, V3), (f64, V3))> = vec![
+        // (shape, hit from (0, 0, 10) looking down z, hit from the centre looking down z)
+        type Case = (Shape, (f64, V3), (f64, V3));
+        let cases: Vec<Case> = vec![
             (
                 Shape::Sphere {
                     centre: [0.0; 3],
