@@ -75,6 +75,32 @@ pub struct TraceStats {
     pub rays: Counters,
     /// Intersection work of shadow rays.
     pub shadows: Counters,
+    /// When `Some`, every secondary ray traced, in tracing order (for tests and inspection).
+    pub log: Option<Vec<TreeRay>>,
+}
+
+/// Why a secondary ray was spawned.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Spawn {
+    /// `R = 2N(N·V) − V`, weight KR.
+    Reflection,
+    /// `T` by Snell's law, weight KT.
+    Refraction,
+    /// The refracted ray of a total internal reflection: `T = R`, weight KT.
+    TotalInternalReflection,
+}
+
+/// One secondary ray of the ray tree.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TreeRay {
+    /// Its depth (the primary ray has 0).
+    pub depth: u32,
+    /// Its weight: the product of the KR/KT factors along its path.
+    pub weight: f64,
+    /// The ray (unit direction).
+    pub ray: Ray,
+    /// Why it was spawned.
+    pub spawn: Spawn,
 }
 
 impl TraceStats {
@@ -155,8 +181,7 @@ impl<'a> Tracer<'a> {
                 shadow: 0,
             };
         };
-        let mut shadow = 0;
-        let colour = self.shade(&ray, &hit, 0, 1.0, stats, Some(&mut shadow));
+        let (colour, shadow) = self.shade(&ray, &hit, 0, 1.0, stats);
         Pixel {
             colour,
             hit: Some(hit),
@@ -172,7 +197,7 @@ impl<'a> Tracer<'a> {
                 stats.missed += 1;
                 self.scene.background
             }
-            Some(hit) => self.shade(ray, &hit, depth, weight, stats, None),
+            Some(hit) => self.shade(ray, &hit, depth, weight, stats).0,
         }
     }
 
@@ -192,33 +217,15 @@ impl<'a> Tracer<'a> {
         }
     }
 
-    /// The colour at `hit` of `ray` (depth `depth`, weight `weight`); `shadow` collects the
-    /// shadow bits of a primary hit.
-    fn shade(
-        &self,
-        ray: &Ray,
-        hit: &Hit,
-        depth: u32,
-        weight: f64,
-        stats: &mut TraceStats,
-        mut shadow: Option<&mut u8>,
-    ) -> [f64; 3] {
-        let Some(m) = self.scene.material_of(hit.id) else {
-            return self.scene.background;
-        };
-        let p = ray.at(hit.t);
-        let Some(d) = normalize(ray.dir) else {
-            return self.scene.background;
-        };
-        let v = scale(d, -1.0);
-        // Leaving the shape when the ray meets the surface from the side opposite its normal.
-        let leaving = dot(hit.normal, d) > 0.0;
-        let n = if leaving {
-            scale(hit.normal, -1.0)
-        } else {
-            hit.normal
+    /// The local term at surface point `p` of object `id` with normal `n` (facing the viewer):
+    /// `KA·C·ambient + Σ unblocked lights KD·max(0, N·L)·C·I`, and the shadow bits (bit k set
+    /// when light k contributes nothing: N·L ≤ 0 or a shadow ray is blocked).
+    pub fn local(&self, id: usize, p: V3, n: V3, stats: &mut TraceStats) -> ([f64; 3], u8) {
+        let Some(m) = self.scene.material_of(id) else {
+            return (self.scene.background, 0);
         };
         let mut c = m.color.map(|ch| m.ka * ch * self.scene.ambient);
+        let mut bits = 0u8;
         for (k, light) in self.scene.lights.iter().enumerate() {
             let lit = self.light_ray(&light.kind, p).and_then(|lr| {
                 let cos = dot(n, lr.l);
@@ -239,13 +246,34 @@ impl<'a> Tracer<'a> {
                         *ch += m.kd * cos * base * light.intensity;
                     }
                 }
-                None => {
-                    if let Some(bits) = shadow.as_deref_mut() {
-                        *bits |= 1 << k;
-                    }
-                }
+                None => bits |= 1 << k,
             }
         }
+        (c, bits)
+    }
+
+    /// The colour at `hit` of `ray` (depth `depth`, weight `weight`) and the shadow bits there.
+    fn shade(
+        &self,
+        ray: &Ray,
+        hit: &Hit,
+        depth: u32,
+        weight: f64,
+        stats: &mut TraceStats,
+    ) -> ([f64; 3], u8) {
+        let (Some(m), Some(d)) = (self.scene.material_of(hit.id), normalize(ray.dir)) else {
+            return (self.scene.background, 0);
+        };
+        let p = ray.at(hit.t);
+        let v = scale(d, -1.0);
+        // Leaving the shape when the ray meets the surface from the side opposite its normal.
+        let leaving = dot(hit.normal, d) > 0.0;
+        let n = if leaving {
+            scale(hit.normal, -1.0)
+        } else {
+            hit.normal
+        };
+        let (mut c, bits) = self.local(hit.id, p, n, stats);
         let cos_i = dot(n, v);
         let r = sub(scale(n, 2.0 * cos_i), v);
         let (n1, n2) = if leaving { (m.ior, 1.0) } else { (1.0, m.ior) };
@@ -256,7 +284,11 @@ impl<'a> Tracer<'a> {
         } else {
             normalize(sub(scale(v, -eta), scale(n, -(eta * cos_i - k.sqrt()))))
         };
-        for (coefficient, dir, is_refraction) in [(m.kr, Some(r), false), (m.kt, t, true)] {
+        let refraction = match t {
+            Some(t) => (t, Spawn::Refraction),
+            None => (r, Spawn::TotalInternalReflection),
+        };
+        for (coefficient, (dir, spawn)) in [(m.kr, (r, Spawn::Reflection)), (m.kt, refraction)] {
             if coefficient == 0.0 {
                 continue;
             }
@@ -269,27 +301,29 @@ impl<'a> Tracer<'a> {
                 stats.cut_by_weight += 1;
                 continue;
             }
-            let dir = match dir {
-                Some(dir) => dir,
-                None => {
-                    // Total internal reflection: T is the reflected ray.
-                    debug_assert!(is_refraction);
-                    stats.total_internal_reflections += 1;
-                    r
-                }
-            };
+            if spawn == Spawn::TotalInternalReflection {
+                stats.total_internal_reflections += 1;
+            }
             let child = depth as usize + 1;
             if stats.secondary_by_depth.len() <= child {
                 stats.secondary_by_depth.resize(child + 1, 0);
             }
             stats.secondary_by_depth[child] += 1;
             let ray = Ray { origin: p, dir };
+            if let Some(log) = stats.log.as_mut() {
+                log.push(TreeRay {
+                    depth: depth + 1,
+                    weight: child_weight,
+                    ray,
+                    spawn,
+                });
+            }
             let sub_colour = self.colour(&ray, depth + 1, child_weight, stats);
             for (ch, s) in c.iter_mut().zip(sub_colour) {
                 *ch += coefficient * s;
             }
         }
-        c
+        (c, bits)
     }
 }
 
