@@ -499,7 +499,7 @@ fn sim_trace_rejects_bad_scenes_and_cameras_with_one_line() {
         .display()
         .to_string();
     let bad = bad.display().to_string();
-    let cases: [(&[&str], &str); 7] = [
+    let cases: [(&[&str], &str); 10] = [
         (
             &["trace", &bad, "--eye", "0,0,5", "--target", "0,0,0"],
             "bad.scene:2: radius -1",
@@ -547,6 +547,37 @@ fn sim_trace_rejects_bad_scenes_and_cameras_with_one_line() {
                 "magic",
             ],
             "magic",
+        ),
+        (
+            &[
+                "trace",
+                &good,
+                "--eye",
+                "0,0,5",
+                "--target",
+                "0,0,0",
+                "--max-depth",
+                "1000",
+            ],
+            "max depth 1000 exceeds 64",
+        ),
+        (
+            &[
+                "trace",
+                &good,
+                "--eye",
+                "0,0,5",
+                "--target",
+                "0,0,0",
+                "--threshold=-1",
+            ],
+            "threshold -1",
+        ),
+        (
+            &[
+                "trace", &good, "--eye", "0,0,5", "--target", "0,0,0", "--size", "0x10",
+            ],
+            "size 0x10",
         ),
     ];
     for (args, want) in cases {
