@@ -591,3 +591,103 @@ fn sim_trace_rejects_bad_scenes_and_cameras_with_one_line() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+mod hostile {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Tokens of every kind, well-formed and not: keywords, numbers from tiny to huge, names.
+    fn token() -> impl Strategy<Value = String> {
+        prop_oneof![
+            prop::sample::select(vec![
+                "sphere",
+                "plane",
+                "box",
+                "cylinder",
+                "cone",
+                "ellipsoid",
+                "polygon",
+                "mesh",
+                "light",
+                "point",
+                "directional",
+                "material",
+                "background",
+                "ambient",
+                "m",
+                "glass",
+                "diamond",
+                "nan",
+                "inf",
+                "-inf",
+                "1e308",
+                "-1e308",
+                "1e-300",
+                "0",
+                "-0",
+                "#",
+                "x.obj",
+                "",
+            ])
+            .prop_map(String::from),
+            (-1e6f64..1e6).prop_map(|v| format!("{v}")),
+            (-3.0f64..3.0).prop_map(|v| format!("{v:.2}")),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+        /// Random lines after a valid material: either a scene or one line naming the line.
+        #[test]
+        fn random_scene_text_never_panics(
+            lines in proptest::collection::vec(proptest::collection::vec(token(), 0..14), 0..8)
+        ) {
+            let text = std::iter::once("material m 1 1 1 0.2 0.8 0.3 0.3 glass".to_string())
+                .chain(lines.iter().map(|l| l.join(" ")))
+                .collect::<Vec<_>>()
+                .join("\n");
+            match TracedScene::parse(&text, Path::new("/nonexistent"), "h.scene") {
+                Ok(_) => {}
+                Err(e) => {
+                    prop_assert!(e.starts_with("h.scene:") && !e.contains('\n'), "{}", e);
+                }
+            }
+        }
+
+        /// Valid scenes with extreme but finite numbers trace without panicking, and every
+        /// structure gives the same image.
+        #[test]
+        fn extreme_scenes_trace(
+            scale in prop::sample::select(vec![1e-6, 1.0, 1e6, 1e150]),
+            spheres in proptest::collection::vec(([-3.0f64..3.0, -3.0f64..3.0, -3.0f64..3.0], 0.01f64..2.0), 1..6),
+            depth in 0u32..8,
+        ) {
+            let mut text = String::from(
+                "light point 0 5 5 1\nlight directional 1 1 0 0.5\n\
+                 material m 1 1 1 0.2 0.8 0.4 0.6 diamond\nplane 0 1 0 3 m\n",
+            );
+            for (c, r) in &spheres {
+                text += &format!("sphere {} {} {} {} m\n", c[0] * scale, c[1] * scale, c[2] * scale, r * scale);
+                text += &format!("box {} {} {} {} {} {} m\n", c[0] * scale, c[1] * scale, c[2] * scale,
+                    (c[0] + r) * scale, (c[1] + r) * scale, (c[2] + r) * scale);
+            }
+            let scene = parse(&text);
+            let cam = CameraSpec {
+                eye: [0.0, 0.0, 8.0 * scale],
+                target: [0.0; 3],
+                up: [0.0, 1.0, 0.0],
+                fovy: 60.0,
+                near: 0.01 * scale,
+                far: 100.0 * scale,
+            };
+            let limits = Limits { max_depth: depth, threshold: 0.0 };
+            let brute = render(&scene, &cam, 6, 4, limits, Structure::None).unwrap();
+            for st in [Structure::Bvh, Structure::Grid, Structure::Both] {
+                let img = render(&scene, &cam, 6, 4, limits, st).unwrap();
+                prop_assert_eq!(&img.ids, &brute.ids);
+                prop_assert_eq!(&img.color, &brute.color);
+            }
+        }
+    }
+}
