@@ -14,7 +14,7 @@ use super::intersect::Aabb;
 use super::query::Query;
 
 /// Target cells per object.
-pub const CELLS_PER_OBJECT: f64 = 2.0;
+pub const CELLS_PER_OBJECT: f64 = 4.0;
 /// Most cells along one axis.
 pub const MAX_CELLS: usize = 64;
 
