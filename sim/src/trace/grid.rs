@@ -169,7 +169,6 @@ impl Grid {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
     use crate::trace::accel::{Accel, Structure};
     use crate::trace::query::Counters;
     use crate::trace::scene::TracedScene;
