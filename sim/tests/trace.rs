@@ -499,89 +499,28 @@ fn sim_trace_rejects_bad_scenes_and_cameras_with_one_line() {
         .display()
         .to_string();
     let bad = bad.display().to_string();
-    let cases: [(&[&str], &str); 10] = [
+    // (scene, eye, further arguments, what the error says); the target is the origin.
+    let cases: [(&str, &str, &[&str], &str); 10] = [
+        (&bad, "0,0,5", &[], "bad.scene:2: radius -1"),
+        ("/nonexistent.scene", "0,0,5", &[], "nonexistent"),
+        (&good, "0,0,0", &[], "same point"),
+        (&good, "0,5,0", &[], "parallel"),
+        (&good, "0,0,5", &["--fov", "0"], "field of view"),
+        (&good, "0,0,5", &["--near", "5", "--far", "1"], "near"),
+        (&good, "0,0,5", &["--renderer", "magic"], "magic"),
         (
-            &["trace", &bad, "--eye", "0,0,5", "--target", "0,0,0"],
-            "bad.scene:2: radius -1",
-        ),
-        (
-            &[
-                "trace",
-                "/nonexistent.scene",
-                "--eye",
-                "0,0,5",
-                "--target",
-                "0,0,0",
-            ],
-            "nonexistent",
-        ),
-        (
-            &["trace", &good, "--eye", "0,0,0", "--target", "0,0,0"],
-            "same point",
-        ),
-        (
-            &["trace", &good, "--eye", "0,5,0", "--target", "0,0,0"],
-            "parallel",
-        ),
-        (
-            &[
-                "trace", &good, "--eye", "0,0,5", "--target", "0,0,0", "--fov", "0",
-            ],
-            "field of view",
-        ),
-        (
-            &[
-                "trace", &good, "--eye", "0,0,5", "--target", "0,0,0", "--near", "5", "--far", "1",
-            ],
-            "near",
-        ),
-        (
-            &[
-                "trace",
-                &good,
-                "--eye",
-                "0,0,5",
-                "--target",
-                "0,0,0",
-                "--renderer",
-                "magic",
-            ],
-            "magic",
-        ),
-        (
-            &[
-                "trace",
-                &good,
-                "--eye",
-                "0,0,5",
-                "--target",
-                "0,0,0",
-                "--max-depth",
-                "1000",
-            ],
+            &good,
+            "0,0,5",
+            &["--max-depth", "1000"],
             "max depth 1000 exceeds 64",
         ),
-        (
-            &[
-                "trace",
-                &good,
-                "--eye",
-                "0,0,5",
-                "--target",
-                "0,0,0",
-                "--threshold=-1",
-            ],
-            "threshold -1",
-        ),
-        (
-            &[
-                "trace", &good, "--eye", "0,0,5", "--target", "0,0,0", "--size", "0x10",
-            ],
-            "size 0x10",
-        ),
+        (&good, "0,0,5", &["--threshold=-1"], "threshold -1"),
+        (&good, "0,0,5", &["--size", "0x10"], "size 0x10"),
     ];
-    for (args, want) in cases {
-        let (code, stdout, stderr) = sim(args);
+    for (scene, eye, extra, want) in cases {
+        let mut args = vec!["trace", scene, "--eye", eye, "--target", "0,0,0"];
+        args.extend_from_slice(extra);
+        let (code, stdout, stderr) = sim(&args);
         assert_eq!(code, 2, "{args:?}: {stdout}{stderr}");
         assert_eq!(stderr.lines().count(), 1, "{args:?}: {stderr}");
         assert!(
