@@ -630,3 +630,47 @@ mod hostile {
         }
     }
 }
+
+#[test]
+fn primary_rays_see_eye_depths_in_near_to_far() {
+    // A unit sphere 3 in front of the eye: the centre pixel meets it at eye depths 2 and 4.
+    let scene = parse("ambient 1\nmaterial m 1 1 1 1 0 0 0 1\nsphere 0 0 -3 1 m\n");
+    let accel = Accel::build(&scene, Structure::None);
+    let tracer = Tracer::new(&accel, Limits::default());
+    let depth_seen = |near: f64, far: f64| {
+        let spec = CameraSpec {
+            eye: [0.0; 3],
+            target: [0.0, 0.0, -1.0],
+            up: [0.0, 1.0, 0.0],
+            fovy: 40.0,
+            near,
+            far,
+        };
+        let cam = check_camera(&spec).unwrap();
+        let mut stats = TraceStats::default();
+        tracer.pixel(&cam, 0, 0, 1, 1, &mut stats).hit.map(|h| h.t)
+    };
+    assert_eq!(depth_seen(0.1, 10.0), Some(2.0));
+    assert_eq!(depth_seen(2.0, 10.0), Some(2.0), "near is included");
+    assert_eq!(
+        depth_seen(2.5, 10.0),
+        Some(4.0),
+        "the front is clipped: the inside shows"
+    );
+    assert_eq!(depth_seen(2.5, 4.0), None, "far is excluded");
+    assert_eq!(depth_seen(0.1, 2.0), None);
+}
+
+#[test]
+fn the_depth_image_holds_eye_depth_along_the_view_axis() {
+    // A wall facing the camera 5 units away: every pixel's eye depth is 5, not its distance.
+    let scene = parse("ambient 1\nmaterial m 1 1 1 1 0 0 0 1\nplane 0 0 1 5 m\n");
+    let cam = camera([0.0; 3], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]);
+    let img = render(&scene, &cam, 9, 7, Limits::default(), Structure::None).unwrap();
+    assert!(img.ids.iter().all(|&id| id == 0));
+    assert!(
+        img.depth.iter().all(|&d| (d - 5.0).abs() < 1e-5),
+        "{:?}",
+        img.depth
+    );
+}
