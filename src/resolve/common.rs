@@ -1,5 +1,23 @@
 //! What the hidden-surface workspaces share: compile-time size checks and a panic-free sort.
 
+/// The inherent `render` of a hidden-surface workspace: `render_sized` at its full `W × H`.
+/// (A macro rather than a trait method, so the workspaces keep it as an inherent method that
+/// needs no import.)
+macro_rules! render_whole_target {
+    () => {
+        /// Renders `scene`, handing each of the `H` rows to `sink` once, top to bottom.
+        pub fn render<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
+            &mut self,
+            scene: &Scene<'_>,
+            options: &RenderOptions<SUB_BITS, C, A>,
+            sink: &mut K,
+        ) -> Result<FrameStats, RenderError<K::Error>> {
+            self.render_sized(W, H, scene, options, sink)
+        }
+    };
+}
+pub(crate) use render_whole_target;
+
 /// Compile-time checks shared by the workspaces.
 pub(crate) const fn check_sizes(w: usize, h: usize, tris: usize) {
     assert!(

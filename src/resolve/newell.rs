@@ -84,7 +84,7 @@ use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::options::{RenderOptions, MAX_INSTANCES};
 use crate::render::{internal, viewport, walk_rows, ActiveTri, NO_ENTRY};
-use crate::resolve::common::{check_sizes, sort_by_key};
+use crate::resolve::common::{check_sizes, render_whole_target, sort_by_key};
 use crate::resolve::depth_sort::Painter;
 use crate::resolve::store::{self, StoredPieces, StoredTriangle};
 use crate::scene::Scene;
@@ -228,15 +228,7 @@ impl<
         self.last
     }
 
-    /// Renders `scene`, handing each of the `H` rows to `sink` once, top to bottom.
-    pub fn render<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
-        &mut self,
-        scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C, A>,
-        sink: &mut K,
-    ) -> Result<FrameStats, RenderError<K::Error>> {
-        self.render_sized(W, H, scene, options, sink)
-    }
+    render_whole_target!();
 
     /// Renders a `width × height` target (at most `W × H`); see
     /// [`Workspace::render_sized`](crate::Workspace::render_sized). More pieces than `PIECES`

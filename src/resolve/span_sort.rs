@@ -8,7 +8,7 @@ use crate::raster::PixelOrigin;
 use crate::render::{
     drive, internal, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve, NO_ENTRY,
 };
-use crate::resolve::common::{check_sizes, sort_by_key, swap_within};
+use crate::resolve::common::{check_sizes, render_whole_target, sort_by_key, swap_within};
 use crate::scene::Scene;
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
@@ -247,15 +247,7 @@ impl<
         }
     }
 
-    /// Renders `scene`, handing each of the `H` rows to `sink` once, top to bottom.
-    pub fn render<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
-        &mut self,
-        scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C, A>,
-        sink: &mut K,
-    ) -> Result<FrameStats, RenderError<K::Error>> {
-        self.render_sized(W, H, scene, options, sink)
-    }
+    render_whole_target!();
 
     /// Renders a `width × height` target (at most `W × H`); see
     /// [`Workspace::render_sized`](crate::Workspace::render_sized).

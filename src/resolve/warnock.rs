@@ -71,7 +71,7 @@ use crate::options::{RenderOptions, MAX_INSTANCES};
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{DepthPlane, PlaneSolver, TriangleWalk};
 use crate::render::{internal, viewport};
-use crate::resolve::common::check_sizes;
+use crate::resolve::common::{check_sizes, render_whole_target};
 use crate::resolve::store::{self, StoredTriangle};
 use crate::scene::Scene;
 use crate::shading::Shading;
@@ -250,15 +250,7 @@ impl<
         self.last
     }
 
-    /// Renders `scene`, handing each of the `H` rows to `sink` once, top to bottom.
-    pub fn render<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
-        &mut self,
-        scene: &Scene<'_>,
-        options: &RenderOptions<SUB_BITS, C, A>,
-        sink: &mut K,
-    ) -> Result<FrameStats, RenderError<K::Error>> {
-        self.render_sized(W, H, scene, options, sink)
-    }
+    render_whole_target!();
 
     /// Renders a `width × height` target (at most `W × H`); see
     /// [`Workspace::render_sized`](crate::Workspace::render_sized). A stack smaller than
