@@ -1,0 +1,211 @@
+//! Ray–primitive intersection in fixed point: the nearest `t` in a window, and the surface normal
+//! at a hit.
+//!
+//! A ray is `origin + t·dir` with `dir` a unit [`Vec3`] and `t` an [`I16F16`] in world units.
+//! Each test returns the smallest root `t` with `t_min ≤ t < t_max`; roots outside the I16F16
+//! range are no hit. Intermediate products are I32F32 (see the bit budget in
+//! [`crate::trace::vector`]); quotients are 64-bit integer divisions of raw bits.
+
+use crate::trace::shape::{Facet, Plane, Shape, Sphere};
+use crate::trace::vector::{narrow, narrow_bits, sqrt, Vec3};
+use fixed::types::{I16F16, I32F32};
+
+/// A ray: origin and unit direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Ray {
+    /// Origin.
+    pub origin: Vec3,
+    /// Unit direction.
+    pub dir: Vec3,
+}
+
+/// `num / den` for two I32F32 values, as an I16F16, or `None` if `den` is 0 or the quotient is
+/// outside the I16F16 range.
+#[inline]
+fn quotient(num: I32F32, den: I32F32) -> Option<I16F16> {
+    let den = den.to_bits();
+    if den == 0 {
+        return None;
+    }
+    // num (|num| < 2^47 raw in the envelope) << 16 stays below 2^63.
+    let q = num.to_bits().checked_mul(1 << 16)?.checked_div(den)?;
+    i32::try_from(q).ok().map(I16F16::from_bits)
+}
+
+/// The first of the sorted roots `a ≤ b` inside `[t_min, t_max)`.
+#[inline]
+fn first_root(a: I16F16, b: I16F16, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
+    [a, b].into_iter().find(|t| *t >= t_min && *t < t_max)
+}
+
+fn sphere(s: &Sphere, ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
+    let oc = ray.origin.sub(s.centre);
+    // b = dir·oc ≤ |oc| < 2^14.5: fits I16F16.
+    let b = narrow(ray.dir.dot(oc))?;
+    let c = oc.dot(oc) - s.radius2;
+    let disc = b.wide_mul(b) - c;
+    if disc < I32F32::ZERO {
+        return None;
+    }
+    let root = sqrt(disc);
+    let nb = b.wrapping_neg();
+    first_root(nb.wrapping_sub(root), nb.wrapping_add(root), t_min, t_max)
+}
+
+/// `t` where the ray meets the plane `normal·p + offset = 0`.
+#[inline]
+fn plane_t(normal: Vec3, offset: I16F16, ray: &Ray) -> Option<I16F16> {
+    let num = normal.dot(ray.origin) + I32F32::from(offset);
+    quotient(-num, normal.dot(ray.dir))
+}
+
+fn plane(p: &Plane, ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
+    plane_t(p.normal, p.offset, ray).filter(|t| *t >= t_min && *t < t_max)
+}
+
+/// The two coordinates of `p` other than `axis`, raw I16F16 bits.
+#[inline]
+fn project(p: Vec3, axis: u8) -> (i64, i64) {
+    let [x, y, z] = p.bits();
+    match axis {
+        0 => (y as i64, z as i64),
+        1 => (z as i64, x as i64),
+        _ => (x as i64, y as i64),
+    }
+}
+
+/// Even–odd point-in-polygon test in the facet's projection (crossing number; concave
+/// polygons work). Exact: every product is of two raw differences below 2^30.
+fn inside(vertices: &[Vec3], axis: u8, p: Vec3) -> bool {
+    let (pu, pv) = project(p, axis);
+    let mut inside = false;
+    let mut prev = match vertices.last() {
+        Some(v) => project(*v, axis),
+        None => return false,
+    };
+    for v in vertices {
+        let (bu, bv) = project(*v, axis);
+        let (au, av) = prev;
+        if (av > pv) != (bv > pv) {
+            // p is left of the crossing point ⇔ (pu − au)(bv − av) < (pv − av)(bu − au), the
+            // inequality flipping when bv < av.
+            let lhs = (pu - au) * (bv - av);
+            let rhs = (pv - av) * (bu - au);
+            if (bv > av && lhs < rhs) || (bv < av && lhs > rhs) {
+                inside = !inside;
+            }
+        }
+        prev = (bu, bv);
+    }
+    inside
+}
+
+fn facet(f: &Facet, vertices: &[Vec3], ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
+    let t = plane_t(f.normal, f.offset, ray).filter(|t| *t >= t_min && *t < t_max)?;
+    inside(vertices, f.axis, ray.origin.along(ray.dir, t)).then_some(t)
+}
+
+impl Shape<'_> {
+    /// The nearest `t` in `[t_min, t_max)` where `ray` meets the primitive.
+    #[inline]
+    pub fn hit(&self, ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
+        match self {
+            Shape::Sphere(s) => sphere(s, ray, t_min, t_max),
+            Shape::Plane(p) => plane(p, ray, t_min, t_max),
+            Shape::Polygon(p) => facet(&p.facet, p.vertices, ray, t_min, t_max),
+            Shape::Triangle(t) => facet(&t.facet, &t.vertices, ray, t_min, t_max),
+        }
+    }
+
+    /// The outward unit normal at `point` on the surface (for planes and polygons, the side
+    /// the normal points to is outside).
+    #[inline]
+    pub fn normal(&self, point: Vec3) -> Vec3 {
+        match self {
+            Shape::Sphere(s) => point.sub(s.centre).normalized().unwrap_or(Vec3::ZERO),
+            Shape::Plane(p) => p.normal,
+            Shape::Polygon(p) => p.facet.normal,
+            Shape::Triangle(t) => t.facet.normal,
+        }
+    }
+}
+
+/// `a − 2(a·n)n`: `a` mirrored about the plane with unit normal `n`.
+#[inline]
+pub fn reflect(a: Vec3, n: Vec3) -> Vec3 {
+    let k = narrow_bits(a.dot_bits(n)).wrapping_mul(2);
+    a.sub(n.scale(I16F16::from_bits(k)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trace::shape::{Polygon, Triangle};
+
+    fn v(x: f32, y: f32, z: f32) -> Vec3 {
+        Vec3 {
+            x: I16F16::from_num(x),
+            y: I16F16::from_num(y),
+            z: I16F16::from_num(z),
+        }
+    }
+    const FAR: I16F16 = I16F16::MAX;
+
+    #[test]
+    fn sphere_roots() {
+        let s = Shape::Sphere(Sphere::new(v(0.0, 0.0, -5.0), I16F16::ONE).unwrap());
+        let ray = Ray {
+            origin: Vec3::ZERO,
+            dir: v(0.0, 0.0, -1.0),
+        };
+        assert_eq!(s.hit(&ray, I16F16::ZERO, FAR), Some(I16F16::from_num(4)));
+        // From inside, the far root.
+        assert_eq!(
+            s.hit(&ray, I16F16::from_num(4.5), FAR),
+            Some(I16F16::from_num(6))
+        );
+        assert_eq!(s.hit(&ray, I16F16::ZERO, I16F16::from_num(4)), None);
+        let miss = Ray {
+            origin: v(1.01, 0.0, 0.0),
+            dir: v(0.0, 0.0, -1.0),
+        };
+        assert_eq!(s.hit(&miss, I16F16::ZERO, FAR), None);
+    }
+
+    #[test]
+    fn concave_polygon_and_triangle() {
+        // An L shape: the notch at (1.5, 1.5) is outside.
+        let l = [
+            v(0.0, 0.0, 0.0),
+            v(2.0, 0.0, 0.0),
+            v(2.0, 1.0, 0.0),
+            v(1.0, 1.0, 0.0),
+            v(1.0, 2.0, 0.0),
+            v(0.0, 2.0, 0.0),
+        ];
+        let poly = Shape::Polygon(Polygon::new(&l).unwrap());
+        let down = |x, y| Ray {
+            origin: v(x, y, 3.0),
+            dir: v(0.0, 0.0, -1.0),
+        };
+        assert_eq!(
+            poly.hit(&down(0.5, 1.5), I16F16::ZERO, FAR),
+            Some(I16F16::from_num(3))
+        );
+        assert_eq!(
+            poly.hit(&down(1.5, 0.5), I16F16::ZERO, FAR),
+            Some(I16F16::from_num(3))
+        );
+        assert_eq!(poly.hit(&down(1.5, 1.5), I16F16::ZERO, FAR), None);
+        assert_eq!(poly.hit(&down(2.5, 0.5), I16F16::ZERO, FAR), None);
+        let tri = Shape::Triangle(Triangle::new([l[0], l[1], l[5]]).unwrap());
+        assert!(tri.hit(&down(0.4, 0.4), I16F16::ZERO, FAR).is_some());
+        assert!(tri.hit(&down(1.1, 1.1), I16F16::ZERO, FAR).is_none());
+    }
+
+    #[test]
+    fn reflection_mirrors() {
+        let r = reflect(v(0.6, -0.8, 0.0), v(0.0, 1.0, 0.0));
+        assert_eq!(r, v(0.6, 0.8, 0.0));
+    }
+}
