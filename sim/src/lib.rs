@@ -30,6 +30,8 @@ pub mod reference;
 #[cfg(not(target_os = "none"))]
 pub mod scene;
 #[cfg(not(target_os = "none"))]
+pub mod trace;
+#[cfg(not(target_os = "none"))]
 pub mod tradeoff;
 
 #[cfg(not(target_os = "none"))]
