@@ -133,7 +133,7 @@ impl Facet {
         }
         // n is twice the area vector, in raw units squared (2^32 per world unit²).
         let len = libm::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        if len < 2f64.powi(32 - 16) {
+        if len < 65536.0 {
             return Err(ShapeError::Degenerate); // area below 2^-16 world units²
         }
         let unit = n.map(|c| (c / len * 65536.0) as i32);
