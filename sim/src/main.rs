@@ -214,7 +214,7 @@ struct CompareArgs {
 /// The views `analyze` and `export` look from.
 #[derive(Args, Debug, Clone)]
 struct Views {
-    /// The OBJ scene (or --demo).
+    /// The OBJ scene (or --demo); for `export`, a traced `.scene` file too.
     scene: Option<PathBuf>,
     /// The built-in demo scene seen from its 8-frame camera orbit (the firmware's views).
     #[arg(long, conflicts_with = "scene")]
@@ -357,7 +357,44 @@ fn analyze_command(a: AnalyzeArgs) -> Result<(), String> {
     Ok(())
 }
 
+/// The command line for a generated file's header, without the output path, so the same scene
+/// and options always produce the same file.
+fn export_command_line() -> String {
+    let mut args = std::env::args().skip(1);
+    let mut kept = vec!["sim".to_string()];
+    while let Some(arg) = args.next() {
+        if arg == "--out" {
+            args.next();
+        } else if !arg.starts_with("--out=") {
+            kept.push(arg);
+        }
+    }
+    kept.join(" ")
+}
+
+/// `sim export SCENE.scene --out f.rs`: a traced scene as static fixed-point data.
+fn export_traced(scene: &std::path::Path, out: &std::path::Path) -> Result<(), String> {
+    use scanline3d_sim::trace::{fixed::FixedScene, scene::TracedScene};
+    let fixed = FixedScene::new(&TracedScene::load(scene)?)?;
+    let source = scanline3d_sim::trace::fixed::export_source(&fixed, &export_command_line());
+    let source = scanline3d_sim::export::rustfmt(&source).unwrap_or(source);
+    std::fs::write(out, source).map_err(|e| format!("{}: {e}", out.display()))?;
+    say!(
+        "wrote {} ({} objects, {} materials, {} lights)",
+        out.display(),
+        fixed.objects().len(),
+        fixed.materials.len(),
+        fixed.lights.len()
+    );
+    Ok(())
+}
+
 fn export_command(a: ExportArgs) -> Result<(), String> {
+    if let Some(scene) =
+        (a.views.scene.as_ref()).filter(|p| p.extension().is_some_and(|e| e == "scene"))
+    {
+        return export_traced(scene, &a.out);
+    }
     if a.views.demo {
         return Err("export takes an OBJ scene (the demo is already built in)".into());
     }
@@ -371,18 +408,7 @@ fn export_command(a: ExportArgs) -> Result<(), String> {
     };
     let (w, h) = a.views.size;
     let analysis = analyze::analyze(&spec, &cams, w, h)?;
-    // The command in the header leaves out the output path, so the same scene and options
-    // always produce the same file.
-    let mut args = std::env::args().skip(1);
-    let mut kept = vec!["sim".to_string()];
-    while let Some(arg) = args.next() {
-        if arg == "--out" {
-            args.next();
-        } else if !arg.starts_with("--out=") {
-            kept.push(arg);
-        }
-    }
-    let command = kept.join(" ");
+    let command = export_command_line();
     let export = scanline3d_sim::export::Export {
         mesh: &spec.instances[0].mesh,
         analysis: &analysis,
