@@ -14,6 +14,9 @@
 //! and every other hidden-surface method (`scanline3d::resolve`: band and full-frame z-buffer,
 //! span sorting, depth sort, Newell's sort, BSP order, Warnock's subdivision) with flat and
 //! perspective-correct Gouraud shading, on a 64×48 target so that their memory stays small.
+//! It also traces the classic scene with the fixed-point ray tracer (`scanline3d::trace`):
+//! scene and camera set-up, every intersection test, shadows, reflection, refraction and the
+//! ray stack, with a stack too small for the depth limit so the overflow path is linked too.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -22,6 +25,16 @@ fn main() {
     println!("panic_never is a link-time check: build it for a bare-metal target, e.g.");
     println!("  cargo build --release --example panic_never --target thumbv6m-none-eabi");
 }
+
+#[cfg(target_os = "none")]
+#[allow(dead_code)]
+#[path = "trace/classic.rs"]
+mod classic;
+
+#[cfg(target_os = "none")]
+#[allow(dead_code)]
+#[path = "trace/view.rs"]
+mod view;
 
 #[cfg(target_os = "none")]
 mod firmware {
@@ -118,6 +131,28 @@ mod firmware {
         }
     }
 
+    /// Traces the classic scene from a camera the optimiser cannot see, with the options and
+    /// stack capacity `STACK` given.
+    #[inline(never)]
+    fn trace<const STACK: usize>(options: scanline3d::trace::TraceOptions, sink: &mut HashSink) {
+        use scanline3d::trace::{Scene, TraceCamera, Tracer};
+        let v = black_box(super::view::CLASSIC);
+        let scene = Scene::new(
+            black_box(&super::classic::OBJECTS),
+            &super::classic::MATERIALS,
+            &super::classic::LIGHTS,
+            super::classic::BACKGROUND,
+            super::classic::AMBIENT,
+        );
+        let camera = TraceCamera::new(v.eye, v.target, v.up, v.fovy, v.near, v.far, 64, 48);
+        if let (Ok(scene), Ok(camera)) = (scene, camera) {
+            let mut row = [Rgb565::new(0, 0, 0); W];
+            let stats = Tracer::<STACK>::new(&scene, &camera, options).render(&mut row, sink);
+            black_box(&stats);
+            black_box(Tracer::<STACK>::new(&scene, &camera, options).trace_pixel(3, 4));
+        }
+    }
+
     #[cfg_attr(target_arch = "arm", cortex_m_rt::entry)]
     #[cfg_attr(target_arch = "riscv32", riscv_rt::entry)]
     fn main() -> ! {
@@ -155,6 +190,12 @@ mod firmware {
                     core::hint::black_box(sink.hash());
                 }
             }
+            // The fixed-point tracer, with room for its ray tree and with too little.
+            let options = black_box(scanline3d::trace::TraceOptions::default());
+            let mut sink = scanline3d::sink::HashSink::new();
+            trace::<5>(options, &mut sink);
+            trace::<2>(options, &mut sink);
+            black_box(sink.hash());
             frame = frame.wrapping_add(1);
         }
     }

@@ -309,14 +309,15 @@ impl TraceCamera {
                 if c.abs() >= 16.0 {
                     return Err(bad);
                 }
-                *o = I8F24::from_num(c);
+                *o = I8F24::checked_from_num(c).ok_or(bad)?;
             }
             Ok(out)
         };
+        let fix1 = |v: f64| I16F16::checked_from_num(v).ok_or(bad);
         let eye = Vec3 {
-            x: I16F16::from_num(eye[0]),
-            y: I16F16::from_num(eye[1]),
-            z: I16F16::from_num(eye[2]),
+            x: fix1(eye[0])?,
+            y: fix1(eye[1])?,
+            z: fix1(eye[2])?,
         };
         if half_w > 16.0 {
             return Err(bad);
@@ -326,8 +327,8 @@ impl TraceCamera {
             corner: fix(corner)?,
             right: fix(right.map(|c| c * sx))?,
             down: fix(true_up.map(|c| -c * sy))?,
-            near: I16F16::from_num(near),
-            far: I16F16::from_num(far),
+            near: fix1(near)?,
+            far: fix1(far)?,
             width,
             height,
         })
