@@ -8,8 +8,9 @@
 //! cargo run --profile firmware -p scanline3d-firmware --example trace --target riscv32imc-unknown-none-elf
 //! ```
 //!
-//! The scene is `trace/classic.scene`, exported by `sim export trace/classic.scene --out
-//! trace/classic.rs` as `static` I16F16 data. Per frame it prints the hash (equal to the host's
+//! The scene is the corpus's `sim/scenes/classic.scene`, exported by `cargo run --bin sim --
+//! export sim/scenes/classic.scene --out firmware/examples/trace/classic.rs` as `static` I16F16
+//! data. Per frame it prints the hash (equal to the host's
 //! fixed tracer: `cargo xtask trace` checks it), instructions per frame, per pixel, per ray and
 //! per intersection test (QEMU `-icount`, instructions, not cycles), the ray counts and the
 //! stack high-water mark.

@@ -49,6 +49,9 @@ enum Command {
     /// Write a scene as Rust source for firmware: static fixed-point arrays and the budget
     /// `analyze` measures.
     Export(ExportArgs),
+    /// Ray-trace a traced scene (issue 21's text format) to PNG, with optional id, depth and
+    /// shadow images.
+    Trace(TraceArgs),
     /// Write the scene corpus as OBJ files (and list its cameras).
     Corpus {
         /// Output directory.
@@ -61,6 +64,79 @@ enum Command {
 enum Renderer {
     Fixed,
     Reference,
+}
+
+/// Which tracer `sim trace` runs.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq)]
+enum TraceRenderer {
+    /// The f64 Whitted tracer.
+    Reference,
+    /// The library's fixed-point tracer (`scanline3d::trace`), what the firmware runs.
+    Fixed,
+}
+
+/// Which acceleration structure the reference tracer uses.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq)]
+enum TraceAccel {
+    /// Test every object.
+    None,
+    /// Bounding-volume hierarchy.
+    Bvh,
+    /// Uniform grid walked with 3D-DDA.
+    Grid,
+    /// Grid whose cells hold a hierarchy.
+    Both,
+}
+
+#[derive(Args, Debug)]
+struct TraceArgs {
+    /// The traced scene file.
+    scene: PathBuf,
+    /// Eye position X,Y,Z.
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true)]
+    eye: [f64; 3],
+    /// Point looked at.
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true)]
+    target: [f64; 3],
+    /// Up direction.
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true, default_value = "0,1,0")]
+    up: [f64; 3],
+    /// Vertical field of view in degrees.
+    #[arg(long, value_parser = finite, default_value = "50")]
+    fov: f64,
+    /// Near plane: primary rays see eye depths in [near, far).
+    #[arg(long, value_parser = finite, default_value = "0.1")]
+    near: f64,
+    /// Far plane.
+    #[arg(long, value_parser = finite, default_value = "100")]
+    far: f64,
+    /// Image size WxH.
+    #[arg(long, value_parser = size, default_value = "240x240")]
+    size: (usize, usize),
+    /// Output PNG.
+    #[arg(long, default_value = "trace.png")]
+    out: PathBuf,
+    /// Primary-hit id image (W×H little-endian i32, −1 = background).
+    #[arg(long)]
+    ids: Option<PathBuf>,
+    /// Primary-hit depth image (W×H little-endian f32 eye depth, +inf = background).
+    #[arg(long)]
+    depth: Option<PathBuf>,
+    /// Shadow image (W×H bytes, bit k set when light k contributes nothing at the primary hit).
+    #[arg(long)]
+    shadow: Option<PathBuf>,
+    /// Which tracer.
+    #[arg(long, value_enum, default_value = "reference")]
+    renderer: TraceRenderer,
+    /// A ray of this depth spawns nothing (the primary ray has depth 0).
+    #[arg(long, default_value_t = scanline3d_sim::trace::whitted::DEFAULT_MAX_DEPTH)]
+    max_depth: u32,
+    /// A secondary ray is traced only if its weight (product of KR/KT along its path) is ≥ W.
+    #[arg(long, value_parser = finite, default_value_t = scanline3d_sim::trace::whitted::DEFAULT_THRESHOLD)]
+    threshold: f64,
+    /// Acceleration structure of the reference tracer (same image, different work).
+    #[arg(long, value_enum, default_value = "both")]
+    accel: TraceAccel,
 }
 
 fn vec3(s: &str) -> Result<[f64; 3], String> {
@@ -530,6 +606,92 @@ fn render(a: RenderArgs) -> Result<(), String> {
     Ok(())
 }
 
+fn trace(a: TraceArgs) -> Result<(), String> {
+    use scanline3d_sim::trace::{accel::Structure, render, scene::TracedScene, whitted::Limits};
+    let traced = TracedScene::load(&a.scene)?;
+    let camera = CameraSpec {
+        eye: a.eye,
+        target: a.target,
+        up: a.up,
+        fovy: a.fov,
+        near: a.near,
+        far: a.far,
+    };
+    if a.threshold < 0.0 {
+        return Err(format!("--threshold {} must not be negative", a.threshold));
+    }
+    let limits = Limits {
+        max_depth: a.max_depth,
+        threshold: a.threshold,
+    };
+    let structure = match a.accel {
+        TraceAccel::None => Structure::None,
+        TraceAccel::Bvh => Structure::Bvh,
+        TraceAccel::Grid => Structure::Grid,
+        TraceAccel::Both => Structure::Both,
+    };
+    let (w, h) = a.size;
+    let (color, ids, depth, shadow, summary) = match a.renderer {
+        TraceRenderer::Reference => {
+            let image = render::render(&traced, &camera, w, h, limits, structure)?;
+            let s = &image.stats;
+            let summary = format!(
+                "{} objects, {} lights; rays: {} primary, {} secondary, {} shadow; tests per ray ({}): {:.2}; ray tree cut by depth {}, by weight {}; {} total internal reflections",
+                traced.objects.len(),
+                traced.lights.len(),
+                s.primary,
+                s.traced_rays() - s.primary,
+                s.shadow,
+                structure.name(),
+                s.tests_per_ray(),
+                s.cut_by_depth,
+                s.cut_by_weight,
+                s.total_internal_reflections
+            );
+            (image.color, image.ids, image.depth, image.shadow, summary)
+        }
+        TraceRenderer::Fixed => {
+            use scanline3d_sim::trace::fixed;
+            let scene = fixed::FixedScene::new(&traced)?;
+            let f = fixed::render(
+                &scene,
+                &camera,
+                w,
+                h,
+                fixed::options(a.max_depth, a.threshold)?,
+            )?;
+            let s = &f.stats;
+            let summary = format!(
+                "{} objects, {} lights; fixed-point tracer: rays: {} primary, {} secondary, {} shadow; tests per ray (none): {:.2}; {} rays dropped (stack full)",
+                traced.objects.len(),
+                traced.lights.len(),
+                s.primary_rays,
+                s.secondary_rays,
+                s.shadow_rays,
+                f64::from(s.intersection_tests) / f64::from(s.rays().max(1)),
+                s.dropped_rays
+            );
+            (f.colour, f.ids, f.depth, f.shadow, summary)
+        }
+    };
+    scene::write_png(&a.out, w, h, &color)?;
+    say!("wrote {}", a.out.display());
+    if let Some(p) = &a.ids {
+        scene::write_ids(p, &ids)?;
+        say!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.depth {
+        scene::write_depth(p, &depth)?;
+        say!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.shadow {
+        std::fs::write(p, &shadow).map_err(|e| format!("{}: {e}", p.display()))?;
+        say!("wrote {}", p.display());
+    }
+    say!("{summary}");
+    Ok(())
+}
+
 /// fixed | reference | mismatch map (red: real, yellow: explained) as one PNG.
 fn side_by_side(path: &Path, fixed: &Image, reference: &Image) -> Result<(), String> {
     let (w, h) = (fixed.width, fixed.height);
@@ -707,6 +869,7 @@ fn main() -> ExitCode {
         Some(Command::Compare(a)) => compare(a),
         Some(Command::Analyze(a)) => analyze_command(a),
         Some(Command::Export(a)) => export_command(a),
+        Some(Command::Trace(a)) => trace(a),
         Some(Command::Corpus { out }) => write_corpus(&out),
     };
     match result {

@@ -123,6 +123,8 @@ struct Pending {
     ray: Ray,
     weight: I16F16,
     depth: u8,
+    /// The object whose surface the ray starts on (`u32::MAX` for a primary ray).
+    from: u32,
 }
 
 /// The nearest hit along a ray.
@@ -221,12 +223,13 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 ray: primary,
                 weight: I16F16::ONE,
                 depth: 0,
+                from: u32::MAX,
             },
             window,
         ));
         while let Some((ray, (t_min, t_max))) = next.take() {
             let is_primary = ray.depth == 0;
-            match self.nearest(&ray.ray, t_min, t_max, &mut stats) {
+            match self.nearest(&ray.ray, ray.from, t_min, t_max, &mut stats) {
                 None => add_weighted(&mut sum, &self.scene.background, ray.weight),
                 Some(hit) => {
                     let shadow = self.shade(&ray, hit, &mut sum, &mut stack, &mut stats);
@@ -244,10 +247,12 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         (out, stats)
     }
 
-    /// The nearest object along `ray` with `t` in `[t_min, t_max)`.
+    /// The nearest object along `ray` (which starts on object `from`) with `t` in
+    /// `[t_min, t_max)`.
     fn nearest(
         &self,
         ray: &Ray,
+        from: u32,
         t_min: I16F16,
         t_max: I16F16,
         stats: &mut TraceStats,
@@ -256,7 +261,12 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         let mut limit = t_max;
         for (id, object) in self.scene.objects.iter().enumerate() {
             stats.intersection_tests += 1;
-            if let Some(t) = object.shape.hit(ray, t_min, limit) {
+            let hit = if id as u32 == from {
+                object.shape.hit_from_surface(ray, t_min, limit)
+            } else {
+                object.shape.hit(ray, t_min, limit)
+            };
+            if let Some(t) = hit {
                 limit = t;
                 best = Some(Hit {
                     t,
@@ -267,11 +277,16 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         best
     }
 
-    /// Whether any object lies along `ray` with `t` in `[EPSILON, t_max)`.
-    fn blocked(&self, ray: &Ray, t_max: I16F16, stats: &mut TraceStats) -> bool {
-        self.scene.objects.iter().any(|object| {
+    /// Whether any object lies along `ray` (which starts on object `from`) with `t` in
+    /// `[EPSILON, t_max)`.
+    fn blocked(&self, ray: &Ray, from: u32, t_max: I16F16, stats: &mut TraceStats) -> bool {
+        self.scene.objects.iter().enumerate().any(|(id, object)| {
             stats.intersection_tests += 1;
-            object.shape.hit(ray, EPSILON, t_max).is_some()
+            if id as u32 == from {
+                object.shape.hit_from_surface(ray, EPSILON, t_max).is_some()
+            } else {
+                object.shape.hit(ray, EPSILON, t_max).is_some()
+            }
         })
     }
 
@@ -319,7 +334,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                     origin: point,
                     dir: towards,
                 };
-                !self.blocked(&shadow_ray, distance, stats)
+                !self.blocked(&shadow_ray, hit.object, distance, stats)
             };
             if lit {
                 diffuse = diffuse.saturating_add(mul(nl, light.intensity));
@@ -344,6 +359,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 ray: Ray { origin: point, dir },
                 weight,
                 depth: pending.depth + 1,
+                from: hit.object,
             };
             if stack.push(child).is_ok() {
                 stats.secondary_rays += 1;

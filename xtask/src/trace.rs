@@ -10,7 +10,7 @@ use crate::*;
 mod view;
 
 /// The classic scene's file (the firmware's `trace/classic.rs` is exported from it).
-const CLASSIC: &str = "firmware/examples/trace/classic.scene";
+const CLASSIC: &str = "sim/scenes/classic.scene";
 
 /// The hash and statistics the host's fixed tracer gives for the firmware's frame.
 fn host_frame() -> Result<(u32, scanline3d::trace::TraceStats), String> {

@@ -1,4 +1,5 @@
-//! The view the `trace` firmware renders the classic scene from; `cargo xtask trace` includes
+//! The view the `trace` firmware renders the classic scene from (the corpus camera "front" of
+//! `sim/scenes/classic.scene`, see `sim/src/trace/corpus.rs`); `cargo xtask trace` includes
 //! this file too and renders the same view with the host's fixed tracer, so the hashes compare
 //! the same frame.
 
@@ -28,7 +29,7 @@ pub const CLASSIC: View = View {
     eye: [0.0, 3.0, 7.0],
     target: [0.0, 0.8, 0.0],
     up: [0.0, 1.0, 0.0],
-    fovy: 45.0,
+    fovy: 50.0,
     near: 0.1,
     far: 100.0,
     width: 240,
