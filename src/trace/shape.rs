@@ -202,6 +202,129 @@ impl Triangle {
     }
 }
 
+/// An axis-aligned box.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AaBox {
+    /// Minimum corner.
+    pub min: Vec3,
+    /// Maximum corner (greater than `min` on every axis).
+    pub max: Vec3,
+}
+
+impl AaBox {
+    /// A box from its corners (min, max), or an error for a corner outside the envelope or
+    /// `min ≥ max` on some axis.
+    pub fn new(min: Vec3, max: Vec3) -> Result<AaBox, ShapeError> {
+        let (min, max) = (check_point(min)?, check_point(max)?);
+        if min.x >= max.x || min.y >= max.y || min.z >= max.z {
+            return Err(ShapeError::Degenerate);
+        }
+        Ok(AaBox { min, max })
+    }
+}
+
+/// An axis-aligned ellipsoid, traced as a sphere of radius `scale_radius` in coordinates
+/// scaled per axis by `scale` = smallest semi-axis / semi-axis (so every factor is ≤ 1 and keeps
+/// 16 fraction bits).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Ellipsoid {
+    /// Centre.
+    pub centre: Vec3,
+    /// Semi-axes along x, y, z.
+    pub radii: Vec3,
+    /// Per-axis factors smallest semi-axis / semi-axis, in (0, 1].
+    pub scale: Vec3,
+    /// The smallest semi-axis.
+    pub scale_radius: I16F16,
+}
+
+impl Ellipsoid {
+    /// An ellipsoid, or an error for a centre outside the envelope or a bad semi-axis (the
+    /// ratio of the largest to the smallest must stay below 2^8).
+    pub fn new(centre: Vec3, radii: Vec3) -> Result<Ellipsoid, ShapeError> {
+        let (rx, ry, rz) = (
+            check_radius(radii.x)?,
+            check_radius(radii.y)?,
+            check_radius(radii.z)?,
+        );
+        let small = rx.min(ry).min(rz);
+        let factor = |r: I16F16| small.checked_div(r).ok_or(ShapeError::BadRadius);
+        let scale = Vec3 {
+            x: factor(rx)?,
+            y: factor(ry)?,
+            z: factor(rz)?,
+        };
+        if scale
+            .x
+            .to_bits()
+            .min(scale.y.to_bits())
+            .min(scale.z.to_bits())
+            < 1 << 8
+        {
+            return Err(ShapeError::BadRadius);
+        }
+        Ok(Ellipsoid {
+            centre: check_point(centre)?,
+            radii,
+            scale,
+            scale_radius: small,
+        })
+    }
+}
+
+/// A capped frustum along `base → base + axis·height` with radius `r0` at the base and `r1`
+/// at the top (`r0 = r1`: a capped cylinder; `r1 = 0`: a cone).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Frustum {
+    /// Centre of the first cap.
+    pub base: Vec3,
+    /// Unit axis from the first cap to the second.
+    pub axis: Vec3,
+    /// Distance between the caps.
+    pub height: I16F16,
+    /// Radius at the first cap.
+    pub r0: I16F16,
+    /// Radius at the second cap.
+    pub r1: I16F16,
+    /// Radius change per unit of height, `(r1 − r0) / height`, at most 2^7 in magnitude.
+    pub slope: I16F16,
+}
+
+impl Frustum {
+    /// A capped cylinder from `p0` to `p1` of radius `r`.
+    pub fn cylinder(p0: Vec3, p1: Vec3, r: I16F16) -> Result<Frustum, ShapeError> {
+        Frustum::new(p0, r, p1, r)
+    }
+
+    /// A capped frustum from `p0` (radius `r0`) to `p1` (radius `r1`); both radii ≥ 0, not both
+    /// 0; an error for caps closer than 2^-8 or a slope above 2^7.
+    pub fn new(p0: Vec3, r0: I16F16, p1: Vec3, r1: I16F16) -> Result<Frustum, ShapeError> {
+        let (p0, p1) = (check_point(p0)?, check_point(p1)?);
+        let ok = |r: I16F16| r >= I16F16::ZERO && r <= MAX_COORD;
+        if !ok(r0) || !ok(r1) || (r0 == I16F16::ZERO && r1 == I16F16::ZERO) {
+            return Err(ShapeError::BadRadius);
+        }
+        let d = p1.sub(p0);
+        let height = crate::trace::vector::sqrt(d.dot(d));
+        if height < I16F16::from_bits(1 << 8) {
+            return Err(ShapeError::Degenerate);
+        }
+        let axis = d.normalized().ok_or(ShapeError::Degenerate)?;
+        let slope = (r1 - r0)
+            .checked_div(height)
+            .filter(|k| k.abs() <= I16F16::from_num(128))
+            .ok_or(ShapeError::Degenerate)?;
+        Ok(Frustum {
+            base: p0,
+            axis,
+            height,
+            r0,
+            r1,
+            slope,
+        })
+    }
+}
+
 /// A traced primitive.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Shape<'a> {
@@ -213,6 +336,12 @@ pub enum Shape<'a> {
     Polygon(Polygon<'a>),
     /// A triangle.
     Triangle(Triangle),
+    /// An axis-aligned box.
+    Box(AaBox),
+    /// An axis-aligned ellipsoid.
+    Ellipsoid(Ellipsoid),
+    /// A capped cylinder or cone frustum.
+    Frustum(Frustum),
 }
 
 /// A primitive with its material (an index into the scene's materials).
