@@ -427,6 +427,196 @@ mod tests {
         }
     }
 
+    use crate::trace::scene::{Light, Material, TraceCamera};
+    use crate::trace::shape::{
+        AaBox, Ellipsoid, Frustum, Object, Plane, Polygon, Shape, Sphere, Triangle,
+    };
+
+    fn f(x: f64) -> I16F16 {
+        I16F16::from_num(x)
+    }
+
+    fn material(kr: f64, kt: f64) -> Material {
+        let grey = Colour::new([f(0.5); 3]).unwrap();
+        Material::new(grey, [f(0.2), f(0.8), f(kr), f(kt)], f(1.5)).unwrap()
+    }
+
+    /// Two facing mirrors (planes z = ±1, facing each other) seen by a camera between them
+    /// looking down −z: every ray reflects forever unless a rule stops it.
+    fn mirrors(kr: f64, options: TraceOptions) -> TraceStats {
+        let objects = [
+            Object {
+                shape: Shape::Plane(Plane::new(v(0.0, 0.0, 1.0), f(1.0)).unwrap()),
+                material: 0,
+            },
+            Object {
+                shape: Shape::Plane(Plane::new(v(0.0, 0.0, -1.0), f(1.0)).unwrap()),
+                material: 0,
+            },
+        ];
+        let materials = [material(kr, 0.0)];
+        let scene = Scene::new(&objects, &materials, &[], Colour::BLACK, f(0.5)).unwrap();
+        let camera = TraceCamera::new(
+            [0.0; 3],
+            [0.0, 0.0, -1.0],
+            [0.0, 1.0, 0.0],
+            10.0,
+            0.1,
+            10.0,
+            1,
+            1,
+        )
+        .unwrap();
+        Tracer::<8>::new(&scene, &camera, options)
+            .trace_pixel(0, 0)
+            .1
+    }
+
+    #[test]
+    fn the_depth_limit_ends_the_ray_tree() {
+        for max_depth in [0, 1, 3, 7] {
+            let s = mirrors(
+                1.0,
+                TraceOptions {
+                    max_depth,
+                    threshold: I16F16::ZERO,
+                },
+            );
+            assert_eq!(
+                s.secondary_rays,
+                u32::from(max_depth),
+                "depth limit {max_depth}"
+            );
+            assert_eq!(s.dropped_rays, 0);
+        }
+    }
+
+    #[test]
+    fn a_weight_below_the_threshold_ends_the_ray_tree() {
+        // Weights 0.5, 0.25, 0.125, …: with threshold 0.2 two reflections are traced.
+        let s = mirrors(
+            0.5,
+            TraceOptions {
+                max_depth: 7,
+                threshold: f(0.2),
+            },
+        );
+        assert_eq!(s.secondary_rays, 2);
+        // A diffuse surface spawns nothing.
+        assert_eq!(mirrors(0.0, TraceOptions::default()).secondary_rays, 0);
+    }
+
+    #[test]
+    fn a_full_ray_stack_is_reported() {
+        // A glass slab (KR and KT) between the camera and the floor branches at every hit.
+        let objects = [
+            Object {
+                shape: Shape::Box(AaBox::new(v(-5.0, -0.5, -5.0), v(5.0, 0.5, 5.0)).unwrap()),
+                material: 0,
+            },
+            Object {
+                shape: Shape::Plane(Plane::new(v(0.0, 1.0, 0.0), f(3.0)).unwrap()),
+                material: 0,
+            },
+        ];
+        let materials = [material(0.3, 0.7)];
+        let scene = Scene::new(&objects, &materials, &[], Colour::BLACK, f(0.5)).unwrap();
+        let camera = TraceCamera::new(
+            [0.0, 3.0, 0.0],
+            [0.0; 3],
+            [0.0, 0.0, -1.0],
+            10.0,
+            0.1,
+            10.0,
+            2,
+            2,
+        )
+        .unwrap();
+        let options = TraceOptions {
+            max_depth: 4,
+            threshold: I16F16::ZERO,
+        };
+        let roomy = Tracer::<5>::new(&scene, &camera, options);
+        let (_, s) = roomy.trace_pixel(0, 0);
+        assert_eq!((s.dropped_rays, s.peak_stack), (0, 4));
+        let tight = Tracer::<2>::new(&scene, &camera, options);
+        assert!(tight.trace_pixel(0, 0).1.dropped_rays > 0);
+        let mut rows = [true; 2];
+        let mut sink = crate::sink::FnSink(|row: crate::sink::Row<'_, Rgb888>| -> Result<(), ()> {
+            rows[usize::from(row.y)] = row.complete;
+            Ok(())
+        });
+        let stats = tight
+            .render(&mut [Rgb888::new(0, 0, 0); 2], &mut sink)
+            .unwrap();
+        let wrong_row = tight.render(&mut [Rgb888::new(0, 0, 0); 3], &mut sink);
+        assert_eq!(wrong_row, Err(TraceError::RowLength));
+        assert!(stats.dropped_rays > 0);
+        assert_eq!(rows, [false, false], "rows that lost rays say so");
+    }
+
+    #[test]
+    fn every_primitive_casts_a_shadow() {
+        // The floor y = 0 seen from above at the origin; the light comes from (1, 1, 0), so
+        // an object around (1.5, 1.5, 0) shadows the origin without being seen from the camera.
+        let c = v(1.5, 1.5, 0.0);
+        let square = [
+            v(1.2, 1.8, -0.3),
+            v(1.8, 1.2, -0.3),
+            v(1.8, 1.2, 0.3),
+            v(1.2, 1.8, 0.3),
+        ];
+        let blockers = [
+            Shape::Sphere(Sphere::new(c, f(0.3)).unwrap()),
+            Shape::Box(AaBox::new(v(1.3, 1.3, -0.2), v(1.7, 1.7, 0.2)).unwrap()),
+            Shape::Frustum(Frustum::cylinder(v(1.5, 1.5, -0.5), v(1.5, 1.5, 0.5), f(0.3)).unwrap()),
+            Shape::Frustum(
+                Frustum::new(v(1.5, 1.2, 0.0), f(0.4), v(1.5, 1.9, 0.0), f(0.0)).unwrap(),
+            ),
+            Shape::Ellipsoid(Ellipsoid::new(c, v(0.3, 0.4, 0.2)).unwrap()),
+            Shape::Polygon(Polygon::new(&square).unwrap()),
+            Shape::Triangle(Triangle::new([square[0], square[1], square[2]]).unwrap()),
+        ];
+        let floor = Object {
+            shape: Shape::Plane(Plane::new(v(0.0, 1.0, 0.0), f(0.0)).unwrap()),
+            material: 0,
+        };
+        let materials = [material(0.0, 0.0)];
+        let lights = [Light::directional(v(1.0, 1.0, 0.0), f(1.0)).unwrap()];
+        let camera = TraceCamera::new(
+            [0.0, 0.5, 0.0001],
+            [0.0; 3],
+            [0.0, 0.0, -1.0],
+            1.0,
+            0.1,
+            10.0,
+            1,
+            1,
+        )
+        .unwrap();
+        let lit = |objects: &[Object<'_>]| {
+            let scene = Scene::new(objects, &materials, &lights, Colour::BLACK, f(0.2)).unwrap();
+            let (p, _) =
+                Tracer::<5>::new(&scene, &camera, TraceOptions::default()).trace_pixel(0, 0);
+            assert_eq!(p.id, Some(0), "the floor is seen");
+            p.shadow
+        };
+        assert_eq!(lit(&[floor]), 0);
+        for b in blockers {
+            assert_eq!(
+                lit(&[
+                    floor,
+                    Object {
+                        shape: b,
+                        material: 0
+                    }
+                ]),
+                1,
+                "{b:?}"
+            );
+        }
+    }
+
     #[test]
     fn snell_and_total_internal_reflection() {
         let n = v(0.0, 1.0, 0.0);
