@@ -12,7 +12,8 @@
 //! export sim/scenes/classic.scene --out firmware/examples/trace/classic.rs` as `static` I16F16
 //! data. Per frame it prints the hash (equal to the host's
 //! fixed tracer: `cargo xtask trace` checks it), instructions per frame, per pixel, per ray and
-//! per intersection test (QEMU `-icount`, instructions, not cycles), the ray counts and the
+//! per intersection test (object tests; the box tests are counted apart) (QEMU `-icount`,
+//! instructions, not cycles), the ray counts and the
 //! stack high-water mark.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
@@ -63,7 +64,13 @@ mod firmware {
             classic::BACKGROUND,
             classic::AMBIENT,
         )
-        .map_err(|_| "scene")?;
+        .map_err(|_| "scene")?
+        .with_bvh(
+            &classic::BVH_NODES,
+            &classic::BVH_ITEMS,
+            classic::BVH_BOUNDED,
+        )
+        .map_err(|_| "bounding volumes")?;
         let v = view::CLASSIC;
         let camera = TraceCamera::new(
             v.eye, v.target, v.up, v.fovy, v.near, v.far, v.width, v.height,
@@ -90,7 +97,7 @@ mod firmware {
         let rays = u64::from(stats.rays());
         let tests = u64::from(stats.intersection_tests);
         println!(
-            "frame 0 hash {:08x} instructions {} instr_per_pixel {} instr_per_ray {} instr_per_test {} rays {} primary {} secondary {} shadow {} tests {} tests_per_ray_x100 {}",
+            "frame 0 hash {:08x} instructions {} instr_per_pixel {} instr_per_ray {} instr_per_test {} rays {} primary {} secondary {} shadow {} tests {} tests_per_ray_x100 {} box_tests_per_ray_x100 {}",
             sink.hash(),
             instructions,
             instructions / pixels,
@@ -101,7 +108,8 @@ mod firmware {
             stats.secondary_rays,
             stats.shadow_rays,
             tests,
-            tests * 100 / rays.max(1)
+            tests * 100 / rays.max(1),
+            u64::from(stats.box_tests) * 100 / rays.max(1)
         );
         println!(
             "summary peak_stack {} static_ram {} ray_stack_entries {} peak_ray_stack {}",

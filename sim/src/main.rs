@@ -134,7 +134,8 @@ struct TraceArgs {
     /// A secondary ray is traced only if its weight (product of KR/KT along its path) is ≥ W.
     #[arg(long, value_parser = finite, default_value_t = scanline3d_sim::trace::whitted::DEFAULT_THRESHOLD)]
     threshold: f64,
-    /// Acceleration structure of the reference tracer (same image, different work).
+    /// Acceleration structure (same image, different work). The fixed tracer has the
+    /// hierarchy only: any value but `none` gives it the hierarchy.
     #[arg(long, value_enum, default_value = "both")]
     accel: TraceAccel,
 }
@@ -659,16 +660,19 @@ fn trace(a: TraceArgs) -> Result<(), String> {
                 w,
                 h,
                 fixed::options(a.max_depth, a.threshold)?,
+                a.accel != TraceAccel::None,
             )?;
             let s = &f.stats;
             let summary = format!(
-                "{} objects, {} lights; fixed-point tracer: rays: {} primary, {} secondary, {} shadow; tests per ray (none): {:.2}; {} rays dropped (stack full)",
+                "{} objects, {} lights; fixed-point tracer: rays: {} primary, {} secondary, {} shadow; tests per ray ({}): {:.2} objects, {:.2} boxes; {} rays dropped (stack full)",
                 traced.objects.len(),
                 traced.lights.len(),
                 s.primary_rays,
                 s.secondary_rays,
                 s.shadow_rays,
+                if a.accel == TraceAccel::None { "none" } else { "bvh" },
                 f64::from(s.intersection_tests) / f64::from(s.rays().max(1)),
+                f64::from(s.box_tests) / f64::from(s.rays().max(1)),
                 s.dropped_rays
             );
             (f.colour, f.ids, f.depth, f.shadow, summary)

@@ -40,6 +40,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod bvh;
 pub mod intersect;
 pub mod scene;
 pub mod shape;

@@ -2,6 +2,7 @@
 //! objects, materials and lights from slices (so all of it can be `static` data in flash), and
 //! the camera that makes primary rays.
 
+use crate::trace::bvh::{Bvh, BvhError, BvhNode};
 use crate::trace::shape::Object;
 use crate::trace::vector::{Vec3, MAX_COORD};
 use fixed::types::{I16F16, I8F24};
@@ -176,9 +177,27 @@ pub struct Scene<'a> {
     pub background: Colour,
     /// Ambient level, in [0, 1].
     pub ambient: I16F16,
+    /// A bounding-volume hierarchy over the objects ([`Scene::with_bvh`]); without one every
+    /// ray tests every object.
+    pub bvh: Option<Bvh<'a>>,
 }
 
 impl<'a> Scene<'a> {
+    /// The scene with a bounding-volume hierarchy over its objects, as
+    /// [`bvh::build`](crate::trace::bvh::build) made it (nodes, items and how many items are in
+    /// the tree), checked against the objects by [`Bvh::new`].
+    pub fn with_bvh(
+        self,
+        nodes: &'a [BvhNode],
+        items: &'a [u32],
+        bounded: usize,
+    ) -> Result<Scene<'a>, BvhError> {
+        Ok(Scene {
+            bvh: Some(Bvh::new(nodes, items, bounded, self.objects)?),
+            ..self
+        })
+    }
+
     /// A scene, or an error for an unknown material index, more than [`MAX_LIGHTS`] lights or
     /// an ambient level outside [0, 1].
     pub fn new(
@@ -209,6 +228,7 @@ impl<'a> Scene<'a> {
             lights,
             background,
             ambient,
+            bvh: None,
         })
     }
 }

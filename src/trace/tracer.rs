@@ -71,6 +71,8 @@ pub struct TraceStats {
     pub shadow_rays: u32,
     /// Ray–primitive intersection tests.
     pub intersection_tests: u32,
+    /// Ray–box tests in the bounding-volume hierarchy.
+    pub box_tests: u32,
     /// Secondary rays not traced because the ray stack was full (0 when `STACK > max_depth`).
     pub dropped_rays: u32,
     /// Most pending rays on the stack at once.
@@ -90,6 +92,7 @@ impl TraceStats {
         self.secondary_rays += o.secondary_rays;
         self.shadow_rays += o.shadow_rays;
         self.intersection_tests += o.intersection_tests;
+        self.box_tests += o.box_tests;
         self.dropped_rays += o.dropped_rays;
         self.peak_stack = self.peak_stack.max(o.peak_stack);
     }
@@ -258,36 +261,70 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         stats: &mut TraceStats,
     ) -> Option<Hit> {
         let mut best: Option<Hit> = None;
-        let mut limit = t_max;
-        for (id, object) in self.scene.objects.iter().enumerate() {
-            stats.intersection_tests += 1;
-            let hit = if id as u32 == from {
-                object.shape.hit_from_surface(ray, t_min, limit)
-            } else {
-                object.shape.hit(ray, t_min, limit)
-            };
-            if let Some(t) = hit {
-                limit = t;
-                best = Some(Hit {
-                    t,
-                    object: id as u32,
-                });
+        let mut tests = 0;
+        let mut test = |id: u32, limit: I16F16| -> I16F16 {
+            tests += 1;
+            match self.hit(id, ray, from, t_min, limit) {
+                Some(t) => {
+                    best = Some(Hit { t, object: id });
+                    t
+                }
+                None => limit,
+            }
+        };
+        match &self.scene.bvh {
+            None => {
+                let mut limit = t_max;
+                for id in 0..self.scene.objects.len() as u32 {
+                    limit = test(id, limit);
+                }
+            }
+            Some(bvh) => {
+                let mut limit = t_max;
+                for id in bvh.unbounded() {
+                    limit = test(*id, limit);
+                }
+                stats.box_tests += bvh.walk(ray, t_min, limit, |id, limit| Some(test(id, limit)));
             }
         }
+        stats.intersection_tests += tests;
         best
+    }
+
+    /// `t` of object `id` along `ray` (which starts on object `from`) in `[t_min, t_max)`.
+    #[inline]
+    fn hit(&self, id: u32, ray: &Ray, from: u32, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
+        let object = self.scene.objects.get(id as usize)?;
+        if id == from {
+            object.shape.hit_from_surface(ray, t_min, t_max)
+        } else {
+            object.shape.hit(ray, t_min, t_max)
+        }
     }
 
     /// Whether any object lies along `ray` (which starts on object `from`) with `t` in
     /// `[EPSILON, t_max)`.
     fn blocked(&self, ray: &Ray, from: u32, t_max: I16F16, stats: &mut TraceStats) -> bool {
-        self.scene.objects.iter().enumerate().any(|(id, object)| {
-            stats.intersection_tests += 1;
-            if id as u32 == from {
-                object.shape.hit_from_surface(ray, EPSILON, t_max).is_some()
-            } else {
-                object.shape.hit(ray, EPSILON, t_max).is_some()
+        let mut tests = 0;
+        let mut blocks = |id: u32| {
+            tests += 1;
+            self.hit(id, ray, from, EPSILON, t_max).is_some()
+        };
+        let blocked = match &self.scene.bvh {
+            None => (0..self.scene.objects.len() as u32).any(&mut blocks),
+            Some(bvh) => {
+                let mut found = bvh.unbounded().iter().any(|id| blocks(*id));
+                if !found {
+                    stats.box_tests += bvh.walk(ray, EPSILON, t_max, |id, limit| {
+                        found = blocks(id);
+                        (!found).then_some(limit)
+                    });
+                }
+                found
             }
-        })
+        };
+        stats.intersection_tests += tests;
+        blocked
     }
 
     /// Adds the local term at `hit` times the ray's weight to `sum`, pushes the reflected and

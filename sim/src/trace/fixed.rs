@@ -10,6 +10,7 @@ use crate::scene::CameraSpec;
 use embedded_graphics::pixelcolor::Rgb565;
 use fixed::types::I16F16;
 use scanline3d::sink::HashSink;
+use scanline3d::trace::bvh::{self, BvhNode};
 use scanline3d::trace::shape::{AaBox, Ellipsoid, Facet, Frustum};
 use scanline3d::trace::{
     Colour, Light, LightKind, Material, Object, Plane, Polygon, Scene, Shape, Sphere, TraceCamera,
@@ -55,6 +56,9 @@ pub struct FixedScene {
     pub background: Colour,
     /// Ambient level.
     pub ambient: I16F16,
+    /// The bounding-volume hierarchy the library built over the objects: nodes, items and how
+    /// many items are in the tree.
+    pub bvh: (Vec<BvhNode>, Vec<u32>, usize),
 }
 
 impl FixedScene {
@@ -137,14 +141,30 @@ impl FixedScene {
                 u16::try_from(o.material).map_err(|_| format!("{what}: too many materials"))?;
             entries.push((entry, material));
         }
-        Ok(FixedScene {
+        let mut fixed = FixedScene {
             polygons,
             entries,
             materials,
             lights,
             background: colour(scene.background, "background")?,
             ambient: fix(scene.ambient, "ambient")?,
-        })
+            bvh: (Vec::new(), Vec::new(), 0),
+        };
+        let objects = fixed.objects();
+        let empty = BvhNode {
+            min: Vec3::ZERO,
+            max: Vec3::ZERO,
+            index: 0,
+            count: 0,
+            axis: 0,
+        };
+        let mut nodes = vec![empty; 2 * objects.len()];
+        let mut items = vec![0; objects.len()];
+        let (used, _, bounded) =
+            bvh::build(&objects, &mut nodes, &mut items).map_err(|e| e.to_string())?;
+        nodes.truncate(used);
+        fixed.bvh = (nodes, items, bounded);
+        Ok(fixed)
     }
 
     /// The objects, borrowing this scene's polygon vertices.
@@ -163,10 +183,14 @@ impl FixedScene {
             .collect()
     }
 
-    /// Runs `f` with the library scene.
-    pub fn with_scene<R>(&self, f: impl FnOnce(&Scene<'_>) -> R) -> Result<R, String> {
+    /// Runs `f` with the library scene, with its bounding-volume hierarchy if `accelerate`.
+    pub fn with_scene<R>(
+        &self,
+        accelerate: bool,
+        f: impl FnOnce(&Scene<'_>) -> R,
+    ) -> Result<R, String> {
         let objects = self.objects();
-        let scene = Scene::new(
+        let mut scene = Scene::new(
             &objects,
             &self.materials,
             &self.lights,
@@ -174,6 +198,12 @@ impl FixedScene {
             self.ambient,
         )
         .map_err(|e| e.to_string())?;
+        if accelerate {
+            let (nodes, items, bounded) = &self.bvh;
+            scene = scene
+                .with_bvh(nodes, items, *bounded)
+                .map_err(|e| e.to_string())?;
+        }
         Ok(f(&scene))
     }
 }
@@ -235,9 +265,10 @@ pub fn render(
     w: usize,
     h: usize,
     options: TraceOptions,
+    accelerate: bool,
 ) -> Result<FixedFrame, String> {
     let camera = camera(cam, w, h)?;
-    scene.with_scene(|scene| {
+    scene.with_scene(accelerate, |scene| {
         let tracer = Tracer::<STACK>::new(scene, &camera, options);
         let mut frame = FixedFrame {
             width: w,
@@ -256,6 +287,7 @@ pub fn render(
                 total.secondary_rays += s.secondary_rays;
                 total.shadow_rays += s.shadow_rays;
                 total.intersection_tests += s.intersection_tests;
+                total.box_tests += s.box_tests;
                 total.dropped_rays += s.dropped_rays;
                 total.peak_stack = total.peak_stack.max(s.peak_stack);
                 frame
@@ -275,7 +307,7 @@ pub fn render(
 }
 
 /// The frame hash the firmware prints: the tracer's rows in [`Rgb565`] through a
-/// [`HashSink`], and the frame's statistics.
+/// [`HashSink`], and the frame's statistics (with the hierarchy, as the firmware).
 pub fn frame_hash(
     scene: &FixedScene,
     cam: &CameraSpec,
@@ -284,7 +316,7 @@ pub fn frame_hash(
     options: TraceOptions,
 ) -> Result<(u32, TraceStats), String> {
     let camera = camera(cam, w, h)?;
-    scene.with_scene(|scene| {
+    scene.with_scene(true, |scene| {
         let mut row = vec![Rgb565::new(0, 0, 0); w];
         let mut sink = HashSink::new();
         Tracer::<STACK>::new(scene, &camera, options)
@@ -434,6 +466,26 @@ pub fn export_source(scene: &FixedScene, command: &str) -> String {
         );
     }
     s += "];\n\n";
+    let (nodes, items, bounded) = &scene.bvh;
+    s += &format!(
+        "/// The bounding-volume hierarchy's nodes ([`scanline3d::trace::bvh`]).\npub static BVH_NODES: [scanline3d::trace::bvh::BvhNode; {}] = [\n",
+        nodes.len()
+    );
+    for n in nodes {
+        s += &format!(
+            "    scanline3d::trace::bvh::BvhNode {{ min: {}, max: {}, index: {}, count: {}, axis: {} }},\n",
+            vec3(n.min),
+            vec3(n.max),
+            n.index,
+            n.count,
+            n.axis
+        );
+    }
+    s += &format!(
+        "];\n\n/// Object ids in leaf order, then the unbounded objects'.\npub static BVH_ITEMS: [u32; {}] = {:?};\n\n/// How many of `BVH_ITEMS` are in the tree.\npub const BVH_BOUNDED: usize = {bounded};\n\n",
+        items.len(),
+        items
+    );
     s += &format!(
         "/// Background colour.\npub const BACKGROUND: Colour = {};\n/// Ambient level.\npub const AMBIENT: I16F16 = {};\n",
         colour(scene.background),
