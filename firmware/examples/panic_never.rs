@@ -16,7 +16,8 @@
 //! perspective-correct Gouraud shading, on a 64×48 target so that their memory stays small.
 //! It also traces the classic scene with the fixed-point ray tracer (`scanline3d::trace`):
 //! scene and camera set-up, every intersection test, shadows, reflection, refraction and the
-//! ray stack, with a stack too small for the depth limit so the overflow path is linked too.
+//! ray stack, with a stack too small for the depth limit so the overflow path is linked too,
+//! without and with a bounding-volume hierarchy (exported, and built at run time).
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -150,6 +151,37 @@ mod firmware {
             let stats = Tracer::<STACK>::new(&scene, &camera, options).render(&mut row, sink);
             black_box(&stats);
             black_box(Tracer::<STACK>::new(&scene, &camera, options).trace_pixel(3, 4));
+            // With the exported bounding-volume hierarchy, and one built here at run time.
+            let exported = scene.with_bvh(
+                black_box(&super::classic::BVH_NODES),
+                &super::classic::BVH_ITEMS,
+                black_box(super::classic::BVH_BOUNDED),
+            );
+            if let Ok(with_bvh) = exported {
+                let stats =
+                    Tracer::<STACK>::new(&with_bvh, &camera, options).render(&mut row, sink);
+                black_box(&stats);
+            }
+            let mut nodes = [scanline3d::trace::bvh::BvhNode {
+                min: scanline3d::trace::Vec3::ZERO,
+                max: scanline3d::trace::Vec3::ZERO,
+                index: 0,
+                count: 0,
+                axis: 0,
+            }; 2 * super::classic::OBJECTS.len()];
+            let mut items = [0u32; super::classic::OBJECTS.len()];
+            if let Ok((used, total, bounded)) =
+                scanline3d::trace::bvh::build(scene.objects, &mut nodes, &mut items)
+            {
+                let built = scene.with_bvh(
+                    nodes.get(..used).unwrap_or(&[]),
+                    items.get(..total).unwrap_or(&[]),
+                    bounded,
+                );
+                if let Ok(with_bvh) = built {
+                    black_box(Tracer::<STACK>::new(&with_bvh, &camera, options).trace_pixel(5, 6));
+                }
+            }
         }
     }
 

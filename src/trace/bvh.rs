@@ -211,9 +211,9 @@ pub fn build(
             count: 0,
             axis,
         };
-        range.sort_unstable_by_key(|id| {
-            let (a, b) = object_box(*id);
-            (centre(a, b, axis), *id)
+        heap_sort_by_key(range, |id| {
+            let (a, b) = object_box(id);
+            (centre(a, b, axis), id)
         });
         if depth >= MAX_BVH_DEPTH {
             return Err(BvhError::TooDeep);
@@ -225,6 +225,38 @@ pub fn build(
             .map_err(|_| BvhError::TooDeep)?;
     }
     Ok((used, total, bounded))
+}
+
+/// Heapsort of `v` by `key`: in place, O(n log n), and without the panic that core's sorts keep
+/// for a key that is not a total order (ours are `(i32, u32)` pairs).
+fn heap_sort_by_key<K: Ord>(v: &mut [u32], key: impl Fn(u32) -> K) {
+    let k = |v: &[u32], i: usize| v.get(i).map(|x| key(*x));
+    let sift_down = |v: &mut [u32], mut root: usize, end: usize| loop {
+        let mut child = 2 * root + 1;
+        if child >= end {
+            break;
+        }
+        if child + 1 < end && k(v, child) < k(v, child + 1) {
+            child += 1;
+        }
+        if k(v, root) >= k(v, child) {
+            break;
+        }
+        if let Some([first, .., last]) = v.get_mut(root..=child) {
+            core::mem::swap(first, last);
+        }
+        root = child;
+    };
+    let n = v.len();
+    for root in (0..n / 2).rev() {
+        sift_down(v, root, n);
+    }
+    for end in (1..n).rev() {
+        if let Some([first, .., last]) = v.get_mut(..=end) {
+            core::mem::swap(first, last);
+        }
+        sift_down(v, 0, end);
+    }
 }
 
 fn min3(a: Vec3, b: Vec3) -> Vec3 {
@@ -445,5 +477,113 @@ impl RayInverse {
             }
         }
         lo <= hi
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trace::shape::{Plane, Sphere};
+    use std::vec::Vec;
+
+    fn sphere(x: i32) -> Object<'static> {
+        let c = Vec3::from_bits(x << 16, 0, 0);
+        Object {
+            shape: Shape::Sphere(Sphere::new(c, I16F16::from_num(0.4)).unwrap()),
+            material: 0,
+        }
+    }
+
+    const EMPTY: BvhNode = BvhNode {
+        min: Vec3::ZERO,
+        max: Vec3::ZERO,
+        index: 0,
+        count: 0,
+        axis: 0,
+    };
+
+    #[test]
+    fn heap_sort_sorts() {
+        let mut v: Vec<u32> = (0..200).map(|i| (i * 7919) % 211).collect();
+        heap_sort_by_key(&mut v, |x| x);
+        assert!(v.windows(2).all(|w| w[0] <= w[1]));
+    }
+
+    #[test]
+    fn build_then_walk_finds_every_object_on_the_ray() {
+        // 20 spheres on the x axis and a plane; a ray along x meets them all.
+        let mut objects: Vec<Object<'static>> = (0..20).map(|i| sphere(i - 10)).collect();
+        objects.insert(
+            7,
+            Object {
+                shape: Shape::Plane(
+                    Plane::new(Vec3::from_bits(0, 1 << 16, 0), I16F16::from_num(5)).unwrap(),
+                ),
+                material: 0,
+            },
+        );
+        let mut nodes = [EMPTY; 42];
+        let mut items = [0u32; 21];
+        let (used, total, bounded) = build(&objects, &mut nodes, &mut items).unwrap();
+        assert_eq!((total, bounded), (21, 20));
+        assert!(used <= 2 * bounded - 1);
+        let bvh = Bvh::new(&nodes[..used], &items, bounded, &objects).unwrap();
+        assert_eq!(bvh.unbounded(), [7]);
+        let ray = Ray {
+            origin: Vec3::from_bits(-20 << 16, 0, 0),
+            dir: Vec3::from_bits(1 << 16, 0, 0),
+        };
+        let mut seen = Vec::new();
+        bvh.walk(&ray, I16F16::ZERO, I16F16::MAX, |id, t| {
+            seen.push(id);
+            Some(t)
+        });
+        seen.sort();
+        let mut want: Vec<u32> = (0..21).filter(|i| *i != 7).collect();
+        want.sort();
+        assert_eq!(seen, want);
+        // A ray far off the axis enters no box beyond the root.
+        let miss = Ray {
+            origin: Vec3::from_bits(-20 << 16, 5 << 16, 0),
+            dir: Vec3::from_bits(1 << 16, 0, 0),
+        };
+        let mut any = false;
+        assert_eq!(
+            bvh.walk(&miss, I16F16::ZERO, I16F16::MAX, |_, t| {
+                any = true;
+                Some(t)
+            }),
+            1
+        );
+        assert!(!any);
+    }
+
+    #[test]
+    fn malformed_hierarchies_are_rejected() {
+        let objects: Vec<Object<'static>> = (0..4).map(sphere).collect();
+        let mut nodes = [EMPTY; 8];
+        let mut items = [0u32; 4];
+        let (used, _, bounded) = build(&objects, &mut nodes, &mut items).unwrap();
+        assert!(Bvh::new(&nodes[..used], &items, bounded, &objects).is_ok());
+        let mut twice = items;
+        twice[1] = twice[0];
+        assert_eq!(
+            Bvh::new(&nodes[..used], &twice, bounded, &objects).err(),
+            Some(BvhError::Malformed)
+        );
+        let mut backwards = nodes;
+        backwards[0].index = 0;
+        assert_eq!(
+            Bvh::new(&backwards[..used], &items, bounded, &objects).err(),
+            Some(BvhError::Malformed)
+        );
+        assert_eq!(
+            Bvh::new(&nodes[..used], &items[..3], bounded, &objects).err(),
+            Some(BvhError::Malformed)
+        );
+        assert_eq!(
+            build(&objects, &mut nodes[..2], &mut items).err(),
+            Some(BvhError::Capacity)
+        );
     }
 }
