@@ -7,7 +7,7 @@
 //! [`crate::trace::vector`]); quotients are 64-bit integer divisions of raw bits.
 
 use crate::trace::shape::{AaBox, Ellipsoid, Facet, Frustum, Plane, Shape, Sphere};
-use crate::trace::vector::{narrow, narrow_bits, sqrt, Vec3};
+use crate::trace::vector::{mul, narrow, narrow_bits, sqrt, Vec3};
 use fixed::types::{I16F16, I32F32};
 
 /// A ray: origin and unit direction.
@@ -252,12 +252,6 @@ fn frustum_span(f: &Frustum, ray: &Ray) -> Option<(I16F16, I16F16)> {
         }
     }
     (t_in <= t_out).then_some((t_in, t_out))
-}
-
-/// `a · b` for two I16F16 values (saturating).
-#[inline]
-fn mul(a: I16F16, b: I16F16) -> I16F16 {
-    I16F16::from_bits(narrow_bits(a.wide_mul(b).to_bits()))
 }
 
 impl Shape<'_> {

@@ -3,8 +3,9 @@
 //! as the rasterizers, with no frame buffer and no depth memory.
 //!
 //! [`vector`] (I16F16 vectors, integer square root) → [`shape`] (primitives, validated) →
-//! [`intersect`] (ray–primitive tests) → [`scene`] (materials, lights, camera) → [`tracer`]
-//! (the ray tree on an explicit stack, shading, rows).
+//! [`intersect`] (ray–primitive tests) → [`bvh`] (bounding volumes, built into caller buffers
+//! or exported as `static` data) → [`scene`] (materials, lights, camera) → [`tracer`] (the ray
+//! tree on an explicit stack, shading, rows).
 //!
 //! ## Envelope and bit budget
 //!
@@ -16,6 +17,7 @@
 //! | camera steps | [`I8F24`](fixed::types::I8F24) | half-width of the view ≤ 16 at distance 1 | 2048 steps accumulate below 2^-13 |
 //! | image | — | 1 to 2048 pixels per side | — |
 //! | lights | — | ≤ 8 | one bit each in the shadow mask |
+//! | ray length through a hierarchy | — | below 2^10 world units | the box test's rounding (t · 2^-16) stays inside the boxes' padding [`bvh::PAD`] |
 //!
 //! RAM per frame: one row of pixels (the caller's slice) plus the ray stack (`STACK` × 36 bytes)
 //! on the call stack; the scene is borrowed and may live in flash.
@@ -31,7 +33,8 @@
 //! let red = Material::new(Colour::new([f(1.0), f(0.2), f(0.2)])?, [f(0.1), f(0.9), f(0.0), f(0.0)], f(1.0))?;
 //! let objects = [Object { shape: Shape::Sphere(Sphere::new(p(0.0, 0.0, 0.0), f(1.0))?), material: 0 }];
 //! let lights = [Light::point(p(5.0, 5.0, 5.0), f(1.0))?];
-//! let scene = Scene::new(&objects, &[red], &lights, Colour::BLACK, f(0.2))?;
+//! let materials = [red];
+//! let scene = Scene::new(&objects, &materials, &lights, Colour::BLACK, f(0.2))?;
 //! let camera = TraceCamera::new([0.0, 0.0, 4.0], [0.0; 3], [0.0, 1.0, 0.0], 60.0, 0.1, 100.0, 32, 24)?;
 //! let mut row = [Rgb565::new(0, 0, 0); 32];
 //! let mut sink = HashSink::new();

@@ -46,6 +46,8 @@ impl core::fmt::Display for TraceSceneError {
     }
 }
 
+impl core::error::Error for TraceSceneError {}
+
 /// The largest material coefficient or light intensity: 8.
 pub const MAX_COEFFICIENT: I16F16 = I16F16::from_bits(8 << 16);
 /// The largest index of refraction: 4 (diamond is 2.42).

@@ -35,6 +35,8 @@ impl core::fmt::Display for ShapeError {
     }
 }
 
+impl core::error::Error for ShapeError {}
+
 /// How far (world units) a polygon vertex may lie off the polygon's plane: 2^-8.
 pub const PLANARITY_TOLERANCE: I16F16 = I16F16::from_bits(1 << 8);
 

@@ -28,7 +28,7 @@ use crate::depth::DepthRow;
 use crate::sink::{Row, RowPixel, RowSink};
 use crate::trace::intersect::{reflect, Ray};
 use crate::trace::scene::{Colour, LightKind, Scene, TraceCamera};
-use crate::trace::vector::{narrow_bits, sqrt, Vec3};
+use crate::trace::vector::{mul, narrow_bits, sqrt, Vec3};
 use embedded_graphics::pixelcolor::Rgb888;
 use fixed::types::{I16F16, I32F32};
 
@@ -144,12 +144,6 @@ pub struct Tracer<'s, 'a, const STACK: usize> {
     scene: &'s Scene<'a>,
     camera: &'s TraceCamera,
     options: TraceOptions,
-}
-
-/// `a · b` for two I16F16 values (products here are of factors below 2^8: no saturation).
-#[inline]
-fn mul(a: I16F16, b: I16F16) -> I16F16 {
-    I16F16::from_bits(narrow_bits(a.wide_mul(b).to_bits()))
 }
 
 impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {

@@ -55,6 +55,7 @@ impl Vec3 {
 
     /// `self + o`, wrapping only outside the envelope (never inside it: 2^13 + 2^13 < 2^15).
     #[inline]
+    #[allow(clippy::should_implement_trait)] // named, not an operator: it wraps outside the envelope
     pub fn add(self, o: Vec3) -> Vec3 {
         let (a, b) = (self.bits(), o.bits());
         Vec3::from_bits(
@@ -66,6 +67,7 @@ impl Vec3 {
 
     /// `self − o` (see [`add`](Self::add)).
     #[inline]
+    #[allow(clippy::should_implement_trait)] // named, not an operator: it wraps outside the envelope
     pub fn sub(self, o: Vec3) -> Vec3 {
         let (a, b) = (self.bits(), o.bits());
         Vec3::from_bits(
@@ -77,6 +79,7 @@ impl Vec3 {
 
     /// `−self`.
     #[inline]
+    #[allow(clippy::should_implement_trait)] // named, not an operator: it wraps outside the envelope
     pub fn neg(self) -> Vec3 {
         let a = self.bits();
         Vec3::from_bits(
@@ -140,6 +143,12 @@ pub const fn narrow_bits(v: i64) -> i32 {
     } else {
         s as i32
     }
+}
+
+/// `a · b` for two I16F16 values, truncated, saturating outside the I16F16 range.
+#[inline]
+pub fn mul(a: I16F16, b: I16F16) -> I16F16 {
+    I16F16::from_bits(narrow_bits(a.wide_mul(b).to_bits()))
 }
 
 /// An I32F32 narrowed to I16F16, or `None` outside the I16F16 range.
