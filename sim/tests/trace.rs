@@ -499,58 +499,28 @@ fn sim_trace_rejects_bad_scenes_and_cameras_with_one_line() {
         .display()
         .to_string();
     let bad = bad.display().to_string();
-    let cases: [(&[&str], &str); 7] = [
+    // (scene, eye, further arguments, what the error says); the target is the origin.
+    let cases: [(&str, &str, &[&str], &str); 10] = [
+        (&bad, "0,0,5", &[], "bad.scene:2: radius -1"),
+        ("/nonexistent.scene", "0,0,5", &[], "nonexistent"),
+        (&good, "0,0,0", &[], "same point"),
+        (&good, "0,5,0", &[], "parallel"),
+        (&good, "0,0,5", &["--fov", "0"], "field of view"),
+        (&good, "0,0,5", &["--near", "5", "--far", "1"], "near"),
+        (&good, "0,0,5", &["--renderer", "magic"], "magic"),
         (
-            &["trace", &bad, "--eye", "0,0,5", "--target", "0,0,0"],
-            "bad.scene:2: radius -1",
+            &good,
+            "0,0,5",
+            &["--max-depth", "1000"],
+            "max depth 1000 exceeds 64",
         ),
-        (
-            &[
-                "trace",
-                "/nonexistent.scene",
-                "--eye",
-                "0,0,5",
-                "--target",
-                "0,0,0",
-            ],
-            "nonexistent",
-        ),
-        (
-            &["trace", &good, "--eye", "0,0,0", "--target", "0,0,0"],
-            "same point",
-        ),
-        (
-            &["trace", &good, "--eye", "0,5,0", "--target", "0,0,0"],
-            "parallel",
-        ),
-        (
-            &[
-                "trace", &good, "--eye", "0,0,5", "--target", "0,0,0", "--fov", "0",
-            ],
-            "field of view",
-        ),
-        (
-            &[
-                "trace", &good, "--eye", "0,0,5", "--target", "0,0,0", "--near", "5", "--far", "1",
-            ],
-            "near",
-        ),
-        (
-            &[
-                "trace",
-                &good,
-                "--eye",
-                "0,0,5",
-                "--target",
-                "0,0,0",
-                "--renderer",
-                "magic",
-            ],
-            "magic",
-        ),
+        (&good, "0,0,5", &["--threshold=-1"], "threshold -1"),
+        (&good, "0,0,5", &["--size", "0x10"], "size 0x10"),
     ];
-    for (args, want) in cases {
-        let (code, stdout, stderr) = sim(args);
+    for (scene, eye, extra, want) in cases {
+        let mut args = vec!["trace", scene, "--eye", eye, "--target", "0,0,0"];
+        args.extend_from_slice(extra);
+        let (code, stdout, stderr) = sim(&args);
         assert_eq!(code, 2, "{args:?}: {stdout}{stderr}");
         assert_eq!(stderr.lines().count(), 1, "{args:?}: {stderr}");
         assert!(
@@ -559,4 +529,148 @@ fn sim_trace_rejects_bad_scenes_and_cameras_with_one_line() {
         );
     }
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+mod hostile {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Tokens of every kind, well-formed and not: keywords, numbers from tiny to huge, names.
+    fn token() -> impl Strategy<Value = String> {
+        prop_oneof![
+            prop::sample::select(vec![
+                "sphere",
+                "plane",
+                "box",
+                "cylinder",
+                "cone",
+                "ellipsoid",
+                "polygon",
+                "mesh",
+                "light",
+                "point",
+                "directional",
+                "material",
+                "background",
+                "ambient",
+                "m",
+                "glass",
+                "diamond",
+                "nan",
+                "inf",
+                "-inf",
+                "1e308",
+                "-1e308",
+                "1e-300",
+                "0",
+                "-0",
+                "#",
+                "x.obj",
+                "",
+            ])
+            .prop_map(String::from),
+            (-1e6f64..1e6).prop_map(|v| format!("{v}")),
+            (-3.0f64..3.0).prop_map(|v| format!("{v:.2}")),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+        /// Random lines after a valid material: either a scene or one line naming the line.
+        #[test]
+        fn random_scene_text_never_panics(
+            lines in proptest::collection::vec(proptest::collection::vec(token(), 0..14), 0..8)
+        ) {
+            let text = std::iter::once("material m 1 1 1 0.2 0.8 0.3 0.3 glass".to_string())
+                .chain(lines.iter().map(|l| l.join(" ")))
+                .collect::<Vec<_>>()
+                .join("\n");
+            match TracedScene::parse(&text, Path::new("/nonexistent"), "h.scene") {
+                Ok(_) => {}
+                Err(e) => {
+                    prop_assert!(e.starts_with("h.scene:") && !e.contains('\n'), "{}", e);
+                }
+            }
+        }
+
+        /// Valid scenes with extreme but finite numbers trace without panicking, and every
+        /// structure gives the same image.
+        #[test]
+        fn extreme_scenes_trace(
+            scale in prop::sample::select(vec![1e-6, 1.0, 1e6, 1e150]),
+            spheres in proptest::collection::vec(([-3.0f64..3.0, -3.0f64..3.0, -3.0f64..3.0], 0.01f64..2.0), 1..6),
+            depth in 0u32..8,
+        ) {
+            let mut text = String::from(
+                "light point 0 5 5 1\nlight directional 1 1 0 0.5\n\
+                 material m 1 1 1 0.2 0.8 0.4 0.6 diamond\nplane 0 1 0 3 m\n",
+            );
+            for (c, r) in &spheres {
+                text += &format!("sphere {} {} {} {} m\n", c[0] * scale, c[1] * scale, c[2] * scale, r * scale);
+                text += &format!("box {} {} {} {} {} {} m\n", c[0] * scale, c[1] * scale, c[2] * scale,
+                    (c[0] + r) * scale, (c[1] + r) * scale, (c[2] + r) * scale);
+            }
+            let scene = parse(&text);
+            let cam = CameraSpec {
+                eye: [0.0, 0.0, 8.0 * scale],
+                target: [0.0; 3],
+                up: [0.0, 1.0, 0.0],
+                fovy: 60.0,
+                near: 0.01 * scale,
+                far: 100.0 * scale,
+            };
+            let limits = Limits { max_depth: depth, threshold: 0.0 };
+            let brute = render(&scene, &cam, 6, 4, limits, Structure::None).unwrap();
+            for st in [Structure::Bvh, Structure::Grid, Structure::Both] {
+                let img = render(&scene, &cam, 6, 4, limits, st).unwrap();
+                prop_assert_eq!(&img.ids, &brute.ids);
+                prop_assert_eq!(&img.color, &brute.color);
+            }
+        }
+    }
+}
+
+#[test]
+fn primary_rays_see_eye_depths_in_near_to_far() {
+    // A unit sphere 3 in front of the eye: the centre pixel meets it at eye depths 2 and 4.
+    let scene = parse("ambient 1\nmaterial m 1 1 1 1 0 0 0 1\nsphere 0 0 -3 1 m\n");
+    let accel = Accel::build(&scene, Structure::None);
+    let tracer = Tracer::new(&accel, Limits::default());
+    let depth_seen = |near: f64, far: f64| {
+        let spec = CameraSpec {
+            eye: [0.0; 3],
+            target: [0.0, 0.0, -1.0],
+            up: [0.0, 1.0, 0.0],
+            fovy: 40.0,
+            near,
+            far,
+        };
+        let cam = check_camera(&spec).unwrap();
+        let mut stats = TraceStats::default();
+        tracer.pixel(&cam, 0, 0, 1, 1, &mut stats).hit.map(|h| h.t)
+    };
+    assert_eq!(depth_seen(0.1, 10.0), Some(2.0));
+    assert_eq!(depth_seen(2.0, 10.0), Some(2.0), "near is included");
+    assert_eq!(
+        depth_seen(2.5, 10.0),
+        Some(4.0),
+        "the front is clipped: the inside shows"
+    );
+    assert_eq!(depth_seen(2.5, 4.0), None, "far is excluded");
+    assert_eq!(depth_seen(0.1, 2.0), None);
+}
+
+#[test]
+fn the_depth_image_holds_eye_depth_along_the_view_axis() {
+    // A wall facing the camera 5 units away: every pixel's eye depth is 5, not its distance.
+    let scene = parse("ambient 1\nmaterial m 1 1 1 1 0 0 0 1\nplane 0 0 1 5 m\n");
+    let cam = camera([0.0; 3], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]);
+    let img = render(&scene, &cam, 9, 7, Limits::default(), Structure::None).unwrap();
+    assert!(img.ids.iter().all(|&id| id == 0));
+    assert!(
+        img.depth.iter().all(|&d| (d - 5.0).abs() < 1e-5),
+        "{:?}",
+        img.depth
+    );
 }

@@ -14,7 +14,7 @@ use super::intersect::Aabb;
 use super::query::Query;
 
 /// Target cells per object.
-pub const CELLS_PER_OBJECT: f64 = 2.0;
+pub const CELLS_PER_OBJECT: f64 = 4.0;
 /// Most cells along one axis.
 pub const MAX_CELLS: usize = 64;
 
@@ -164,5 +164,68 @@ impl Grid {
             cell[axis] = next as usize;
             t_next[axis] += t_delta[axis];
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::trace::accel::{Accel, Structure};
+    use crate::trace::query::Counters;
+    use crate::trace::scene::TracedScene;
+    use crate::trace::vector::{Ray, Span};
+    use std::path::Path;
+
+    /// Unit boxes on a 4×4×4 lattice (touching faces) and small spheres between them: rays
+    /// along cell boundaries, parallel to axes and from inside must find what brute force finds.
+    #[test]
+    fn dda_agrees_with_brute_force_on_boundaries_and_axis_parallel_rays() {
+        let mut text = String::from("material m 1 1 1 0 1 0 0 1\n");
+        for x in 0..4 {
+            for y in 0..4 {
+                for z in 0..4 {
+                    if (x + y + z) % 3 == 0 {
+                        text += &format!("box {x} {y} {z} {} {} {} m\n", x + 1, y + 1, z + 1);
+                    } else if (x * y + z) % 4 == 1 {
+                        text += &format!("sphere {}.5 {}.5 {}.5 0.3 m\n", x, y, z);
+                    }
+                }
+            }
+        }
+        let scene = TracedScene::parse(&text, Path::new("."), "lattice").unwrap();
+        let brute = Accel::build(&scene, Structure::None);
+        let grid = Accel::build(&scene, Structure::Grid);
+        let both = Accel::build(&scene, Structure::Both);
+        let bvh = Accel::build(&scene, Structure::Bvh);
+        assert!(grid.grid_dims().unwrap().iter().all(|&d| d > 1));
+        let mut rays = Vec::new();
+        for a in 0..=8 {
+            for b in 0..=8 {
+                let (u, v) = (a as f64 * 0.5, b as f64 * 0.5);
+                // Axis-parallel rays, on and between cell boundaries, both directions.
+                for (o, d) in [
+                    ([-1.0, u, v], [1.0, 0.0, 0.0]),
+                    ([5.0, u, v], [-1.0, 0.0, 0.0]),
+                    ([u, -1.0, v], [0.0, 1.0, 0.0]),
+                    ([u, v, 5.0], [0.0, 0.0, -1.0]),
+                    ([u, v, 2.0], [0.6, 0.0, 0.8]),
+                    ([u, 2.0, v], [-0.48, 0.6, 0.64]),
+                ] {
+                    rays.push(Ray { origin: o, dir: d });
+                }
+            }
+        }
+        let span = Span::open(1e-9, f64::INFINITY);
+        let mut hits = 0;
+        for ray in &rays {
+            let mut c = Counters::default();
+            let want = brute.nearest(*ray, span, &mut c);
+            hits += want.is_some() as usize;
+            assert_eq!(grid.nearest(*ray, span, &mut c), want, "{ray:?}");
+            assert_eq!(both.nearest(*ray, span, &mut c), want, "{ray:?}");
+            assert_eq!(bvh.nearest(*ray, span, &mut c), want, "{ray:?}");
+            let blocked = want.is_some();
+            assert_eq!(grid.blocked(*ray, span, &mut c), blocked);
+        }
+        assert!(hits > rays.len() / 3, "{hits} of {}", rays.len());
     }
 }

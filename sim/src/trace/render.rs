@@ -34,6 +34,7 @@ pub fn render(
     structure: Structure,
 ) -> Result<TracedImage, String> {
     let cam = check_camera(camera)?;
+    limits.check()?;
     if w == 0 || h == 0 {
         return Err(format!("image size {w}x{h} is empty"));
     }

@@ -36,6 +36,10 @@ pub const DEFAULT_MAX_DEPTH: u32 = 4;
 /// Default weight threshold: 2⁻⁸, a ray whose weight is below one 8-bit step is not traced.
 pub const DEFAULT_THRESHOLD: f64 = 1.0 / 256.0;
 
+/// Largest depth limit accepted: the f64 tracer recurses once per level, and a deeper tree
+/// than this adds nothing an 8-bit pixel can show unless every surface is a perfect mirror.
+pub const MAX_DEPTH_LIMIT: u32 = 64;
+
 /// Ray-tree limits.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Limits {
@@ -43,6 +47,25 @@ pub struct Limits {
     pub max_depth: u32,
     /// A secondary ray is traced only if its weight is ≥ this.
     pub threshold: f64,
+}
+
+impl Limits {
+    /// Checks the limits: `max_depth ≤ MAX_DEPTH_LIMIT`, `threshold` finite and ≥ 0.
+    pub fn check(&self) -> Result<(), String> {
+        if self.max_depth > MAX_DEPTH_LIMIT {
+            return Err(format!(
+                "max depth {} exceeds {MAX_DEPTH_LIMIT}",
+                self.max_depth
+            ));
+        }
+        if !(self.threshold.is_finite() && self.threshold >= 0.0) {
+            return Err(format!(
+                "threshold {} must be a finite number >= 0",
+                self.threshold
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl Default for Limits {
