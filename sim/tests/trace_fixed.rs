@@ -157,3 +157,73 @@ fn the_hierarchy_cuts_tests_on_the_mesh_tenfold() {
     );
     assert!(brute >= 10.0 * bvh);
 }
+
+/// The firmware's scene data is what `sim export` makes of the corpus's classic scene today.
+#[test]
+fn the_firmware_scene_is_the_exported_classic_scene() {
+    let scene = corpus::by_name("classic").unwrap();
+    let fixed_scene = fixed::FixedScene::new(&scene.load().unwrap()).unwrap();
+    let source = fixed::export_source(&fixed_scene, "sim export sim/scenes/classic.scene");
+    let source = scanline3d_sim::export::rustfmt(&source).expect("rustfmt runs");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../firmware/examples/trace/classic.rs"
+    );
+    let committed = std::fs::read_to_string(path).unwrap();
+    assert!(
+        source == committed,
+        "firmware/examples/trace/classic.rs is stale: run `cargo run --bin sim -- export sim/scenes/classic.scene --out firmware/examples/trace/classic.rs`"
+    );
+}
+
+/// `sim trace --renderer fixed` writes the images, and rejects a depth limit its stack cannot
+/// hold with a one-line error and exit status 2.
+#[test]
+fn sim_trace_renders_with_the_fixed_tracer() {
+    let dir = std::env::temp_dir().join(format!("trace_fixed_cli_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (png, ids, shadow) = (
+        dir.join("f.png"),
+        dir.join("ids.bin"),
+        dir.join("shadow.bin"),
+    );
+    let scene = corpus::by_name("classic").unwrap().path();
+    let run = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_sim"))
+            .args([
+                "trace",
+                scene.to_str().unwrap(),
+                "--eye",
+                "0,3,7",
+                "--target",
+                "0,0.8,0",
+            ])
+            .args(["--fov", "50", "--size", "32x24", "--renderer", "fixed"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = run(&[
+        "--out",
+        png.to_str().unwrap(),
+        "--ids",
+        ids.to_str().unwrap(),
+        "--shadow",
+        shadow.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(std::fs::read(&ids).unwrap().len(), 32 * 24 * 4);
+    assert_eq!(std::fs::read(&shadow).unwrap().len(), 32 * 24);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("fixed-point tracer"), "{stdout}");
+    let deep = run(&["--out", png.to_str().unwrap(), "--max-depth", "40"]);
+    assert_eq!(deep.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&deep.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("--max-depth 40"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
