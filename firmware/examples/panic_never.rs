@@ -17,7 +17,8 @@
 //! It also traces the classic scene with the fixed-point ray tracer (`scanline3d::trace`):
 //! scene and camera set-up, every intersection test, shadows, reflection, refraction and the
 //! ray stack, with a stack too small for the depth limit so the overflow path is linked too,
-//! without and with a bounding-volume hierarchy (exported, and built at run time).
+//! without and with a bounding-volume hierarchy (exported, and built at run time) and with a
+//! uniform grid built at run time.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -180,6 +181,29 @@ mod firmware {
                 );
                 if let Ok(with_bvh) = built {
                     black_box(Tracer::<STACK>::new(&with_bvh, &camera, options).trace_pixel(5, 6));
+                }
+            }
+            // And a uniform grid built at run time.
+            use scanline3d::trace::grid::{self, GridShape};
+            let corner = |v: i32| scanline3d::trace::Vec3::from_bits(v, v / 2, v);
+            let cell = black_box(fixed::types::I16F16::ONE);
+            if let Ok(shape) = GridShape::around(corner(-5 << 16), corner(5 << 16), cell) {
+                let mut starts = [0u32; 1024];
+                let mut items = [0u32; 1024];
+                let mut planes = [0u32; 8];
+                let built = grid::build(scene.objects, shape, &mut starts, &mut items, &mut planes);
+                if let Ok((used, unbounded)) = built {
+                    let with_grid = scene.with_grid(
+                        shape,
+                        starts.get(..=shape.cells()).unwrap_or(&[]),
+                        items.get(..used).unwrap_or(&[]),
+                        planes.get(..unbounded).unwrap_or(&[]),
+                    );
+                    if let Ok(with_grid) = with_grid {
+                        let stats = Tracer::<STACK>::new(&with_grid, &camera, options)
+                            .render(&mut row, sink);
+                        black_box(&stats);
+                    }
                 }
             }
         }

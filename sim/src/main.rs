@@ -135,7 +135,7 @@ struct TraceArgs {
     #[arg(long, value_parser = finite, default_value_t = scanline3d_sim::trace::whitted::DEFAULT_THRESHOLD)]
     threshold: f64,
     /// Acceleration structure (same image, different work). The fixed tracer has the
-    /// hierarchy only: any value but `none` gives it the hierarchy.
+    /// hierarchy and the grid but not their combination: `both` gives it the hierarchy.
     #[arg(long, value_enum, default_value = "both")]
     accel: TraceAccel,
     /// Also trace with every acceleration structure, check the images are identical and print
@@ -699,19 +699,24 @@ fn trace(a: TraceArgs) -> Result<(), String> {
                 w,
                 h,
                 fixed::options(a.max_depth, a.threshold)?,
-                a.accel != TraceAccel::None,
+                match a.accel {
+                    TraceAccel::None => fixed::Accel::None,
+                    TraceAccel::Bvh | TraceAccel::Both => fixed::Accel::Bvh,
+                    TraceAccel::Grid => fixed::Accel::Grid,
+                },
             )?;
             let s = &f.stats;
             let summary = format!(
-                "{} objects, {} lights; fixed-point tracer: rays: {} primary, {} secondary, {} shadow; tests per ray ({}): {:.2} objects, {:.2} boxes; {} rays dropped (stack full)",
+                "{} objects, {} lights; fixed-point tracer: rays: {} primary, {} secondary, {} shadow; tests per ray ({:?}): {:.2} objects, {:.2} boxes, {:.2} grid cells; {} rays dropped (stack full)",
                 traced.objects.len(),
                 traced.lights.len(),
                 s.primary_rays,
                 s.secondary_rays,
                 s.shadow_rays,
-                if a.accel == TraceAccel::None { "none" } else { "bvh" },
+                a.accel,
                 f64::from(s.intersection_tests) / f64::from(s.rays().max(1)),
                 f64::from(s.box_tests) / f64::from(s.rays().max(1)),
+                f64::from(s.grid_cells) / f64::from(s.rays().max(1)),
                 s.dropped_rays
             );
             (f.colour, f.ids, f.depth, f.shadow, summary)

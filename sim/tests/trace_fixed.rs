@@ -49,7 +49,7 @@ fn compare(
     let fixed_scene =
         fixed::FixedScene::new(&traced).unwrap_or_else(|e| panic!("{} {label}: {e}", scene.name));
     let options = fixed::options(limits.max_depth, limits.threshold).unwrap();
-    let ours = fixed::render(&fixed_scene, cam, SIZE, SIZE, options, true).unwrap();
+    let ours = fixed::render(&fixed_scene, cam, SIZE, SIZE, options, fixed::Accel::Bvh).unwrap();
     assert_eq!(ours.stats.dropped_rays, 0);
     let n = SIZE * SIZE;
     let mut c = Comparison {
@@ -113,49 +113,59 @@ fn fixed_tracer_matches_the_reference_on_every_corpus_scene() {
     assert!(failures.is_empty(), "outside the bounds: {failures:?}");
 }
 
-/// The hierarchy changes the work, not the image: the classic scene is traced to the same
-/// pixels with and without it, with far fewer intersection tests.
+/// The hierarchy and the grid change the work, not the image: the classic scene is traced to
+/// the same pixels with each and without, with far fewer intersection tests.
 #[test]
-fn the_hierarchy_gives_the_same_image_with_fewer_tests() {
+fn the_accelerations_give_the_same_image_with_fewer_tests() {
     let scene = corpus::by_name("classic").unwrap();
     let (_, cam) = &scene.cameras[0];
     let fixed_scene = fixed::FixedScene::new(&scene.load().unwrap()).unwrap();
     let options = scanline3d::trace::TraceOptions::default();
-    let plain = fixed::render(&fixed_scene, cam, 64, 64, options, false).unwrap();
-    let fast = fixed::render(&fixed_scene, cam, 64, 64, options, true).unwrap();
-    assert_eq!(plain.colour, fast.colour);
-    assert_eq!(plain.ids, fast.ids);
-    assert_eq!(plain.shadow, fast.shadow);
-    assert_eq!(plain.stats.rays(), fast.stats.rays());
+    let render = |accel| fixed::render(&fixed_scene, cam, 64, 64, options, accel).unwrap();
+    let plain = render(fixed::Accel::None);
     let per_ray =
         |s: &scanline3d::trace::TraceStats| f64::from(s.intersection_tests) / f64::from(s.rays());
-    eprintln!(
-        "classic, tests per ray: {:.2} without, {:.2} objects + {:.2} boxes with the hierarchy",
-        per_ray(&plain.stats),
-        per_ray(&fast.stats),
-        f64::from(fast.stats.box_tests) / f64::from(fast.stats.rays())
-    );
-    assert!(per_ray(&plain.stats) >= 10.0 * per_ray(&fast.stats));
+    for accel in [fixed::Accel::Bvh, fixed::Accel::Grid] {
+        let fast = render(accel);
+        assert_eq!(plain.colour, fast.colour, "{accel:?}");
+        assert_eq!(plain.ids, fast.ids, "{accel:?}");
+        assert_eq!(plain.shadow, fast.shadow, "{accel:?}");
+        assert_eq!(plain.stats.rays(), fast.stats.rays(), "{accel:?}");
+        let rays = f64::from(fast.stats.rays());
+        eprintln!(
+            "classic, tests per ray: {:.2} without, {:.2} objects + {:.2} boxes + {:.2} cells with {accel:?}",
+            per_ray(&plain.stats),
+            per_ray(&fast.stats),
+            f64::from(fast.stats.box_tests) / rays,
+            f64::from(fast.stats.grid_cells) / rays
+        );
+        assert!(
+            per_ray(&plain.stats) >= 5.0 * per_ray(&fast.stats),
+            "{accel:?}"
+        );
+    }
 }
 
-/// On the 1,280-triangle mesh, the hierarchy needs at least 10× fewer tests per ray than
-/// testing every object (boxes and objects counted together).
+/// On the 1,280-triangle mesh each structure needs at least 10× fewer tests per ray than
+/// testing every object (boxes and cells counted as tests too).
 #[test]
-fn the_hierarchy_cuts_tests_on_the_mesh_tenfold() {
+fn each_structure_cuts_tests_on_the_mesh_tenfold() {
     let scene = corpus::by_name("mesh").unwrap();
     let (_, cam) = &scene.cameras[0];
     let fixed_scene = fixed::FixedScene::new(&scene.load().unwrap()).unwrap();
     let options = scanline3d::trace::TraceOptions::default();
-    let plain = fixed::render(&fixed_scene, cam, 24, 24, options, false).unwrap();
-    let fast = fixed::render(&fixed_scene, cam, 24, 24, options, true).unwrap();
-    assert_eq!(plain.ids, fast.ids);
+    let render = |accel| fixed::render(&fixed_scene, cam, 24, 24, options, accel).unwrap();
+    let plain = render(fixed::Accel::None);
     let brute = f64::from(plain.stats.intersection_tests) / f64::from(plain.stats.rays());
-    let bvh = f64::from(fast.stats.intersection_tests + fast.stats.box_tests)
-        / f64::from(fast.stats.rays());
-    eprintln!(
-        "mesh, tests per ray: {brute:.1} without, {bvh:.1} (objects + boxes) with the hierarchy"
-    );
-    assert!(brute >= 10.0 * bvh);
+    for accel in [fixed::Accel::Bvh, fixed::Accel::Grid] {
+        let fast = render(accel);
+        assert_eq!(plain.ids, fast.ids, "{accel:?}");
+        let s = &fast.stats;
+        let work =
+            f64::from(s.intersection_tests + s.box_tests + s.grid_cells) / f64::from(s.rays());
+        eprintln!("mesh, tests per ray: {brute:.1} without, {work:.1} (objects + boxes + cells) with {accel:?}");
+        assert!(brute >= 10.0 * work, "{accel:?}");
+    }
 }
 
 /// The firmware's scene data is what `sim export` makes of the corpus's classic scene today.

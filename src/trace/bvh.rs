@@ -431,8 +431,8 @@ impl<'a> Bvh<'a> {
     }
 }
 
-/// A ray's origin and the reciprocals of its direction, for box tests.
-struct RayInverse {
+/// A ray's origin and the reciprocals of its direction, for box tests (shared with the grid).
+pub(crate) struct RayInverse {
     origin: [i64; 3],
     /// 1/dir per axis in 16 fraction bits (|value| < 2^32 raw), truncated (relative error
     /// below 2^-16); `None` for a zero component.
@@ -440,7 +440,7 @@ struct RayInverse {
 }
 
 impl RayInverse {
-    fn new(ray: &Ray) -> RayInverse {
+    pub(crate) fn new(ray: &Ray) -> RayInverse {
         let d = ray.dir.bits();
         RayInverse {
             origin: ray.origin.bits().map(i64::from),
@@ -452,22 +452,40 @@ impl RayInverse {
         }
     }
 
+    /// The reciprocal of the direction's component `axis` (16 fraction bits), if not 0.
+    pub(crate) fn reciprocal(&self, axis: usize) -> Option<i64> {
+        self.inv.get(axis).copied().flatten()
+    }
+
     /// Whether the ray is inside the node's box for some `t` in `[t_min, t_max)`.
     #[inline]
     fn enters(&self, n: &BvhNode, t_min: I16F16, t_max: I16F16) -> bool {
-        // In 32 fraction bits.
+        self.span(n.min.bits(), n.max.bits().map(i64::from), t_min, t_max)
+            .is_some()
+    }
+
+    /// The interval of `t` (32 fraction bits) within `[t_min, t_max]` in which the ray is
+    /// inside the box `min..max` (raw I16F16 bits), if any.
+    #[inline]
+    pub(crate) fn span(
+        &self,
+        min: [i32; 3],
+        max: [i64; 3],
+        t_min: I16F16,
+        t_max: I16F16,
+    ) -> Option<(i64, i64)> {
         let (mut lo, mut hi) = (I32F32::from(t_min).to_bits(), I32F32::from(t_max).to_bits());
         let slabs = self
             .origin
             .iter()
             .zip(&self.inv)
-            .zip(n.min.bits().into_iter().zip(n.max.bits()));
+            .zip(min.into_iter().zip(max));
         for ((&o, inv), (a, b)) in slabs {
-            let (a, b) = (i64::from(a), i64::from(b));
+            let a = i64::from(a);
             match *inv {
                 None => {
                     if o < a || o > b {
-                        return false;
+                        return None;
                     }
                 }
                 Some(inv) => {
@@ -478,7 +496,7 @@ impl RayInverse {
                 }
             }
         }
-        lo <= hi
+        (lo <= hi).then_some((lo, hi))
     }
 }
 

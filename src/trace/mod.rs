@@ -44,6 +44,7 @@
 //! ```
 
 pub mod bvh;
+pub mod grid;
 pub mod intersect;
 pub mod scene;
 pub mod shape;

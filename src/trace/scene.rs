@@ -3,6 +3,7 @@
 //! the camera that makes primary rays.
 
 use crate::trace::bvh::{Bvh, BvhError, BvhNode};
+use crate::trace::grid::{Grid, GridError, GridShape};
 use crate::trace::shape::Object;
 use crate::trace::vector::{Vec3, MAX_COORD};
 use fixed::types::{I16F16, I8F24};
@@ -182,9 +183,33 @@ pub struct Scene<'a> {
     /// A bounding-volume hierarchy over the objects ([`Scene::with_bvh`]); without one every
     /// ray tests every object.
     pub bvh: Option<Bvh<'a>>,
+    /// A uniform grid over the objects ([`Scene::with_grid`]); used instead of the hierarchy
+    /// when both are given.
+    pub grid: Option<Grid<'a>>,
 }
 
 impl<'a> Scene<'a> {
+    /// The scene with a uniform grid over its objects, as
+    /// [`grid::build`](crate::trace::grid::build) made it, checked by [`Grid::new`].
+    pub fn with_grid(
+        self,
+        shape: GridShape,
+        starts: &'a [u32],
+        items: &'a [u32],
+        unbounded: &'a [u32],
+    ) -> Result<Scene<'a>, GridError> {
+        Ok(Scene {
+            grid: Some(Grid::new(
+                shape,
+                starts,
+                items,
+                unbounded,
+                self.objects.len(),
+            )?),
+            ..self
+        })
+    }
+
     /// The scene with a bounding-volume hierarchy over its objects, as
     /// [`bvh::build`](crate::trace::bvh::build) made it (nodes, items and how many items are in
     /// the tree), checked against the objects by [`Bvh::new`].
@@ -231,6 +256,7 @@ impl<'a> Scene<'a> {
             background,
             ambient,
             bvh: None,
+            grid: None,
         })
     }
 }

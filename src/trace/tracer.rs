@@ -73,6 +73,8 @@ pub struct TraceStats {
     pub intersection_tests: u32,
     /// Ray–box tests in the bounding-volume hierarchy.
     pub box_tests: u32,
+    /// Grid cells visited.
+    pub grid_cells: u32,
     /// Secondary rays not traced because the ray stack was full (0 when `STACK > max_depth`).
     pub dropped_rays: u32,
     /// Most pending rays on the stack at once.
@@ -93,6 +95,7 @@ impl TraceStats {
         self.shadow_rays += o.shadow_rays;
         self.intersection_tests += o.intersection_tests;
         self.box_tests += o.box_tests;
+        self.grid_cells += o.grid_cells;
         self.dropped_rays += o.dropped_rays;
         self.peak_stack = self.peak_stack.max(o.peak_stack);
     }
@@ -266,14 +269,21 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 None => limit,
             }
         };
-        match &self.scene.bvh {
-            None => {
+        match (&self.scene.grid, &self.scene.bvh) {
+            (Some(grid), _) => {
+                let mut limit = t_max;
+                for id in grid.unbounded() {
+                    limit = test(*id, limit);
+                }
+                stats.grid_cells += grid.walk(ray, t_min, limit, |id, limit| Some(test(id, limit)));
+            }
+            (None, None) => {
                 let mut limit = t_max;
                 for id in 0..self.scene.objects.len() as u32 {
                     limit = test(id, limit);
                 }
             }
-            Some(bvh) => {
+            (None, Some(bvh)) => {
                 let mut limit = t_max;
                 for id in bvh.unbounded() {
                     limit = test(*id, limit);
@@ -304,9 +314,19 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             tests += 1;
             self.hit(id, ray, from, EPSILON, t_max).is_some()
         };
-        let blocked = match &self.scene.bvh {
-            None => (0..self.scene.objects.len() as u32).any(&mut blocks),
-            Some(bvh) => {
+        let blocked = match (&self.scene.grid, &self.scene.bvh) {
+            (Some(grid), _) => {
+                let mut found = grid.unbounded().iter().any(|id| blocks(*id));
+                if !found {
+                    stats.grid_cells += grid.walk(ray, EPSILON, t_max, |id, limit| {
+                        found = blocks(id);
+                        (!found).then_some(limit)
+                    });
+                }
+                found
+            }
+            (None, None) => (0..self.scene.objects.len() as u32).any(&mut blocks),
+            (None, Some(bvh)) => {
                 let mut found = bvh.unbounded().iter().any(|id| blocks(*id));
                 if !found {
                     stats.box_tests += bvh.walk(ray, EPSILON, t_max, |id, limit| {

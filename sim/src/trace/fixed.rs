@@ -11,6 +11,7 @@ use embedded_graphics::pixelcolor::Rgb565;
 use fixed::types::I16F16;
 use scanline3d::sink::HashSink;
 use scanline3d::trace::bvh::{self, BvhNode};
+use scanline3d::trace::grid::{self, GridShape};
 use scanline3d::trace::shape::{AaBox, Ellipsoid, Facet, Frustum};
 use scanline3d::trace::{
     Colour, Light, LightKind, Material, Object, Plane, Polygon, Scene, Shape, Sphere, TraceCamera,
@@ -59,6 +60,20 @@ pub struct FixedScene {
     /// The bounding-volume hierarchy the library built over the objects: nodes, items and how
     /// many items are in the tree.
     pub bvh: (Vec<BvhNode>, Vec<u32>, usize),
+    /// The uniform grid the library built over the objects: shape, cell starts, cell items,
+    /// unbounded objects.
+    pub grid: (GridShape, Vec<u32>, Vec<u32>, Vec<u32>),
+}
+
+/// Which acceleration structure the fixed tracer uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Accel {
+    /// Every ray tests every object.
+    None,
+    /// The bounding-volume hierarchy.
+    Bvh,
+    /// The uniform grid (3D-DDA).
+    Grid,
 }
 
 impl FixedScene {
@@ -149,6 +164,16 @@ impl FixedScene {
             background: colour(scene.background, "background")?,
             ambient: fix(scene.ambient, "ambient")?,
             bvh: (Vec::new(), Vec::new(), 0),
+            grid: (
+                GridShape {
+                    min: Vec3::ZERO,
+                    cell: I16F16::ONE,
+                    dims: [1; 3],
+                },
+                Vec::new(),
+                Vec::new(),
+                Vec::new(),
+            ),
         };
         let objects = fixed.objects();
         let empty = BvhNode {
@@ -163,7 +188,10 @@ impl FixedScene {
         let (used, _, bounded) =
             bvh::build(&objects, &mut nodes, &mut items).map_err(|e| e.to_string())?;
         nodes.truncate(used);
+        let grid = grid_over(&objects)?;
+        drop(objects);
         fixed.bvh = (nodes, items, bounded);
+        fixed.grid = grid;
         Ok(fixed)
     }
 
@@ -183,10 +211,10 @@ impl FixedScene {
             .collect()
     }
 
-    /// Runs `f` with the library scene, with its bounding-volume hierarchy if `accelerate`.
+    /// Runs `f` with the library scene and the acceleration structure `accel`.
     pub fn with_scene<R>(
         &self,
-        accelerate: bool,
+        accel: Accel,
         f: impl FnOnce(&Scene<'_>) -> R,
     ) -> Result<R, String> {
         let objects = self.objects();
@@ -198,14 +226,68 @@ impl FixedScene {
             self.ambient,
         )
         .map_err(|e| e.to_string())?;
-        if accelerate {
-            let (nodes, items, bounded) = &self.bvh;
-            scene = scene
-                .with_bvh(nodes, items, *bounded)
-                .map_err(|e| e.to_string())?;
+        match accel {
+            Accel::None => {}
+            Accel::Bvh => {
+                let (nodes, items, bounded) = &self.bvh;
+                scene = scene
+                    .with_bvh(nodes, items, *bounded)
+                    .map_err(|e| e.to_string())?;
+            }
+            Accel::Grid => {
+                let (shape, starts, items, unbounded) = &self.grid;
+                scene = scene
+                    .with_grid(*shape, starts, items, unbounded)
+                    .map_err(|e| e.to_string())?;
+            }
         }
         Ok(f(&scene))
     }
+}
+
+/// A grid of about 4 cubic cells per bounded object over their common box.
+fn grid_over(objects: &[Object<'_>]) -> Result<(GridShape, Vec<u32>, Vec<u32>, Vec<u32>), String> {
+    let boxes: Vec<_> = objects
+        .iter()
+        .filter_map(|o| bvh::bounds(&o.shape))
+        .collect();
+    let (lo, hi) = boxes
+        .iter()
+        .fold(([f64::MAX; 3], [f64::MIN; 3]), |(lo, hi), (a, b)| {
+            let (a, b) = (a.bits().map(f64::from), b.bits().map(f64::from));
+            (
+                [lo[0].min(a[0]), lo[1].min(a[1]), lo[2].min(a[2])],
+                [hi[0].max(b[0]), hi[1].max(b[1]), hi[2].max(b[2])],
+            )
+        });
+    let raw = |v: [f64; 3]| Vec3::from_bits(v[0] as i32, v[1] as i32, v[2] as i32);
+    let (lo, hi) = if boxes.is_empty() {
+        (Vec3::ZERO, Vec3::ZERO)
+    } else {
+        (raw(lo), raw(hi))
+    };
+    let extent = [hi.x - lo.x, hi.y - lo.y, hi.z - lo.z].map(|e| e.to_num::<f64>().max(1e-3));
+    // Cell volume = box volume / (4 · objects), each axis at least 1/64 of the longest.
+    let longest = extent.iter().cloned().fold(0.0, f64::max);
+    let volume: f64 = extent.iter().map(|e| e.max(longest / 64.0)).product();
+    let cell = (volume / (4.0 * boxes.len().max(1) as f64))
+        .cbrt()
+        .max(longest / 64.0);
+    let shape = GridShape::around(lo, hi, fix(cell, "grid cell")?).map_err(|e| e.to_string())?;
+    let mut starts = vec![0; shape.cells() + 1];
+    let mut unbounded = vec![0; objects.len()];
+    // Count first with room for every pair, then trim.
+    let mut items = vec![0; boxes.len() * 64 + 64];
+    let (used, planes) = loop {
+        match grid::build(objects, shape, &mut starts, &mut items, &mut unbounded) {
+            Ok(r) => break r,
+            Err(scanline3d::trace::grid::GridError::Capacity) => items.resize(items.len() * 4, 0),
+            Err(e) => return Err(e.to_string()),
+        }
+    };
+    items.truncate(used);
+    unbounded.truncate(planes);
+    Ok((shape, starts, items, unbounded))
 }
 
 /// The library camera for `camera` at `w × h`.
@@ -265,10 +347,10 @@ pub fn render(
     w: usize,
     h: usize,
     options: TraceOptions,
-    accelerate: bool,
+    accel: Accel,
 ) -> Result<FixedFrame, String> {
     let camera = camera(cam, w, h)?;
-    scene.with_scene(accelerate, |scene| {
+    scene.with_scene(accel, |scene| {
         let tracer = Tracer::<STACK>::new(scene, &camera, options);
         let mut frame = FixedFrame {
             width: w,
@@ -288,6 +370,7 @@ pub fn render(
                 total.shadow_rays += s.shadow_rays;
                 total.intersection_tests += s.intersection_tests;
                 total.box_tests += s.box_tests;
+                total.grid_cells += s.grid_cells;
                 total.dropped_rays += s.dropped_rays;
                 total.peak_stack = total.peak_stack.max(s.peak_stack);
                 frame
@@ -316,7 +399,7 @@ pub fn frame_hash(
     options: TraceOptions,
 ) -> Result<(u32, TraceStats), String> {
     let camera = camera(cam, w, h)?;
-    scene.with_scene(true, |scene| {
+    scene.with_scene(Accel::Bvh, |scene| {
         let mut row = vec![Rgb565::new(0, 0, 0); w];
         let mut sink = HashSink::new();
         Tracer::<STACK>::new(scene, &camera, options)
