@@ -60,10 +60,12 @@ pub struct FixedScene {
     /// The bounding-volume hierarchy the library built over the objects: nodes, items and how
     /// many items are in the tree.
     pub bvh: (Vec<BvhNode>, Vec<u32>, usize),
-    /// The uniform grid the library built over the objects: shape, cell starts, cell items,
-    /// unbounded objects.
-    pub grid: (GridShape, Vec<u32>, Vec<u32>, Vec<u32>),
+    /// The uniform grid the library built over the objects.
+    pub grid: GridParts,
 }
+
+/// A uniform grid's parts: shape, cell starts, cell items, unbounded objects.
+pub type GridParts = (GridShape, Vec<u32>, Vec<u32>, Vec<u32>);
 
 /// Which acceleration structure the fixed tracer uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -246,7 +248,7 @@ impl FixedScene {
 }
 
 /// A grid of about 4 cubic cells per bounded object over their common box.
-fn grid_over(objects: &[Object<'_>]) -> Result<(GridShape, Vec<u32>, Vec<u32>, Vec<u32>), String> {
+fn grid_over(objects: &[Object<'_>]) -> Result<GridParts, String> {
     let boxes: Vec<_> = objects
         .iter()
         .filter_map(|o| bvh::bounds(&o.shape))
