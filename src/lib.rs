@@ -130,6 +130,7 @@ pub mod scene;
 pub mod shading;
 pub mod sink;
 pub mod stats;
+pub mod trace;
 // A pipeline stage: public only with the feature `internals` (measurement firmware, tests).
 #[cfg(feature = "internals")]
 pub mod vertex;

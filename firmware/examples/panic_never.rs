@@ -14,6 +14,11 @@
 //! and every other hidden-surface method (`scanline3d::resolve`: band and full-frame z-buffer,
 //! span sorting, depth sort, Newell's sort, BSP order, Warnock's subdivision) with flat and
 //! perspective-correct Gouraud shading, on a 64×48 target so that their memory stays small.
+//! It also traces the classic scene with the fixed-point ray tracer (`scanline3d::trace`):
+//! scene and camera set-up, every intersection test, shadows, reflection, refraction and the
+//! ray stack, with a stack too small for the depth limit so the overflow path is linked too,
+//! without and with a bounding-volume hierarchy (exported, and built at run time) and with a
+//! uniform grid built at run time.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -22,6 +27,16 @@ fn main() {
     println!("panic_never is a link-time check: build it for a bare-metal target, e.g.");
     println!("  cargo build --release --example panic_never --target thumbv6m-none-eabi");
 }
+
+#[cfg(target_os = "none")]
+#[allow(dead_code)]
+#[path = "trace/classic.rs"]
+mod classic;
+
+#[cfg(target_os = "none")]
+#[allow(dead_code)]
+#[path = "trace/view.rs"]
+mod view;
 
 #[cfg(target_os = "none")]
 mod firmware {
@@ -118,6 +133,82 @@ mod firmware {
         }
     }
 
+    /// Traces the classic scene from a camera the optimiser cannot see, with the options and
+    /// stack capacity `STACK` given.
+    #[inline(never)]
+    fn trace<const STACK: usize>(options: scanline3d::trace::TraceOptions, sink: &mut HashSink) {
+        use scanline3d::trace::{Scene, TraceCamera, Tracer};
+        let v = black_box(super::view::CLASSIC);
+        let scene = Scene::new(
+            black_box(&super::classic::OBJECTS),
+            &super::classic::MATERIALS,
+            &super::classic::LIGHTS,
+            super::classic::BACKGROUND,
+            super::classic::AMBIENT,
+        );
+        let camera = TraceCamera::new(v.eye, v.target, v.up, v.fovy, v.near, v.far, 64, 48);
+        if let (Ok(scene), Ok(camera)) = (scene, camera) {
+            let mut row = [Rgb565::new(0, 0, 0); W];
+            let stats = Tracer::<STACK>::new(&scene, &camera, options).render(&mut row, sink);
+            black_box(&stats);
+            black_box(Tracer::<STACK>::new(&scene, &camera, options).trace_pixel(3, 4));
+            // With the exported bounding-volume hierarchy, and one built here at run time.
+            let exported = scene.with_bvh(
+                black_box(&super::classic::BVH_NODES),
+                &super::classic::BVH_ITEMS,
+                black_box(super::classic::BVH_BOUNDED),
+            );
+            if let Ok(with_bvh) = exported {
+                let stats =
+                    Tracer::<STACK>::new(&with_bvh, &camera, options).render(&mut row, sink);
+                black_box(&stats);
+            }
+            let mut nodes = [scanline3d::trace::bvh::BvhNode {
+                min: scanline3d::trace::Vec3::ZERO,
+                max: scanline3d::trace::Vec3::ZERO,
+                index: 0,
+                count: 0,
+                axis: 0,
+            }; 2 * super::classic::OBJECTS.len()];
+            let mut items = [0u32; super::classic::OBJECTS.len()];
+            if let Ok((used, total, bounded)) =
+                scanline3d::trace::bvh::build(scene.objects, &mut nodes, &mut items)
+            {
+                let built = scene.with_bvh(
+                    nodes.get(..used).unwrap_or(&[]),
+                    items.get(..total).unwrap_or(&[]),
+                    bounded,
+                );
+                if let Ok(with_bvh) = built {
+                    black_box(Tracer::<STACK>::new(&with_bvh, &camera, options).trace_pixel(5, 6));
+                }
+            }
+            // And a uniform grid built at run time.
+            use scanline3d::trace::grid::{self, GridShape};
+            let corner = |v: i32| scanline3d::trace::Vec3::from_bits(v, v / 2, v);
+            let cell = black_box(fixed::types::I16F16::ONE);
+            if let Ok(shape) = GridShape::around(corner(-5 << 16), corner(5 << 16), cell) {
+                let mut starts = [0u32; 1024];
+                let mut items = [0u32; 1024];
+                let mut planes = [0u32; 8];
+                let built = grid::build(scene.objects, shape, &mut starts, &mut items, &mut planes);
+                if let Ok((used, unbounded)) = built {
+                    let with_grid = scene.with_grid(
+                        shape,
+                        starts.get(..=shape.cells()).unwrap_or(&[]),
+                        items.get(..used).unwrap_or(&[]),
+                        planes.get(..unbounded).unwrap_or(&[]),
+                    );
+                    if let Ok(with_grid) = with_grid {
+                        let stats = Tracer::<STACK>::new(&with_grid, &camera, options)
+                            .render(&mut row, sink);
+                        black_box(&stats);
+                    }
+                }
+            }
+        }
+    }
+
     #[cfg_attr(target_arch = "arm", cortex_m_rt::entry)]
     #[cfg_attr(target_arch = "riscv32", riscv_rt::entry)]
     fn main() -> ! {
@@ -155,6 +246,12 @@ mod firmware {
                     core::hint::black_box(sink.hash());
                 }
             }
+            // The fixed-point tracer, with room for its ray tree and with too little.
+            let options = black_box(scanline3d::trace::TraceOptions::default());
+            let mut sink = scanline3d::sink::HashSink::new();
+            trace::<5>(options, &mut sink);
+            trace::<2>(options, &mut sink);
+            black_box(sink.hash());
             frame = frame.wrapping_add(1);
         }
     }

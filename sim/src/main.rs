@@ -71,6 +71,8 @@ enum Renderer {
 enum TraceRenderer {
     /// The f64 Whitted tracer.
     Reference,
+    /// The library's fixed-point tracer (`scanline3d::trace`), what the firmware runs.
+    Fixed,
 }
 
 /// Which acceleration structure the reference tracer uses.
@@ -132,7 +134,8 @@ struct TraceArgs {
     /// A secondary ray is traced only if its weight (product of KR/KT along its path) is ≥ W.
     #[arg(long, value_parser = finite, default_value_t = scanline3d_sim::trace::whitted::DEFAULT_THRESHOLD)]
     threshold: f64,
-    /// Acceleration structure of the reference tracer (same image, different work).
+    /// Acceleration structure (same image, different work). The fixed tracer has the
+    /// hierarchy and the grid but not their combination: `both` gives it the hierarchy.
     #[arg(long, value_enum, default_value = "both")]
     accel: TraceAccel,
     /// Also trace with every acceleration structure, check the images are identical and print
@@ -292,7 +295,7 @@ struct CompareArgs {
 /// The views `analyze` and `export` look from.
 #[derive(Args, Debug, Clone)]
 struct Views {
-    /// The OBJ scene (or --demo).
+    /// The OBJ scene (or --demo); for `export`, a traced `.scene` file too.
     scene: Option<PathBuf>,
     /// The built-in demo scene seen from its 8-frame camera orbit (the firmware's views).
     #[arg(long, conflicts_with = "scene")]
@@ -435,7 +438,44 @@ fn analyze_command(a: AnalyzeArgs) -> Result<(), String> {
     Ok(())
 }
 
+/// The command line for a generated file's header, without the output path, so the same scene
+/// and options always produce the same file.
+fn export_command_line() -> String {
+    let mut args = std::env::args().skip(1);
+    let mut kept = vec!["sim".to_string()];
+    while let Some(arg) = args.next() {
+        if arg == "--out" {
+            args.next();
+        } else if !arg.starts_with("--out=") {
+            kept.push(arg);
+        }
+    }
+    kept.join(" ")
+}
+
+/// `sim export SCENE.scene --out f.rs`: a traced scene as static fixed-point data.
+fn export_traced(scene: &std::path::Path, out: &std::path::Path) -> Result<(), String> {
+    use scanline3d_sim::trace::{fixed::FixedScene, scene::TracedScene};
+    let fixed = FixedScene::new(&TracedScene::load(scene)?)?;
+    let source = scanline3d_sim::trace::fixed::export_source(&fixed, &export_command_line());
+    let source = scanline3d_sim::export::rustfmt(&source).unwrap_or(source);
+    std::fs::write(out, source).map_err(|e| format!("{}: {e}", out.display()))?;
+    say!(
+        "wrote {} ({} objects, {} materials, {} lights)",
+        out.display(),
+        fixed.objects().len(),
+        fixed.materials.len(),
+        fixed.lights.len()
+    );
+    Ok(())
+}
+
 fn export_command(a: ExportArgs) -> Result<(), String> {
+    if let Some(scene) =
+        (a.views.scene.as_ref()).filter(|p| p.extension().is_some_and(|e| e == "scene"))
+    {
+        return export_traced(scene, &a.out);
+    }
     if a.views.demo {
         return Err("export takes an OBJ scene (the demo is already built in)".into());
     }
@@ -449,18 +489,7 @@ fn export_command(a: ExportArgs) -> Result<(), String> {
     };
     let (w, h) = a.views.size;
     let analysis = analyze::analyze(&spec, &cams, w, h)?;
-    // The command in the header leaves out the output path, so the same scene and options
-    // always produce the same file.
-    let mut args = std::env::args().skip(1);
-    let mut kept = vec!["sim".to_string()];
-    while let Some(arg) = args.next() {
-        if arg == "--out" {
-            args.next();
-        } else if !arg.starts_with("--out=") {
-            kept.push(arg);
-        }
-    }
-    let command = kept.join(" ");
+    let command = export_command_line();
     let export = scanline3d_sim::export::Export {
         mesh: &spec.instances[0].mesh,
         analysis: &analysis,
@@ -642,37 +671,72 @@ fn trace(a: TraceArgs) -> Result<(), String> {
         TraceAccel::Both => Structure::Both,
     };
     let (w, h) = a.size;
-    let image = match a.renderer {
-        TraceRenderer::Reference => render::render(&traced, &camera, w, h, limits, structure)?,
+    let (color, ids, depth, shadow, summary) = match a.renderer {
+        TraceRenderer::Reference => {
+            let image = render::render(&traced, &camera, w, h, limits, structure)?;
+            let s = &image.stats;
+            let summary = format!(
+                "{} objects, {} lights; rays: {} primary, {} secondary, {} shadow; tests per ray ({}): {:.2}; ray tree cut by depth {}, by weight {}; {} total internal reflections",
+                traced.objects.len(),
+                traced.lights.len(),
+                s.primary,
+                s.traced_rays() - s.primary,
+                s.shadow,
+                structure.name(),
+                s.tests_per_ray(),
+                s.cut_by_depth,
+                s.cut_by_weight,
+                s.total_internal_reflections
+            );
+            (image.color, image.ids, image.depth, image.shadow, summary)
+        }
+        TraceRenderer::Fixed => {
+            use scanline3d_sim::trace::fixed;
+            let scene = fixed::FixedScene::new(&traced)?;
+            let f = fixed::render(
+                &scene,
+                &camera,
+                w,
+                h,
+                fixed::options(a.max_depth, a.threshold)?,
+                match a.accel {
+                    TraceAccel::None => fixed::Accel::None,
+                    TraceAccel::Bvh | TraceAccel::Both => fixed::Accel::Bvh,
+                    TraceAccel::Grid => fixed::Accel::Grid,
+                },
+            )?;
+            let s = &f.stats;
+            let summary = format!(
+                "{} objects, {} lights; fixed-point tracer: rays: {} primary, {} secondary, {} shadow; tests per ray ({:?}): {:.2} objects, {:.2} boxes, {:.2} grid cells; {} rays dropped (stack full)",
+                traced.objects.len(),
+                traced.lights.len(),
+                s.primary_rays,
+                s.secondary_rays,
+                s.shadow_rays,
+                a.accel,
+                f64::from(s.intersection_tests) / f64::from(s.rays().max(1)),
+                f64::from(s.box_tests) / f64::from(s.rays().max(1)),
+                f64::from(s.grid_cells) / f64::from(s.rays().max(1)),
+                s.dropped_rays
+            );
+            (f.colour, f.ids, f.depth, f.shadow, summary)
+        }
     };
-    scene::write_png(&a.out, w, h, &image.color)?;
+    scene::write_png(&a.out, w, h, &color)?;
     say!("wrote {}", a.out.display());
     if let Some(p) = &a.ids {
-        scene::write_ids(p, &image.ids)?;
+        scene::write_ids(p, &ids)?;
         say!("wrote {}", p.display());
     }
     if let Some(p) = &a.depth {
-        scene::write_depth(p, &image.depth)?;
+        scene::write_depth(p, &depth)?;
         say!("wrote {}", p.display());
     }
     if let Some(p) = &a.shadow {
-        std::fs::write(p, &image.shadow).map_err(|e| format!("{}: {e}", p.display()))?;
+        std::fs::write(p, &shadow).map_err(|e| format!("{}: {e}", p.display()))?;
         say!("wrote {}", p.display());
     }
-    let s = &image.stats;
-    say!(
-        "{} objects, {} lights; rays: {} primary, {} secondary, {} shadow; tests per ray ({}): {:.2}; ray tree cut by depth {}, by weight {}; {} total internal reflections",
-        traced.objects.len(),
-        traced.lights.len(),
-        s.primary,
-        s.traced_rays() - s.primary,
-        s.shadow,
-        structure.name(),
-        s.tests_per_ray(),
-        s.cut_by_depth,
-        s.cut_by_weight,
-        s.total_internal_reflections
-    );
+    say!("{summary}");
     Ok(())
 }
 

@@ -15,6 +15,7 @@ mod package;
 mod peers;
 mod profile;
 mod test;
+mod trace;
 mod tradeoff;
 
 use firmware::*;
@@ -158,6 +159,7 @@ fn main() -> ExitCode {
     let result = match task.as_str() {
         "test" => test(),
         "firmware" => install().and_then(|_| firmware()),
+        "trace" => install().and_then(|_| trace::trace()),
         "lean" => install().and_then(|_| lean()),
         "package" => install().and_then(|_| package()),
         "peers" => peers(),
@@ -188,7 +190,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | trace | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }

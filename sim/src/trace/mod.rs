@@ -6,11 +6,13 @@
 //! helpers and rays), [`intersect`] (ray–primitive tests and bounding boxes), [`query`]
 //! (nearest/any hit with test counters), [`bvh`] (bounding volumes), [`grid`] (space
 //! subdivision, 3D-DDA), [`accel`] (choosing one), [`corpus`] (the traced scenes and their cameras), [`whitted`] (the shading model and the ray
-//! tree's termination rules) and [`render`] (a frame's images).
+//! tree's termination rules) and [`render`] (a frame's images); [`fixed`] runs the library's
+//! fixed-point tracer on the same scenes and exports them as firmware data.
 
 pub mod accel;
 pub mod bvh;
 pub mod corpus;
+pub mod fixed;
 pub mod grid;
 pub mod intersect;
 pub mod query;

@@ -1,0 +1,454 @@
+//! A traced scene in fixed point: materials, lights, background and ambient, borrowing its
+//! objects, materials and lights from slices (so all of it can be `static` data in flash), and
+//! the camera that makes primary rays.
+
+use crate::trace::bvh::{Bvh, BvhError, BvhNode};
+use crate::trace::grid::{Grid, GridError, GridShape};
+use crate::trace::shape::Object;
+use crate::trace::vector::{Vec3, MAX_COORD};
+use fixed::types::{I16F16, I8F24};
+
+/// Why a scene, material, light or camera was rejected.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TraceSceneError {
+    /// A colour channel or the ambient level is outside [0, 1].
+    BadColour,
+    /// A material coefficient (KA, KD, KR, KT) is outside [0, [`MAX_COEFFICIENT`]].
+    BadCoefficient,
+    /// An index of refraction is outside [1, [`MAX_IOR`]].
+    BadIor,
+    /// A light's intensity is outside [0, [`MAX_COEFFICIENT`]], its position outside the
+    /// envelope or its direction zero.
+    BadLight,
+    /// More than [`MAX_LIGHTS`] lights.
+    TooManyLights,
+    /// More objects than ids (`u32::MAX − 1`).
+    TooManyObjects,
+    /// An object names a material index the scene does not have.
+    UnknownMaterial,
+    /// Camera: eye outside the envelope, eye = target, up parallel to the view direction,
+    /// field of view outside (0°, 160°], near ≤ 0, far ≤ near, far beyond the envelope, or a
+    /// size of zero or above [`MAX_TRACE_SIZE`].
+    BadCamera,
+}
+
+impl core::fmt::Display for TraceSceneError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            TraceSceneError::BadColour => "a colour channel or the ambient level is outside [0, 1]",
+            TraceSceneError::BadCoefficient => "a material coefficient is outside [0, 8]",
+            TraceSceneError::BadIor => "an index of refraction is outside [1, 4]",
+            TraceSceneError::BadLight => "a light has a bad intensity, position or direction",
+            TraceSceneError::TooManyLights => "more than 8 lights",
+            TraceSceneError::TooManyObjects => "too many objects",
+            TraceSceneError::UnknownMaterial => "an object names a material the scene lacks",
+            TraceSceneError::BadCamera => "the camera is outside the tracer's envelope",
+        })
+    }
+}
+
+impl core::error::Error for TraceSceneError {}
+
+/// The largest material coefficient or light intensity: 8.
+pub const MAX_COEFFICIENT: I16F16 = I16F16::from_bits(8 << 16);
+/// The largest index of refraction: 4 (diamond is 2.42).
+pub const MAX_IOR: I16F16 = I16F16::from_bits(4 << 16);
+/// The most lights a scene may have: one bit each in a shadow mask byte.
+pub const MAX_LIGHTS: usize = 8;
+/// The largest traced image side, in pixels.
+pub const MAX_TRACE_SIZE: u16 = 2048;
+
+/// A linear RGB colour, each channel an [`I16F16`] (1.0 = full).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Colour(pub [I16F16; 3]);
+
+impl Colour {
+    /// Black.
+    pub const BLACK: Colour = Colour([I16F16::ZERO; 3]);
+
+    /// A colour with every channel in [0, 1].
+    pub fn new(rgb: [I16F16; 3]) -> Result<Colour, TraceSceneError> {
+        if rgb.iter().all(|c| *c >= I16F16::ZERO && *c <= I16F16::ONE) {
+            Ok(Colour(rgb))
+        } else {
+            Err(TraceSceneError::BadColour)
+        }
+    }
+}
+
+/// A surface's material: `KA·C·ambient + Σ KD·(N·L)·C·I` locally, plus KR of the reflected
+/// and KT of the refracted ray.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Material {
+    /// Surface colour C.
+    pub colour: Colour,
+    /// Ambient coefficient KA.
+    pub ka: I16F16,
+    /// Diffuse coefficient KD.
+    pub kd: I16F16,
+    /// Reflection coefficient KR.
+    pub kr: I16F16,
+    /// Transmission coefficient KT.
+    pub kt: I16F16,
+    /// Index of refraction (inside the object; outside is air, 1.0).
+    pub ior: I16F16,
+}
+
+impl Material {
+    /// A material, or an error for a coefficient outside [0, [`MAX_COEFFICIENT`]] or an IOR
+    /// outside [1, [`MAX_IOR`]].
+    pub fn new(
+        colour: Colour,
+        [ka, kd, kr, kt]: [I16F16; 4],
+        ior: I16F16,
+    ) -> Result<Material, TraceSceneError> {
+        if [ka, kd, kr, kt]
+            .iter()
+            .any(|k| *k < I16F16::ZERO || *k > MAX_COEFFICIENT)
+        {
+            return Err(TraceSceneError::BadCoefficient);
+        }
+        if ior < I16F16::ONE || ior > MAX_IOR {
+            return Err(TraceSceneError::BadIor);
+        }
+        Ok(Material {
+            colour,
+            ka,
+            kd,
+            kr,
+            kt,
+            ior,
+        })
+    }
+}
+
+/// Where a light is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightKind {
+    /// A point light at this position (no distance falloff).
+    Point(Vec3),
+    /// A light at infinity; the unit vector points from surfaces towards it.
+    Directional(Vec3),
+}
+
+/// A light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Light {
+    /// Position or direction.
+    pub kind: LightKind,
+    /// Intensity I.
+    pub intensity: I16F16,
+}
+
+impl Light {
+    /// A point light at `position`.
+    pub fn point(position: Vec3, intensity: I16F16) -> Result<Light, TraceSceneError> {
+        if !position.in_envelope() {
+            return Err(TraceSceneError::BadLight);
+        }
+        Light::with(LightKind::Point(position), intensity)
+    }
+
+    /// A directional light; `towards` (any length) points from surfaces to the light.
+    pub fn directional(towards: Vec3, intensity: I16F16) -> Result<Light, TraceSceneError> {
+        if !towards.in_envelope() {
+            return Err(TraceSceneError::BadLight);
+        }
+        let unit = towards.normalized().ok_or(TraceSceneError::BadLight)?;
+        Light::with(LightKind::Directional(unit), intensity)
+    }
+
+    fn with(kind: LightKind, intensity: I16F16) -> Result<Light, TraceSceneError> {
+        if intensity < I16F16::ZERO || intensity > MAX_COEFFICIENT {
+            return Err(TraceSceneError::BadLight);
+        }
+        Ok(Light { kind, intensity })
+    }
+}
+
+/// A traced scene: objects (ids are their indices), materials, lights, background colour and
+/// ambient level, all borrowed.
+#[derive(Clone, Copy, Debug)]
+pub struct Scene<'a> {
+    /// Primitives; an object's id is its index.
+    pub objects: &'a [Object<'a>],
+    /// Materials, indexed by [`Object::material`].
+    pub materials: &'a [Material],
+    /// Lights; light k is bit k of a shadow mask.
+    pub lights: &'a [Light],
+    /// Colour of rays that hit nothing.
+    pub background: Colour,
+    /// Ambient level, in [0, 1].
+    pub ambient: I16F16,
+    /// A bounding-volume hierarchy over the objects ([`Scene::with_bvh`]); without one every
+    /// ray tests every object.
+    pub bvh: Option<Bvh<'a>>,
+    /// A uniform grid over the objects ([`Scene::with_grid`]); used instead of the hierarchy
+    /// when both are given.
+    pub grid: Option<Grid<'a>>,
+}
+
+impl<'a> Scene<'a> {
+    /// The scene with a uniform grid over its objects, as
+    /// [`grid::build`](crate::trace::grid::build) made it, checked by [`Grid::new`].
+    pub fn with_grid(
+        self,
+        shape: GridShape,
+        starts: &'a [u32],
+        items: &'a [u32],
+        unbounded: &'a [u32],
+    ) -> Result<Scene<'a>, GridError> {
+        Ok(Scene {
+            grid: Some(Grid::new(
+                shape,
+                starts,
+                items,
+                unbounded,
+                self.objects.len(),
+            )?),
+            ..self
+        })
+    }
+
+    /// The scene with a bounding-volume hierarchy over its objects, as
+    /// [`bvh::build`](crate::trace::bvh::build) made it (nodes, items and how many items are in
+    /// the tree), checked against the objects by [`Bvh::new`].
+    pub fn with_bvh(
+        self,
+        nodes: &'a [BvhNode],
+        items: &'a [u32],
+        bounded: usize,
+    ) -> Result<Scene<'a>, BvhError> {
+        Ok(Scene {
+            bvh: Some(Bvh::new(nodes, items, bounded, self.objects)?),
+            ..self
+        })
+    }
+
+    /// A scene, or an error for an unknown material index, more than [`MAX_LIGHTS`] lights or
+    /// an ambient level outside [0, 1].
+    pub fn new(
+        objects: &'a [Object<'a>],
+        materials: &'a [Material],
+        lights: &'a [Light],
+        background: Colour,
+        ambient: I16F16,
+    ) -> Result<Scene<'a>, TraceSceneError> {
+        if lights.len() > MAX_LIGHTS {
+            return Err(TraceSceneError::TooManyLights);
+        }
+        if objects.len() >= u32::MAX as usize {
+            return Err(TraceSceneError::TooManyObjects);
+        }
+        if objects
+            .iter()
+            .any(|o| usize::from(o.material) >= materials.len())
+        {
+            return Err(TraceSceneError::UnknownMaterial);
+        }
+        if ambient < I16F16::ZERO || ambient > I16F16::ONE {
+            return Err(TraceSceneError::BadColour);
+        }
+        Ok(Scene {
+            objects,
+            materials,
+            lights,
+            background,
+            ambient,
+            bvh: None,
+            grid: None,
+        })
+    }
+}
+
+/// The camera of a traced frame: `look_at` + `perspective` as in the rasterizers (DESIGN.md),
+/// pixel centres at `(c + ½, r + ½)`.
+///
+/// The direction through pixel (c, r) is `corner + c·right + r·down`, accumulated in [`I8F24`]
+/// (24 fraction bits, so 2048 steps add at most 2^-13 of error before the sum is rounded to
+/// I16F16 and normalised); its component along the view direction is exactly 1, so a primary
+/// ray's eye depth is its `t` along that direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TraceCamera {
+    /// Eye position.
+    pub eye: Vec3,
+    /// Direction through the centre of pixel (0, 0).
+    pub corner: [I8F24; 3],
+    /// Step from one column to the next.
+    pub right: [I8F24; 3],
+    /// Step from one row to the next (downwards).
+    pub down: [I8F24; 3],
+    /// Near distance along the view direction (primary rays see eye depths in [near, far)).
+    pub near: I16F16,
+    /// Far distance along the view direction.
+    pub far: I16F16,
+    /// Image width in pixels.
+    pub width: u16,
+    /// Image height in pixels.
+    pub height: u16,
+}
+
+impl TraceCamera {
+    /// A camera at `eye` looking at `target`, `fovy_degrees` vertical field of view, aspect
+    /// `width / height`, primary rays limited to eye depths in `[near, far)`. The basis is
+    /// computed in f64 once; everything per pixel is integer.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        eye: [f64; 3],
+        target: [f64; 3],
+        up: [f64; 3],
+        fovy_degrees: f64,
+        near: f64,
+        far: f64,
+        width: u16,
+        height: u16,
+    ) -> Result<TraceCamera, TraceSceneError> {
+        let bad = TraceSceneError::BadCamera;
+        let limit = MAX_COORD.to_num::<f64>();
+        let finite = |v: &[f64]| v.iter().all(|c| c.is_finite());
+        if !finite(&eye) || !finite(&target) || !finite(&up) || !finite(&[fovy_degrees, near, far])
+        {
+            return Err(bad);
+        }
+        if eye.iter().any(|c| c.abs() > limit)
+            || !(fovy_degrees > 0.0 && fovy_degrees <= 160.0)
+            || !(near > 0.0 && far > near && far <= limit)
+            || near < 1.0 / 256.0
+            || width == 0
+            || height == 0
+            || width > MAX_TRACE_SIZE
+            || height > MAX_TRACE_SIZE
+        {
+            return Err(bad);
+        }
+        let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let unit = |a: [f64; 3]| {
+            let l = libm::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+            if l > 1e-9 {
+                Ok(a.map(|c| c / l))
+            } else {
+                Err(bad)
+            }
+        };
+        let forward = unit(sub(target, eye))?;
+        let right = unit(cross(forward, up))?;
+        let true_up = cross(right, forward);
+        // Half-heights of the image plane at distance 1.
+        let half_h = libm::tan(fovy_degrees.to_radians() / 2.0);
+        let half_w = half_h * f64::from(width) / f64::from(height);
+        let (sx, sy) = (
+            2.0 * half_w / f64::from(width),
+            2.0 * half_h / f64::from(height),
+        );
+        let corner: [f64; 3] = core::array::from_fn(|i| {
+            forward[i] + right[i] * (-half_w + sx / 2.0) + true_up[i] * (half_h - sy / 2.0)
+        });
+        let fix = |v: [f64; 3]| -> Result<[I8F24; 3], TraceSceneError> {
+            let mut out = [I8F24::ZERO; 3];
+            for (o, c) in out.iter_mut().zip(v) {
+                // Keep |corner + W·right + H·down| below 2^6 per component.
+                if c.abs() >= 16.0 {
+                    return Err(bad);
+                }
+                *o = I8F24::checked_from_num(c).ok_or(bad)?;
+            }
+            Ok(out)
+        };
+        let fix1 = |v: f64| I16F16::checked_from_num(v).ok_or(bad);
+        let eye = Vec3 {
+            x: fix1(eye[0])?,
+            y: fix1(eye[1])?,
+            z: fix1(eye[2])?,
+        };
+        if half_w > 16.0 {
+            return Err(bad);
+        }
+        Ok(TraceCamera {
+            eye,
+            corner: fix(corner)?,
+            right: fix(right.map(|c| c * sx))?,
+            down: fix(true_up.map(|c| -c * sy))?,
+            near: fix1(near)?,
+            far: fix1(far)?,
+            width,
+            height,
+        })
+    }
+
+    /// The direction through the centre of pixel (`column`, `row`), not normalised: its
+    /// component along the view direction is 1. Raw I16F16 bits.
+    #[inline]
+    pub fn pixel_direction(&self, column: u16, row: u16) -> Vec3 {
+        let (c, r) = (i32::from(column), i32::from(row));
+        // |corner| < 16 and |c·right|, |r·down| < 2·half-width ≤ 32: the sum stays below 2^7.
+        let axis = |i: usize| {
+            let pick = |v: &[I8F24; 3]| v.get(i).map_or(0, |x| x.to_bits());
+            let sum = pick(&self.corner)
+                .wrapping_add(pick(&self.right).wrapping_mul(c))
+                .wrapping_add(pick(&self.down).wrapping_mul(r));
+            // 24 → 16 fraction bits, rounded to nearest.
+            (sum + (1 << 7)) >> 8
+        };
+        Vec3::from_bits(axis(0), axis(1), axis(2))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn camera_centre_ray_points_at_the_target() {
+        let cam = TraceCamera::new(
+            [0.0, 0.0, 5.0],
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            60.0,
+            0.1,
+            100.0,
+            4,
+            4,
+        )
+        .unwrap();
+        // Pixels (1, 1) and (2, 2) straddle the centre symmetrically.
+        let a = cam.pixel_direction(1, 1).bits();
+        let b = cam.pixel_direction(2, 2).bits();
+        assert_eq!(a[2], -65536);
+        assert!((a[0] + b[0]).abs() <= 1 && (a[1] + b[1]).abs() <= 1);
+        assert!(
+            a[0] < 0 && a[1] > 0,
+            "row 0 is at the top, column 0 at the left"
+        );
+    }
+
+    #[test]
+    fn bad_cameras_are_rejected() {
+        let ok = |eye, fov, near, far, w| {
+            TraceCamera::new(eye, [0.0; 3], [0.0, 1.0, 0.0], fov, near, far, w, 4).is_ok()
+        };
+        assert!(ok([0.0, 0.0, 5.0], 60.0, 0.1, 100.0, 4));
+        assert!(!ok([0.0, 0.0, 0.0], 60.0, 0.1, 100.0, 4));
+        assert!(!ok([0.0, 0.0, 5.0], 0.0, 0.1, 100.0, 4));
+        assert!(!ok([0.0, 0.0, 5.0], 60.0, 1.0, 0.5, 4));
+        assert!(!ok([0.0, 0.0, 5.0], 60.0, 0.1, 100.0, 0));
+        assert!(!ok([0.0, 0.0, 5.0], f64::NAN, 0.1, 100.0, 4));
+        assert!(TraceCamera::new(
+            [0.0, 5.0, 0.0],
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            60.0,
+            0.1,
+            9.0,
+            4,
+            4
+        )
+        .is_err());
+    }
+}

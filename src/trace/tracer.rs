@@ -1,0 +1,696 @@
+//! The fixed-point Whitted tracer: per pixel a primary ray, then the ray tree on an explicit,
+//! bounded stack; finished rows go to a [`RowSink`].
+//!
+//! ## The shading model (the same as `sim`'s f64 reference)
+//!
+//! A ray's colour is the background if it hits nothing with `t ≥` [`EPSILON`] (primary rays:
+//! eye depth in `[near, far)`); otherwise the local term `KA·C·ambient + Σ KD·max(0, N·L)·C·I`
+//! over the lights whose shadow ray reaches them unblocked (any object hit with
+//! `EPSILON ≤ t <` the light's distance blocks it), plus `KR·colour(R)` and `KT·colour(T)`.
+//! N faces the incoming ray; `R = d − 2(N·d)N`; `T` follows Snell's law from IOR 1 into the
+//! object's IOR when the ray enters it (its outward normal faces the ray) and from the IOR to
+//! 1 when it leaves; on total internal reflection `T = R`. The tree ends where the lecture's four
+//! rules say: no hit, a diffuse surface (KR = KT = 0), a child's weight (product of KR/KT along
+//! its path) below [`TraceOptions::threshold`], or the depth limit
+//! [`TraceOptions::max_depth`] (the primary ray has depth 0; a ray at the limit spawns
+//! nothing). The pixel is clamped to [0, 1] per channel once, then rounded to 8 bits.
+//!
+//! ## No recursion
+//!
+//! Since the model is linear, a ray's contribution is its weight times its local term: the tree
+//! is walked depth first with a stack of pending rays, each carrying its weight and depth. Each
+//! ray pops one entry and pushes at most two, so `max_depth + 1` entries always suffice; the
+//! stack's capacity is the const generic `STACK` of [`Tracer`]. A ray that finds the stack full
+//! is not traced: [`TraceStats::dropped_rays`] counts it and the row goes out with
+//! `complete: false`.
+
+use crate::depth::DepthRow;
+use crate::sink::{Row, RowPixel, RowSink};
+use crate::trace::intersect::{reflect, Ray};
+use crate::trace::scene::{Colour, LightKind, Scene, TraceCamera};
+use crate::trace::vector::{mul, narrow_bits, sqrt, Vec3};
+use embedded_graphics::pixelcolor::Rgb888;
+use fixed::types::{I16F16, I32F32};
+
+/// The smallest `t` (world units) a secondary or shadow ray accepts, so a ray leaving a surface
+/// does not hit it again: 2^-10 ≈ 0.001, above the position error of a hit (a few 2^-16 steps
+/// times the distance in units of 2^4; see `vector` and `intersect`).
+pub const EPSILON: I16F16 = I16F16::from_bits(1 << 6);
+
+/// Default depth limit of the ray tree.
+pub const DEFAULT_MAX_DEPTH: u8 = 4;
+/// Default weight threshold: a secondary ray whose weight is below 1/256 is not traced.
+pub const DEFAULT_THRESHOLD: I16F16 = I16F16::from_bits(1 << 8);
+
+/// The termination rules a frame uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TraceOptions {
+    /// Depth of the deepest ray that may be traced (the primary ray has depth 0).
+    pub max_depth: u8,
+    /// Smallest weight of a traced secondary ray.
+    pub threshold: I16F16,
+}
+
+impl Default for TraceOptions {
+    fn default() -> Self {
+        TraceOptions {
+            max_depth: DEFAULT_MAX_DEPTH,
+            threshold: DEFAULT_THRESHOLD,
+        }
+    }
+}
+
+/// What one frame (or pixel) did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TraceStats {
+    /// Primary rays.
+    pub primary_rays: u32,
+    /// Reflected and refracted rays traced.
+    pub secondary_rays: u32,
+    /// Shadow rays traced (lights with N·L ≤ 0 need none).
+    pub shadow_rays: u32,
+    /// Ray–primitive intersection tests.
+    pub intersection_tests: u32,
+    /// Ray–box tests in the bounding-volume hierarchy.
+    pub box_tests: u32,
+    /// Grid cells visited.
+    pub grid_cells: u32,
+    /// Secondary rays not traced because the ray stack was full (0 when `STACK > max_depth`).
+    pub dropped_rays: u32,
+    /// Most pending rays on the stack at once.
+    pub peak_stack: u16,
+    /// Rows handed to the sink.
+    pub rows: u16,
+}
+
+impl TraceStats {
+    /// All rays traced: primary, secondary and shadow.
+    pub fn rays(&self) -> u32 {
+        self.primary_rays + self.secondary_rays + self.shadow_rays
+    }
+
+    fn add(&mut self, o: &TraceStats) {
+        self.primary_rays += o.primary_rays;
+        self.secondary_rays += o.secondary_rays;
+        self.shadow_rays += o.shadow_rays;
+        self.intersection_tests += o.intersection_tests;
+        self.box_tests += o.box_tests;
+        self.grid_cells += o.grid_cells;
+        self.dropped_rays += o.dropped_rays;
+        self.peak_stack = self.peak_stack.max(o.peak_stack);
+    }
+}
+
+/// Why a traced frame failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TraceError<E> {
+    /// The row buffer's length is not the camera's width.
+    RowLength,
+    /// The sink refused a row.
+    Sink(E),
+}
+
+/// What the tracer found at one pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelTrace {
+    /// The pixel's colour (clamped, rounded to 8 bits).
+    pub colour: Rgb888,
+    /// Id of the object the primary ray hit, if any.
+    pub id: Option<u32>,
+    /// Eye depth of the primary hit.
+    pub depth: I16F16,
+    /// Bit k set when light k contributes nothing at the primary hit (N·L ≤ 0 or blocked).
+    pub shadow: u8,
+}
+
+/// A ray waiting on the stack.
+#[derive(Clone, Copy, Debug)]
+struct Pending {
+    ray: Ray,
+    weight: I16F16,
+    depth: u8,
+    /// The object whose surface the ray starts on (`u32::MAX` for a primary ray).
+    from: u32,
+}
+
+/// The nearest hit along a ray.
+#[derive(Clone, Copy, Debug)]
+struct Hit {
+    t: I16F16,
+    object: u32,
+}
+
+/// A Whitted tracer over one scene and camera whose ray stack holds `STACK` pending rays
+/// (`STACK · 36` bytes on the call stack).
+#[derive(Clone, Copy, Debug)]
+pub struct Tracer<'s, 'a, const STACK: usize> {
+    scene: &'s Scene<'a>,
+    camera: &'s TraceCamera,
+    options: TraceOptions,
+}
+
+impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
+    /// A tracer for `scene` seen by `camera`.
+    pub fn new(scene: &'s Scene<'a>, camera: &'s TraceCamera, options: TraceOptions) -> Self {
+        Tracer {
+            scene,
+            camera,
+            options,
+        }
+    }
+
+    /// Renders the frame row by row into `row` (length = the camera's width), handing each row
+    /// to `sink`.
+    pub fn render<P: RowPixel, S: RowSink<P>>(
+        &self,
+        row: &mut [P],
+        sink: &mut S,
+    ) -> Result<TraceStats, TraceError<S::Error>> {
+        if row.len() != usize::from(self.camera.width) {
+            return Err(TraceError::RowLength);
+        }
+        let mut stats = TraceStats::default();
+        for y in 0..self.camera.height {
+            let dropped_before = stats.dropped_rays;
+            for (x, pixel) in (0..self.camera.width).zip(row.iter_mut()) {
+                let (p, s) = self.trace_pixel(x, y);
+                stats.add(&s);
+                *pixel = P::from_shade(p.colour, p.id.unwrap_or(u32::MAX));
+            }
+            sink.write_row(Row {
+                y,
+                pixels: row,
+                depth: DepthRow::NONE,
+                complete: stats.dropped_rays == dropped_before,
+            })
+            .map_err(TraceError::Sink)?;
+            stats.rows += 1;
+        }
+        Ok(stats)
+    }
+
+    /// Traces the pixel (`column`, `row`): its colour, primary id, depth and shadow mask, and
+    /// what it cost.
+    pub fn trace_pixel(&self, column: u16, row: u16) -> (PixelTrace, TraceStats) {
+        let mut stats = TraceStats {
+            primary_rays: 1,
+            ..TraceStats::default()
+        };
+        let mut out = PixelTrace {
+            colour: Rgb888::new(0, 0, 0),
+            id: None,
+            depth: I16F16::ZERO,
+            shadow: 0,
+        };
+        let raw = self.camera.pixel_direction(column, row);
+        let len = sqrt(raw.dot(raw));
+        let Some(dir) = raw.normalized() else {
+            return (out, stats);
+        };
+        // Eye depth = t / len (the raw direction has unit forward component).
+        let primary = Ray {
+            origin: self.camera.eye,
+            dir,
+        };
+        let window = (
+            mul(self.camera.near, len),
+            I16F16::from_bits(narrow_bits(self.camera.far.wide_mul(len).to_bits())),
+        );
+        let mut sum = Colour::BLACK;
+        let mut stack: heapless::Vec<Pending, STACK> = heapless::Vec::new();
+        let mut next = Some((
+            Pending {
+                ray: primary,
+                weight: I16F16::ONE,
+                depth: 0,
+                from: u32::MAX,
+            },
+            window,
+        ));
+        while let Some((ray, (t_min, t_max))) = next.take() {
+            let is_primary = ray.depth == 0;
+            match self.nearest(&ray.ray, ray.from, t_min, t_max, &mut stats) {
+                None => add_weighted(&mut sum, &self.scene.background, ray.weight),
+                Some(hit) => {
+                    let shadow = self.shade(&ray, hit, &mut sum, &mut stack, &mut stats);
+                    if is_primary {
+                        out.id = Some(hit.object);
+                        out.depth = hit.t.checked_div(len).unwrap_or(I16F16::MAX);
+                        out.shadow = shadow;
+                    }
+                }
+            }
+            stats.peak_stack = stats.peak_stack.max(stack.len() as u16);
+            next = stack.pop().map(|p| (p, (EPSILON, I16F16::MAX)));
+        }
+        out.colour = to_rgb888(&sum);
+        (out, stats)
+    }
+
+    /// The nearest object along `ray` (which starts on object `from`) with `t` in
+    /// `[t_min, t_max)`.
+    fn nearest(
+        &self,
+        ray: &Ray,
+        from: u32,
+        t_min: I16F16,
+        t_max: I16F16,
+        stats: &mut TraceStats,
+    ) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let mut tests = 0;
+        let mut test = |id: u32, limit: I16F16| -> I16F16 {
+            tests += 1;
+            match self.hit(id, ray, from, t_min, limit) {
+                Some(t) => {
+                    best = Some(Hit { t, object: id });
+                    t
+                }
+                None => limit,
+            }
+        };
+        match (&self.scene.grid, &self.scene.bvh) {
+            (Some(grid), _) => {
+                let mut limit = t_max;
+                for id in grid.unbounded() {
+                    limit = test(*id, limit);
+                }
+                stats.grid_cells += grid.walk(ray, t_min, limit, |id, limit| Some(test(id, limit)));
+            }
+            (None, None) => {
+                let mut limit = t_max;
+                for id in 0..self.scene.objects.len() as u32 {
+                    limit = test(id, limit);
+                }
+            }
+            (None, Some(bvh)) => {
+                let mut limit = t_max;
+                for id in bvh.unbounded() {
+                    limit = test(*id, limit);
+                }
+                stats.box_tests += bvh.walk(ray, t_min, limit, |id, limit| Some(test(id, limit)));
+            }
+        }
+        stats.intersection_tests += tests;
+        best
+    }
+
+    /// `t` of object `id` along `ray` (which starts on object `from`) in `[t_min, t_max)`.
+    #[inline]
+    fn hit(&self, id: u32, ray: &Ray, from: u32, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
+        let object = self.scene.objects.get(id as usize)?;
+        if id == from {
+            object.shape.hit_from_surface(ray, t_min, t_max)
+        } else {
+            object.shape.hit(ray, t_min, t_max)
+        }
+    }
+
+    /// Whether any object lies along `ray` (which starts on object `from`) with `t` in
+    /// `[EPSILON, t_max)`.
+    fn blocked(&self, ray: &Ray, from: u32, t_max: I16F16, stats: &mut TraceStats) -> bool {
+        let mut tests = 0;
+        let mut blocks = |id: u32| {
+            tests += 1;
+            self.hit(id, ray, from, EPSILON, t_max).is_some()
+        };
+        let blocked = match (&self.scene.grid, &self.scene.bvh) {
+            (Some(grid), _) => {
+                let mut found = grid.unbounded().iter().any(|id| blocks(*id));
+                if !found {
+                    stats.grid_cells += grid.walk(ray, EPSILON, t_max, |id, limit| {
+                        found = blocks(id);
+                        (!found).then_some(limit)
+                    });
+                }
+                found
+            }
+            (None, None) => (0..self.scene.objects.len() as u32).any(&mut blocks),
+            (None, Some(bvh)) => {
+                let mut found = bvh.unbounded().iter().any(|id| blocks(*id));
+                if !found {
+                    stats.box_tests += bvh.walk(ray, EPSILON, t_max, |id, limit| {
+                        found = blocks(id);
+                        (!found).then_some(limit)
+                    });
+                }
+                found
+            }
+        };
+        stats.intersection_tests += tests;
+        blocked
+    }
+
+    /// Adds the local term at `hit` times the ray's weight to `sum`, pushes the reflected and
+    /// refracted rays the rules allow, and returns the shadow mask at the hit.
+    fn shade(
+        &self,
+        pending: &Pending,
+        hit: Hit,
+        sum: &mut Colour,
+        stack: &mut heapless::Vec<Pending, STACK>,
+        stats: &mut TraceStats,
+    ) -> u8 {
+        let scene = self.scene;
+        let Some(object) = scene.objects.get(hit.object as usize) else {
+            return 0;
+        };
+        let Some(material) = scene.materials.get(usize::from(object.material)) else {
+            return 0;
+        };
+        let ray = &pending.ray;
+        let point = ray.origin.along(ray.dir, hit.t);
+        let outward = object.shape.normal(point);
+        // N faces the incoming ray; `entering` when the outward normal does.
+        let entering = outward.dot_bits(ray.dir) < 0;
+        let normal = if entering { outward } else { outward.neg() };
+
+        let mut diffuse = I16F16::ZERO; // Σ max(0, N·L)·I over unblocked lights
+        let mut shadow = 0u8;
+        for (k, light) in scene.lights.iter().enumerate() {
+            let (towards, distance) = match light.kind {
+                LightKind::Directional(d) => (d, I16F16::MAX),
+                LightKind::Point(p) => {
+                    let v = p.sub(point);
+                    match v.normalized() {
+                        Some(d) => (d, sqrt(v.dot(v))),
+                        None => (Vec3::ZERO, I16F16::ZERO),
+                    }
+                }
+            };
+            let nl = I16F16::from_bits(narrow_bits(normal.dot_bits(towards)));
+            let lit = nl > I16F16::ZERO && {
+                stats.shadow_rays += 1;
+                let shadow_ray = Ray {
+                    origin: point,
+                    dir: towards,
+                };
+                !self.blocked(&shadow_ray, hit.object, distance, stats)
+            };
+            if lit {
+                diffuse = diffuse.saturating_add(mul(nl, light.intensity));
+            } else {
+                shadow |= 1u8.checked_shl(k as u32).unwrap_or(0);
+            }
+        }
+        let factor = mul(material.ka, scene.ambient).saturating_add(mul(material.kd, diffuse));
+        let local = Colour(material.colour.0.map(|c| mul(c, factor)));
+        add_weighted(sum, &local, pending.weight);
+
+        if pending.depth >= self.options.max_depth {
+            return shadow;
+        }
+        let reflected = reflect(ray.dir, normal);
+        let mut push = |k: I16F16, dir: Vec3, stats: &mut TraceStats| {
+            let weight = mul(pending.weight, k);
+            if k == I16F16::ZERO || weight < self.options.threshold {
+                return;
+            }
+            let child = Pending {
+                ray: Ray { origin: point, dir },
+                weight,
+                depth: pending.depth + 1,
+                from: hit.object,
+            };
+            if stack.push(child).is_ok() {
+                stats.secondary_rays += 1;
+            } else {
+                stats.dropped_rays += 1;
+            }
+        };
+        push(material.kr, reflected, stats);
+        if material.kt != I16F16::ZERO {
+            let (n1, n2) = if entering {
+                (I16F16::ONE, material.ior)
+            } else {
+                (material.ior, I16F16::ONE)
+            };
+            let refracted = refract(ray.dir, normal, n1, n2).unwrap_or(reflected);
+            push(material.kt, refracted, stats);
+        }
+        shadow
+    }
+}
+
+/// The refracted direction of unit `d` through a surface with unit normal `n` facing it, from
+/// IOR `n1` into `n2` (Snell's law), or `None` on total internal reflection.
+pub fn refract(d: Vec3, n: Vec3, n1: I16F16, n2: I16F16) -> Option<Vec3> {
+    let eta = n1.checked_div(n2)?;
+    let cos_i = I16F16::from_bits(narrow_bits(-d.dot_bits(n)));
+    // k = 1 − η²(1 − cos²θi): the squared cosine of the refracted angle.
+    let sin2_i = I32F32::ONE - cos_i.wide_mul(cos_i);
+    let eta2 = eta.wide_mul(eta);
+    let k = I32F32::ONE
+        - I32F32::from_bits(((eta2.to_bits() as i128 * sin2_i.to_bits() as i128) >> 32) as i64);
+    if k < I32F32::ZERO {
+        return None;
+    }
+    let cos_t = sqrt(k);
+    let along_n = mul(eta, cos_i) - cos_t;
+    d.scale(eta).add(n.scale(along_n)).normalized()
+}
+
+/// `sum += c · weight`, per channel.
+#[inline]
+fn add_weighted(sum: &mut Colour, c: &Colour, weight: I16F16) {
+    for (s, c) in sum.0.iter_mut().zip(c.0) {
+        *s = s.saturating_add(mul(c, weight));
+    }
+}
+
+/// Clamps each channel to [0, 1] and rounds `255·c` to nearest.
+#[inline]
+fn to_rgb888(c: &Colour) -> Rgb888 {
+    let [r, g, b] =
+        c.0.map(|v| ((v.to_bits().clamp(0, 1 << 16) as u32 * 255 + (1 << 15)) >> 16) as u8);
+    Rgb888::new(r, g, b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: f32, y: f32, z: f32) -> Vec3 {
+        Vec3 {
+            x: I16F16::from_num(x),
+            y: I16F16::from_num(y),
+            z: I16F16::from_num(z),
+        }
+    }
+
+    use crate::trace::scene::{Light, Material, TraceCamera};
+    use crate::trace::shape::{
+        AaBox, Ellipsoid, Frustum, Object, Plane, Polygon, Shape, Sphere, Triangle,
+    };
+
+    fn f(x: f64) -> I16F16 {
+        I16F16::from_num(x)
+    }
+
+    fn material(kr: f64, kt: f64) -> Material {
+        let grey = Colour::new([f(0.5); 3]).unwrap();
+        Material::new(grey, [f(0.2), f(0.8), f(kr), f(kt)], f(1.5)).unwrap()
+    }
+
+    /// Two facing mirrors (planes z = ±1, facing each other) seen by a camera between them
+    /// looking down −z: every ray reflects forever unless a rule stops it.
+    fn mirrors(kr: f64, options: TraceOptions) -> TraceStats {
+        let objects = [
+            Object {
+                shape: Shape::Plane(Plane::new(v(0.0, 0.0, 1.0), f(1.0)).unwrap()),
+                material: 0,
+            },
+            Object {
+                shape: Shape::Plane(Plane::new(v(0.0, 0.0, -1.0), f(1.0)).unwrap()),
+                material: 0,
+            },
+        ];
+        let materials = [material(kr, 0.0)];
+        let scene = Scene::new(&objects, &materials, &[], Colour::BLACK, f(0.5)).unwrap();
+        let camera = TraceCamera::new(
+            [0.0; 3],
+            [0.0, 0.0, -1.0],
+            [0.0, 1.0, 0.0],
+            10.0,
+            0.1,
+            10.0,
+            1,
+            1,
+        )
+        .unwrap();
+        Tracer::<8>::new(&scene, &camera, options)
+            .trace_pixel(0, 0)
+            .1
+    }
+
+    #[test]
+    fn the_depth_limit_ends_the_ray_tree() {
+        for max_depth in [0, 1, 3, 7] {
+            let s = mirrors(
+                1.0,
+                TraceOptions {
+                    max_depth,
+                    threshold: I16F16::ZERO,
+                },
+            );
+            assert_eq!(
+                s.secondary_rays,
+                u32::from(max_depth),
+                "depth limit {max_depth}"
+            );
+            assert_eq!(s.dropped_rays, 0);
+        }
+    }
+
+    #[test]
+    fn a_weight_below_the_threshold_ends_the_ray_tree() {
+        // Weights 0.5, 0.25, 0.125, …: with threshold 0.2 two reflections are traced.
+        let s = mirrors(
+            0.5,
+            TraceOptions {
+                max_depth: 7,
+                threshold: f(0.2),
+            },
+        );
+        assert_eq!(s.secondary_rays, 2);
+        // A diffuse surface spawns nothing.
+        assert_eq!(mirrors(0.0, TraceOptions::default()).secondary_rays, 0);
+    }
+
+    #[test]
+    fn a_full_ray_stack_is_reported() {
+        // A glass slab (KR and KT) between the camera and the floor branches at every hit.
+        let objects = [
+            Object {
+                shape: Shape::Box(AaBox::new(v(-5.0, -0.5, -5.0), v(5.0, 0.5, 5.0)).unwrap()),
+                material: 0,
+            },
+            Object {
+                shape: Shape::Plane(Plane::new(v(0.0, 1.0, 0.0), f(3.0)).unwrap()),
+                material: 0,
+            },
+        ];
+        let materials = [material(0.3, 0.7)];
+        let scene = Scene::new(&objects, &materials, &[], Colour::BLACK, f(0.5)).unwrap();
+        let camera = TraceCamera::new(
+            [0.0, 3.0, 0.0],
+            [0.0; 3],
+            [0.0, 0.0, -1.0],
+            10.0,
+            0.1,
+            10.0,
+            2,
+            2,
+        )
+        .unwrap();
+        let options = TraceOptions {
+            max_depth: 4,
+            threshold: I16F16::ZERO,
+        };
+        let roomy = Tracer::<5>::new(&scene, &camera, options);
+        let (_, s) = roomy.trace_pixel(0, 0);
+        assert_eq!((s.dropped_rays, s.peak_stack), (0, 4));
+        let tight = Tracer::<2>::new(&scene, &camera, options);
+        assert!(tight.trace_pixel(0, 0).1.dropped_rays > 0);
+        let mut rows = [true; 2];
+        let mut sink = crate::sink::FnSink(|row: crate::sink::Row<'_, Rgb888>| -> Result<(), ()> {
+            rows[usize::from(row.y)] = row.complete;
+            Ok(())
+        });
+        let stats = tight
+            .render(&mut [Rgb888::new(0, 0, 0); 2], &mut sink)
+            .unwrap();
+        let wrong_row = tight.render(&mut [Rgb888::new(0, 0, 0); 3], &mut sink);
+        assert_eq!(wrong_row, Err(TraceError::RowLength));
+        assert!(stats.dropped_rays > 0);
+        assert_eq!(rows, [false, false], "rows that lost rays say so");
+    }
+
+    #[test]
+    fn every_primitive_casts_a_shadow() {
+        // The floor y = 0 seen from above at the origin; the light comes from (1, 1, 0), so
+        // an object around (1.5, 1.5, 0) shadows the origin without being seen from the camera.
+        let c = v(1.5, 1.5, 0.0);
+        let square = [
+            v(1.2, 1.8, -0.3),
+            v(1.8, 1.2, -0.3),
+            v(1.8, 1.2, 0.3),
+            v(1.2, 1.8, 0.3),
+        ];
+        let blockers = [
+            Shape::Sphere(Sphere::new(c, f(0.3)).unwrap()),
+            Shape::Box(AaBox::new(v(1.3, 1.3, -0.2), v(1.7, 1.7, 0.2)).unwrap()),
+            Shape::Frustum(Frustum::cylinder(v(1.5, 1.5, -0.5), v(1.5, 1.5, 0.5), f(0.3)).unwrap()),
+            Shape::Frustum(
+                Frustum::new(v(1.5, 1.2, 0.0), f(0.4), v(1.5, 1.9, 0.0), f(0.0)).unwrap(),
+            ),
+            Shape::Ellipsoid(Ellipsoid::new(c, v(0.3, 0.4, 0.2)).unwrap()),
+            Shape::Polygon(Polygon::new(&square).unwrap()),
+            Shape::Triangle(Triangle::new([square[0], square[1], square[2]]).unwrap()),
+        ];
+        let floor = Object {
+            shape: Shape::Plane(Plane::new(v(0.0, 1.0, 0.0), f(0.0)).unwrap()),
+            material: 0,
+        };
+        let materials = [material(0.0, 0.0)];
+        let lights = [Light::directional(v(1.0, 1.0, 0.0), f(1.0)).unwrap()];
+        let camera = TraceCamera::new(
+            [0.0, 0.5, 0.0001],
+            [0.0; 3],
+            [0.0, 0.0, -1.0],
+            1.0,
+            0.1,
+            10.0,
+            1,
+            1,
+        )
+        .unwrap();
+        let lit = |objects: &[Object<'_>]| {
+            let scene = Scene::new(objects, &materials, &lights, Colour::BLACK, f(0.2)).unwrap();
+            let (p, _) =
+                Tracer::<5>::new(&scene, &camera, TraceOptions::default()).trace_pixel(0, 0);
+            assert_eq!(p.id, Some(0), "the floor is seen");
+            p.shadow
+        };
+        assert_eq!(lit(&[floor]), 0);
+        for b in blockers {
+            assert_eq!(
+                lit(&[
+                    floor,
+                    Object {
+                        shape: b,
+                        material: 0
+                    }
+                ]),
+                1,
+                "{b:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn snell_and_total_internal_reflection() {
+        let n = v(0.0, 1.0, 0.0);
+        let d = v(0.6, -0.8, 0.0); // sin θi = 0.6
+        let glass = I16F16::from_num(1.5);
+        let t = refract(d, n, I16F16::ONE, glass).unwrap();
+        assert!((t.x.to_num::<f64>() - 0.4).abs() < 1e-3, "{t:?}"); // sin θt = 0.6 / 1.5
+                                                                    // Leaving diamond at sin θi = 0.6 > 1/2.42: total internal reflection.
+        assert_eq!(refract(d, n, I16F16::from_num(2.42), I16F16::ONE), None);
+        // Straight through at normal incidence.
+        assert_eq!(
+            refract(v(0.0, -1.0, 0.0), n, I16F16::ONE, glass),
+            Some(v(0.0, -1.0, 0.0))
+        );
+    }
+
+    #[test]
+    fn rounding_of_the_final_colour() {
+        let c = Colour([
+            I16F16::from_num(-0.5),
+            I16F16::from_num(0.5),
+            I16F16::from_num(3),
+        ]);
+        assert_eq!(to_rgb888(&c), Rgb888::new(0, 128, 255));
+    }
+}

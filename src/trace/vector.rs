@@ -1,0 +1,281 @@
+//! The tracer's arithmetic: 3-vectors of [`I16F16`], wide dot products in [`I32F32`], an integer
+//! square root and normalisation.
+//!
+//! ## Bit budget
+//!
+//! Every coordinate the tracer stores is an [`I16F16`] (range ±32768, step 2^-16 ≈ 1.5·10^-5).
+//! Scene coordinates are limited to ±[`MAX_COORD`] = 2^12, so a difference of two points is at
+//! most 2^13 per axis and a dot product of two differences at most 3·2^26, far inside the
+//! [`I32F32`] range (±2^31) that holds every product. A product of two I16F16 raw values is
+//! below 2^58, so the sum of three fits an `i64`. Unit vectors (directions, normals) have
+//! components in [−1, 1]. Narrowing an I32F32 back to I16F16 truncates towards −∞ (an error
+//! below one I16F16 step) and is checked: a value outside the I16F16 range is an error, never a
+//! wrapped number.
+
+use fixed::types::{I16F16, I32F32};
+
+/// The largest scene coordinate magnitude (any axis), in world units: 2^12.
+pub const MAX_COORD: I16F16 = I16F16::from_bits(4096 << 16);
+
+/// A point or direction in world space, each component an [`I16F16`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Vec3 {
+    /// x.
+    pub x: I16F16,
+    /// y.
+    pub y: I16F16,
+    /// z.
+    pub z: I16F16,
+}
+
+impl Vec3 {
+    /// The zero vector.
+    pub const ZERO: Vec3 = Vec3::from_bits(0, 0, 0);
+
+    /// A vector from raw I16F16 bits (what `sim export` writes).
+    pub const fn from_bits(x: i32, y: i32, z: i32) -> Vec3 {
+        Vec3 {
+            x: I16F16::from_bits(x),
+            y: I16F16::from_bits(y),
+            z: I16F16::from_bits(z),
+        }
+    }
+
+    /// The raw I16F16 bits, x, y, z.
+    pub const fn bits(self) -> [i32; 3] {
+        [self.x.to_bits(), self.y.to_bits(), self.z.to_bits()]
+    }
+
+    /// Whether every component lies within ±[`MAX_COORD`].
+    pub const fn in_envelope(self) -> bool {
+        let m = MAX_COORD.to_bits();
+        let [x, y, z] = self.bits();
+        x >= -m && x <= m && y >= -m && y <= m && z >= -m && z <= m
+    }
+
+    /// `self + o`, wrapping only outside the envelope (never inside it: 2^13 + 2^13 < 2^15).
+    #[inline]
+    #[allow(clippy::should_implement_trait)] // named, not an operator: it wraps outside the envelope
+    pub fn add(self, o: Vec3) -> Vec3 {
+        let (a, b) = (self.bits(), o.bits());
+        Vec3::from_bits(
+            a[0].wrapping_add(b[0]),
+            a[1].wrapping_add(b[1]),
+            a[2].wrapping_add(b[2]),
+        )
+    }
+
+    /// `self − o` (see [`add`](Self::add)).
+    #[inline]
+    #[allow(clippy::should_implement_trait)] // named, not an operator: it wraps outside the envelope
+    pub fn sub(self, o: Vec3) -> Vec3 {
+        let (a, b) = (self.bits(), o.bits());
+        Vec3::from_bits(
+            a[0].wrapping_sub(b[0]),
+            a[1].wrapping_sub(b[1]),
+            a[2].wrapping_sub(b[2]),
+        )
+    }
+
+    /// `−self`.
+    #[inline]
+    #[allow(clippy::should_implement_trait)] // named, not an operator: it wraps outside the envelope
+    pub fn neg(self) -> Vec3 {
+        let a = self.bits();
+        Vec3::from_bits(
+            a[0].wrapping_neg(),
+            a[1].wrapping_neg(),
+            a[2].wrapping_neg(),
+        )
+    }
+
+    /// The dot product, exact, in I32F32.
+    #[inline]
+    pub const fn dot(self, o: Vec3) -> I32F32 {
+        I32F32::from_bits(self.dot_bits(o))
+    }
+
+    /// The dot product's raw I32F32 bits.
+    #[inline]
+    pub const fn dot_bits(self, o: Vec3) -> i64 {
+        let (a, b) = (self.bits(), o.bits());
+        (a[0] as i64 * b[0] as i64)
+            .wrapping_add(a[1] as i64 * b[1] as i64)
+            .wrapping_add(a[2] as i64 * b[2] as i64)
+    }
+
+    /// `self · s` for a scalar `s`, each product narrowed to I16F16 (saturating: only reached
+    /// outside the envelope).
+    #[inline]
+    pub fn scale(self, s: I16F16) -> Vec3 {
+        let a = self.bits();
+        let s = s.to_bits() as i64;
+        Vec3::from_bits(
+            narrow_bits(a[0] as i64 * s),
+            narrow_bits(a[1] as i64 * s),
+            narrow_bits(a[2] as i64 * s),
+        )
+    }
+
+    /// `self + d · t`: a point along a ray.
+    #[inline]
+    pub fn along(self, d: Vec3, t: I16F16) -> Vec3 {
+        self.add(d.scale(t))
+    }
+
+    /// The unit vector along `self`, or `None` for a vector shorter than 2^-8 (too short to
+    /// give a direction with 16 fraction bits: see [`normalize_bits`]).
+    #[inline]
+    pub fn normalized(self) -> Option<Vec3> {
+        normalize_bits(self.bits()).map(|[x, y, z]| Vec3::from_bits(x, y, z))
+    }
+}
+
+/// Raw I32F32 bits narrowed to raw I16F16 bits (`>> 16`, towards −∞), saturating outside the
+/// I16F16 range.
+#[inline]
+pub const fn narrow_bits(v: i64) -> i32 {
+    let s = v >> 16;
+    if s > i32::MAX as i64 {
+        i32::MAX
+    } else if s < i32::MIN as i64 {
+        i32::MIN
+    } else {
+        s as i32
+    }
+}
+
+/// `a · b` for two I16F16 values, truncated, saturating outside the I16F16 range.
+#[inline]
+pub fn mul(a: I16F16, b: I16F16) -> I16F16 {
+    I16F16::from_bits(narrow_bits(a.wide_mul(b).to_bits()))
+}
+
+/// An I32F32 narrowed to I16F16, or `None` outside the I16F16 range.
+#[inline]
+pub fn narrow(v: I32F32) -> Option<I16F16> {
+    i32::try_from(v.to_bits() >> 16).ok().map(I16F16::from_bits)
+}
+
+/// ⌊√v⌋ for a 32-bit integer, bit by bit (16 steps, no division).
+#[inline]
+pub const fn isqrt32(v: u32) -> u32 {
+    let mut rem = v;
+    let mut root = 0u32;
+    let mut bit = 1u32 << 30;
+    while bit > rem {
+        bit >>= 2;
+    }
+    while bit != 0 {
+        if rem >= root + bit {
+            rem -= root + bit;
+            root = (root >> 1) + bit;
+        } else {
+            root >>= 1;
+        }
+        bit >>= 2;
+    }
+    root
+}
+
+/// √v for a non-negative I32F32, as an I16F16 (negative input gives 0).
+///
+/// The raw I16F16 result is ⌊√bits⌋ of the I32F32's raw bits, computed with a 32-bit square root
+/// after shifting the radicand right by an even `2k` so it fits 32 bits: the result is exact
+/// (⌊√⌋) for a radicand below 1.0 (2^32 raw) and otherwise at most 2^k raw steps low,
+/// a relative error below 2^-15.
+#[inline]
+pub const fn sqrt(v: I32F32) -> I16F16 {
+    let bits = v.to_bits();
+    if bits <= 0 {
+        return I16F16::ZERO;
+    }
+    let bits = bits as u64;
+    let high = 64 - bits.leading_zeros();
+    let shift = if high > 32 { (high - 31) & !1 } else { 0 };
+    // (high - 31) rounded up to even keeps the shifted value below 2^32.
+    let shift = if high > 32 && (bits >> shift) > u32::MAX as u64 {
+        shift + 2
+    } else {
+        shift
+    };
+    let root = (isqrt32((bits >> shift) as u32) as u64) << (shift / 2);
+    if root > i32::MAX as u64 {
+        I16F16::MAX
+    } else {
+        I16F16::from_bits(root as i32)
+    }
+}
+
+/// Normalises raw I16F16 components to a unit vector (raw I16F16), or `None` for a vector
+/// shorter than 2^-8.
+///
+/// The length comes from [`sqrt`]; the components are multiplied by its reciprocal held in
+/// I2F30-like precision (`2^46 / length_bits`, one 64-bit division), so each unit component is
+/// within 2 steps of 2^-16 of the exact one.
+#[inline]
+pub fn normalize_bits(v: [i32; 3]) -> Option<[i32; 3]> {
+    let len2 = Vec3::from_bits(v[0], v[1], v[2]).dot_bits(Vec3::from_bits(v[0], v[1], v[2]));
+    let len = sqrt(I32F32::from_bits(len2)).to_bits();
+    if len < 1 << 8 {
+        return None;
+    }
+    let inv = (1i64 << 46) / len as i64; // 1/length in 30 fraction bits
+    let c = |x: i32| ((x as i64 * inv) >> 30) as i32;
+    Some([c(v[0]), c(v[1]), c(v[2])])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn isqrt32_is_floor_sqrt() {
+        for v in (0u32..70_000).chain([u32::MAX, u32::MAX - 1, 1 << 30, (1 << 31) + 12345]) {
+            let r = isqrt32(v) as u64;
+            assert!(r * r <= v as u64 && (r + 1) * (r + 1) > v as u64, "{v}");
+        }
+    }
+
+    #[test]
+    fn sqrt_is_within_its_bound() {
+        for x in [
+            0.0,
+            0.25,
+            1.0,
+            2.0,
+            3.0,
+            100.0,
+            1234.5678,
+            3.0 * 8192.0 * 8192.0,
+        ] {
+            let got = sqrt(I32F32::from_num(x)).to_num::<f64>();
+            let want = f64::sqrt(x);
+            assert!(
+                (got - want).abs() <= want * 2f64.powi(-15) + 2f64.powi(-16),
+                "{x}: {got}"
+            );
+        }
+        assert_eq!(sqrt(I32F32::from_num(-4)), I16F16::ZERO);
+    }
+
+    #[test]
+    fn normalized_has_unit_length() {
+        for v in [
+            [3.0, 4.0, 0.0],
+            [0.01, -0.02, 0.03],
+            [4000.0, -4000.0, 4000.0],
+        ] {
+            let n = Vec3 {
+                x: I16F16::from_num(v[0]),
+                y: I16F16::from_num(v[1]),
+                z: I16F16::from_num(v[2]),
+            }
+            .normalized()
+            .unwrap();
+            let len = n.dot(n).to_num::<f64>().sqrt();
+            assert!((len - 1.0).abs() < 1e-4, "{v:?}: {len}");
+        }
+        assert_eq!(Vec3::from_bits(1, 1, 1).normalized(), None);
+    }
+}
