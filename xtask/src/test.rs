@@ -77,10 +77,10 @@ pub(crate) fn test() -> Result<(), String> {
     )?;
     // Link-time proof that the render path cannot panic: the panic_never example's panic
     // handler calls an undefined symbol, so the link fails if any panic is reachable. It also
-    // builds the library for each target: no_std, no allocator. The demo firmware is built in
-    // the same invocation, so one target's single-threaded LTO runs beside another's.
-    step("library for every target: no_std, the panic-never link check, the demo firmware");
-    build_firmware_examples("firmware", &["panic_never", "firmware"])?;
+    // builds the library for each target: no_std, no allocator. The firmware examples run below
+    // are built here too, the three targets side by side.
+    step("library for every target: no_std, the panic-never link check, the demo and traced firmware");
+    build_firmware_examples("firmware", &["panic_never", "firmware", "trace"])?;
     // The instrumented fuzz build runs beside the package checks and the firmware, whose QEMU
     // runs leave a core free.
     step("fuzz target: AFL-instrumented build started in the background");

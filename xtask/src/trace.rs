@@ -42,6 +42,8 @@ pub(crate) fn trace() -> Result<(), String> {
         stats.rays(),
         stats.intersection_tests
     );
+    step("traced firmware for every target (a no-op when built)");
+    build_firmware_examples("firmware", &["trace"])?;
     for (target, machine) in FIRMWARE {
         step(&format!("traced classic scene on QEMU {machine}, {target}"));
         let out = run_example(target, "firmware", "trace")?;
