@@ -26,11 +26,15 @@ pub mod metrics;
 #[cfg(all(not(target_os = "none"), feature = "peers"))]
 pub mod peers;
 #[cfg(not(target_os = "none"))]
+pub mod progress;
+#[cfg(not(target_os = "none"))]
 pub mod reference;
 #[cfg(not(target_os = "none"))]
 pub mod scene;
 #[cfg(not(target_os = "none"))]
 pub mod tradeoff;
+#[cfg(not(target_os = "none"))]
+pub mod world;
 
 #[cfg(not(target_os = "none"))]
 use metrics::{ErrorBound, Metrics};
