@@ -228,6 +228,18 @@ impl World {
         Ok(world)
     }
 
+    /// The mesh as OBJ text (positions as f64, faces in order; colours are not written).
+    pub fn to_obj(&self) -> String {
+        let mut s = String::new();
+        for p in &self.positions {
+            s += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+        }
+        for t in &self.triangles {
+            s += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+        }
+        s
+    }
+
     /// Largest |coordinate|.
     pub fn max_coord(&self) -> f64 {
         self.positions
