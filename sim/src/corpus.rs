@@ -423,12 +423,12 @@ pub mod real_world {
         ]
     }
 
-    /// Closed meshes passing through each other (three spheres and two boxes, 1,944
+    /// Closed meshes passing through each other (three spheres and two boxes, 264
     /// triangles): a BSP tree must split many of their triangles, and every pixel inside the
     /// union is covered.
     pub fn bsp_split() -> MeshData {
         let sphere = |c: [f64; 3], r: f64| {
-            let (v, f) = meshgen::icosphere(3);
+            let (v, f) = meshgen::icosphere(1);
             (
                 v.into_iter()
                     .map(|p| [0, 1, 2].map(|k| c[k] + r * p[k]))

@@ -218,12 +218,12 @@ impl World {
         if world.triangles.is_empty() {
             return Err(format!("{name}: no faces"));
         }
-        if let Some(i) = world
-            .positions
-            .iter()
-            .position(|p| p.iter().any(|c| !c.is_finite()))
-        {
-            return Err(format!("{name}: vertex {i} is not finite"));
+        for (i, p) in world.positions.iter().enumerate() {
+            if let Some(c) = p.iter().find(|c| !c.is_finite()) {
+                return Err(format!(
+                    "{name}: vertex {i} coordinate {c} is not a finite number"
+                ));
+            }
         }
         Ok(world)
     }

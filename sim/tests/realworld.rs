@@ -274,3 +274,42 @@ fn obj_materials_become_face_colours_and_normals_are_kept() {
     assert_eq!(world.triangles.len(), 12);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+// ---- 5. Watertight BSP splits ----
+
+/// Pixels inside the silhouette of a closed scene (the reference covers the pixel and its
+/// eight neighbours) that the fixed-point render leaves empty.
+fn holes(fixed: &[i32], reference: &[i32]) -> usize {
+    let at = |x: i64, y: i64| reference[(y as usize) * W + x as usize];
+    let mut n = 0;
+    for y in 1..H as i64 - 1 {
+        for x in 1..W as i64 - 1 {
+            let inside = (-1..=1).all(|dy| (-1..=1).all(|dx| at(x + dx, y + dy) >= 0));
+            n += (inside && fixed[y as usize * W + x as usize] < 0) as usize;
+        }
+    }
+    n
+}
+
+#[test]
+fn bsp_splits_are_watertight() {
+    let mesh = real_world::bsp_split();
+    assert!(World::from_mesh(&mesh).orientation().closed());
+    let bsp = scanline3d_sim::bsp::build(&mesh).unwrap();
+    assert!(bsp.splits >= 200, "split-heavy: {} splits", bsp.splits);
+    let soup = real_world::soup();
+    let [soup_out, soup_in] = real_world::soup_cameras();
+    let [a, b] = real_world::bsp_split_cameras();
+    for (spec, closed) in [
+        (spec_of(&mesh, a), true),
+        (spec_of(&mesh, b), true),
+        (spec_of(&soup, soup_out), false),
+        (spec_of(&soup, soup_in), false),
+    ] {
+        let (m, fixed, reference) = accuracy_with(&spec, W, H, 4, Algorithm::Bsp).unwrap();
+        assert_eq!(m.real, 0, "{m}");
+        if closed {
+            assert_eq!(holes(&fixed.image.ids, &reference.ids), 0);
+        }
+    }
+}
