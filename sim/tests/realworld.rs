@@ -27,29 +27,25 @@ fn spec_of(mesh: &MeshData, camera: CameraSpec) -> SceneSpec {
     default_spec(World::from_mesh(mesh), camera, Culling::Auto)
 }
 
-/// Every method at the default settings (4 sub-pixel bits), then the exact preset.
+/// Every method at the default settings (4 sub-pixel bits), then the exact preset, with the
+/// host time of each fixed-point render (printed, not checked).
 fn table(name: &str, spec: &SceneSpec) -> Vec<(String, Metrics)> {
     let mut rows = Vec::new();
     for a in Algorithm::ALL {
-        let (m, _, _) = match accuracy_with(spec, W, H, 4, a) {
-            Ok(r) => r,
-            Err(e) => {
-                println!("{name:<14} {a:<13} {e}");
-                continue;
-            }
-        };
+        let start = std::time::Instant::now();
+        let (m, _, _) = accuracy_with(spec, W, H, 4, a).unwrap();
         println!(
-            "{name:<14} {a:<13} id {:>6.3} %  real {:>3}",
+            "| {name} | {a} | {:.3} | {} | {:.2} |",
             m.id_mismatch_percent(),
-            m.real
+            m.real,
+            start.elapsed().as_secs_f64()
         );
         rows.push((a.to_string(), m));
     }
     let (m, _, _) =
         accuracy_preset(spec, W, H, PresetChoice::Exact, Algorithm::SpanZBuffer).unwrap();
     println!(
-        "{name:<14} {:<13} id {:>6.3} %  real {:>3}",
-        "exact preset",
+        "| {name} | exact preset | {:.3} | {} | |",
         m.id_mismatch_percent(),
         m.real
     );
@@ -57,11 +53,21 @@ fn table(name: &str, spec: &SceneSpec) -> Vec<(String, Metrics)> {
     rows
 }
 
+/// The numbers: on the soup from outside and inside and on the scanned-style mesh,
+/// with the default command line (culling decided, here two-sided for the soup), every correct
+/// method has no real mismatches and at most 2 % id mismatches, and the exact preset at most
+/// 0.1 %. Newell–Newell–Sancha does not reach that yet (it leaves real mismatches where pieces
+/// of interpenetrating triangles meet: see docs/realworld.md); here it must finish the frame
+/// within its capacities, which it used not to.
 #[test]
 fn hard_scenes_every_method() {
     let soup = real_world::soup();
     let [outside, inside] = real_world::soup_cameras();
     let scanned = real_world::scanned();
+    assert!(scanned.triangles.len() >= 3000 && soup.triangles.len() >= 400);
+    println!("| scene | method | id mismatch % | real | seconds (host) |");
+    println!("|---|---|---|---|---|");
+    let mut failures = Vec::new();
     for (name, spec) in [
         ("soup outside", spec_of(&soup, outside)),
         ("soup inside", spec_of(&soup, inside)),
@@ -70,8 +76,16 @@ fn hard_scenes_every_method() {
             spec_of(&scanned, real_world::scanned_cameras()[0]),
         ),
     ] {
-        table(name, &spec);
+        for (method, m) in table(name, &spec) {
+            let limit = if method == "exact" { 0.1 } else { 2.0 };
+            let correct = method != Algorithm::DepthSort.to_string()
+                && method != Algorithm::Newell.to_string();
+            if correct && (m.real > 0 || m.id_mismatch_percent() > limit) {
+                failures.push(format!("{name} {method}: {m}"));
+            }
+        }
     }
+    assert!(failures.is_empty(), "{failures:#?}");
 }
 
 // ---- 2. Culling that is right by default ----
@@ -172,7 +186,11 @@ fn km_scale_city_renders_at_near_far_1e5() {
         }
         let (m, fixed, _) =
             accuracy_preset(&spec, W, H, PresetChoice::Exact, Algorithm::SpanZBuffer).unwrap();
-        println!("city from {:?}: exact preset {m}", cam.eye);
+        println!(
+            "city from {:?} ({} chunks): exact preset {m}",
+            cam.eye,
+            spec.instances.len()
+        );
         let covered = fixed.image.ids.iter().filter(|&&i| i >= 0).count();
         assert!(
             covered > W * H / 10,
