@@ -476,9 +476,12 @@ pub mod real_world {
         for p in &v {
             obj += &format!("v {} {} {}\n", p[0], p[1], p[2]);
         }
+        // Normals leaning towards ±y (not what area weighting gives), so a test can tell them
+        // from computed ones.
         for p in &v {
-            let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-            obj += &format!("vn {} {} {}\n", p[0] / l, p[1] / l, p[2] / l);
+            let n = [p[0], 2.0 * p[1], p[2]];
+            let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            obj += &format!("vn {} {} {}\n", n[0] / l, n[1] / l, n[2] / l);
         }
         let names = ["brick", "glass", "roof"];
         for (k, t) in f.iter().enumerate() {

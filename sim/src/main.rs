@@ -347,7 +347,8 @@ struct ExportArgs {
     /// Output Rust file.
     #[arg(long)]
     out: PathBuf,
-    /// Also export vertex normals (only Gouraud shading uses them).
+    /// Also export vertex normals: the OBJ file's when it has them, else area-weighted ones
+    /// (only Gouraud shading uses them).
     #[arg(long)]
     normals: bool,
     /// Also build a BSP tree and export it (`BSP_TREE`, `SceneBspWorkspace`): the mesh becomes

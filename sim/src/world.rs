@@ -719,7 +719,8 @@ pub struct Loaded {
 
 impl Loaded {
     /// Loads `path` with progress on standard error for large files; with `orient`, flips the
-    /// faces [`Orientation::flips`] names first. Warnings go to standard error.
+    /// faces [`Orientation::flips`] names first. Warnings go to standard error, among them a
+    /// closed mesh with inconsistent winding (with the faces to flip) that was not oriented.
     pub fn load(path: &Path, orient: bool) -> Result<Loaded, String> {
         let progress = crate::progress::Progress::start(
             &format!("loading {}", path.display()),
@@ -738,6 +739,8 @@ impl Loaded {
         let orientation = world.orientation();
         if orient {
             world.flip(&orientation.flips);
+        } else if orientation.closed() && !orientation.flips.is_empty() {
+            eprintln!("sim: warning: the mesh is {orientation}");
         }
         let (instances, order) = world.instances()?;
         Ok(Loaded {
@@ -757,18 +760,14 @@ impl Loaded {
             .collect()
     }
 
-    /// Whether to cull, and why, for `views` at aspect ratio `aspect`. With
-    /// [`Culling::Auto`], a closed mesh with inconsistent winding is reported on standard error
-    /// (with the faces to flip) unless it was oriented on loading.
+    /// Whether to cull, and why, for `views` at aspect ratio `aspect`.
     pub fn culling(&self, culling: Culling, views: &[CameraSpec], aspect: f64) -> CullDecision {
         let orientation = if self.orientation.flips.is_empty() {
             self.orientation.clone()
         } else {
+            // Oriented on loading, or not: what the faces are now.
             self.world.orientation()
         };
-        if orientation.closed() && !orientation.flips.is_empty() {
-            eprintln!("sim: warning: the mesh is {orientation}");
-        }
         match culling {
             Culling::On => CullDecision {
                 cull: true,

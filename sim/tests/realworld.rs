@@ -32,6 +32,12 @@ fn spec_of(mesh: &MeshData, camera: CameraSpec) -> SceneSpec {
 fn table(name: &str, spec: &SceneSpec) -> Vec<(String, Metrics)> {
     let mut rows = Vec::new();
     for a in Algorithm::ALL {
+        // Newell splits the soup into tens of thousands of pieces: seconds in release,
+        // minutes in a debug build, so only release runs it there.
+        if a == Algorithm::Newell && name.starts_with("soup") && cfg!(debug_assertions) {
+            println!("| {name} | {a} | (release builds only) | | |");
+            continue;
+        }
         let start = std::time::Instant::now();
         let (m, _, _) = accuracy_with(spec, W, H, 4, a).unwrap();
         println!(
@@ -269,8 +275,14 @@ fn obj_materials_become_face_colours_and_normals_are_kept() {
     let (instances, _) = world.instances().unwrap();
     let normals = instances[0].mesh.normals.as_ref().unwrap();
     let n0 = normals[0].map(|c| c.to_num::<f64>());
-    let s = 1.0 / 3f64.sqrt();
-    assert!(n0.iter().all(|c| (c.abs() - s).abs() < 1e-4), "{n0:?}");
+    let s = 1.0 / 6f64.sqrt();
+    let expected = [s, 2.0 * s, s];
+    assert!(
+        n0.iter()
+            .zip(expected)
+            .all(|(c, e)| (c.abs() - e).abs() < 1e-4),
+        "{n0:?}"
+    );
     // The id image does not depend on the colours.
     let cam = CameraSpec::looking_at([2.0, 1.5, 3.0], [0.0; 3], 50.0, 0.1, 20.0);
     let with = default_spec(world.clone(), cam, Culling::Auto);

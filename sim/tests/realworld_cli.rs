@@ -158,3 +158,31 @@ fn a_km_scale_city_renders_with_the_default_command_line() {
     assert!(stderr.contains("docs/large-worlds.md"), "{stderr}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn export_uses_the_obj_files_vertex_normals() {
+    let dir = scratch("normals");
+    let (obj, mtl, _) = real_world::materials_obj();
+    std::fs::write(dir.join("box.obj"), obj).unwrap();
+    std::fs::write(dir.join("materials.mtl"), mtl).unwrap();
+    let (code, _, stderr) = sim(
+        &[
+            "export",
+            "box.obj",
+            "--normals",
+            "--views",
+            "1",
+            "--size",
+            "32x32",
+            "--out",
+            "b.rs",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 0, "{stderr}");
+    let src = std::fs::read_to_string(dir.join("b.rs")).unwrap();
+    // (1, 2, 1)/√6 in I16F16 bits: 26755, 53510; area weighting would give 37837 (1/√3).
+    assert!(src.contains("26755") && src.contains("53510"), "{src}");
+    assert!(!src.contains("37837"), "{src}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
