@@ -253,7 +253,8 @@ pub fn all() -> Vec<CorpusScene> {
                 CameraSpec::looking_at([0.0, 4.0, 7.0], [0.0, -0.5, 0.0], 55.0, 0.2, 40.0),
                 CameraSpec::looking_at([6.0, 1.5, 3.0], [-1.0, 0.0, -1.0], 60.0, 0.2, 40.0),
             ],
-            cull_back_faces: true,
+            // Open: the second camera sees its underside past the near edge.
+            cull_back_faces: false,
         },
         CorpusScene {
             name: "near-plane",
