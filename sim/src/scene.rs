@@ -631,7 +631,8 @@ impl SceneSpec {
             }
             for p in 0..w * h {
                 let (id, d) = (r.image.ids[p], r.image.depth[p]);
-                if id < 0 || !(d < image.depth[p]) {
+                // NaN depth (none kept) never wins; an equal depth keeps the earlier pass.
+                if id < 0 || d.partial_cmp(&image.depth[p]) != Some(std::cmp::Ordering::Less) {
                     continue;
                 }
                 let at = starts.partition_point(|s| s.0 <= id as usize) - 1;
