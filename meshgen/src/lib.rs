@@ -204,3 +204,122 @@ pub fn hsr_scene(level: usize) -> Vec<HsrObject> {
 pub fn fixed_bits(v: f64) -> i32 {
     (v * 65536.0).round() as i32
 }
+
+/// A small deterministic random generator (SplitMix64), so generated scenes are the same on
+/// every machine.
+#[derive(Clone, Debug)]
+pub struct Rng(u64);
+
+impl Rng {
+    /// A generator from `seed`.
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed)
+    }
+
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in `[lo, hi)`.
+    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// `n` random triangles in the cube `[−half, half]³`, each a random triangle of edge about
+/// `size` around a random centre, randomly wound: a soup whose triangles pass through each
+/// other everywhere.
+pub fn soup(n: usize, half: f64, size: f64, seed: u64) -> Shape {
+    let mut rng = Rng::new(seed);
+    let mut v = Vec::with_capacity(3 * n);
+    let mut f = Vec::with_capacity(n);
+    for k in 0..n {
+        let c = [0; 3].map(|_| rng.range(-half, half));
+        for _ in 0..3 {
+            v.push([0, 1, 2].map(|i| c[i] + rng.range(-size, size)));
+        }
+        let b = 3 * k as u16;
+        f.push([b, b + 1, b + 2]);
+    }
+    (v, f)
+}
+
+/// `shape` with the winding of each triangle reversed with probability one half.
+pub fn random_winding((v, f): Shape, seed: u64) -> Shape {
+    let mut rng = Rng::new(seed);
+    let f = f
+        .into_iter()
+        .map(|[a, b, c]| {
+            if rng.next_u64() & 1 == 1 {
+                [a, c, b]
+            } else {
+                [a, b, c]
+            }
+        })
+        .collect();
+    (v, f)
+}
+
+/// Boxes on a `blocks × blocks` grid of city blocks covering `[0, extent]²` in x and z (y up),
+/// each of random height between `extent / 400` and `extent / 40`: a closed mesh per box, 12
+/// triangles each, with vertex coordinates up to `extent`. Box `k` of the grid is boxes
+/// `12k..12k+12`.
+pub fn city(blocks: usize, extent: f64, seed: u64) -> Vec<Shape> {
+    let mut rng = Rng::new(seed);
+    let cell = extent / blocks as f64;
+    let mut out = Vec::with_capacity(blocks * blocks);
+    for j in 0..blocks {
+        for i in 0..blocks {
+            let street = cell * rng.range(0.15, 0.3);
+            let height = rng.range(extent / 400.0, extent / 40.0);
+            let (v, f) = cube();
+            let (x0, z0) = (i as f64 * cell + street, j as f64 * cell + street);
+            let (sx, sz) = ((cell - 2.0 * street) / 2.0, (cell - 2.0 * street) / 2.0);
+            let v = v
+                .into_iter()
+                .map(|[x, y, z]| {
+                    [
+                        x0 + (x + 1.0) * sx,
+                        (y + 1.0) * height / 2.0,
+                        z0 + (z + 1.0) * sz,
+                    ]
+                })
+                .collect();
+            out.push((v, f));
+        }
+    }
+    out
+}
+
+/// A scanned-looking closed surface: an icosphere of `20 · 4^n` triangles with every vertex
+/// moved along its normal by smooth bumps plus `noise` of random jitter.
+pub fn scanned(subdivisions: u32, noise: f64, seed: u64) -> Shape {
+    let (v, f) = icosphere(subdivisions);
+    let mut rng = Rng::new(seed);
+    let v = v
+        .into_iter()
+        .map(|p| {
+            let bumps = 0.15 * (3.0 * p[0]).sin() * (2.0 * p[1]).cos() + 0.1 * (5.0 * p[2]).sin();
+            let r = 1.0 + bumps + rng.range(-noise, noise);
+            p.map(|c| c * r)
+        })
+        .collect();
+    (v, f)
+}
+
+/// Concatenates shapes into one (indices renumbered, order kept).
+pub fn merge(shapes: impl IntoIterator<Item = Shape>) -> Shape {
+    let mut v: Vec<[f64; 3]> = Vec::new();
+    let mut f = Vec::new();
+    for (sv, sf) in shapes {
+        let base = v.len() as u16;
+        v.extend(sv);
+        f.extend(sf.into_iter().map(|t| t.map(|i| i + base)));
+    }
+    (v, f)
+}

@@ -47,20 +47,66 @@ pub fn sphere_views(
         .collect()
 }
 
-/// The default sphere of views for a scene: `count` views at 3 × its bounding radius from its
-/// centre, 50° field of view, near = distance / 20, far = distance × 4 (what `sim analyze` and
-/// `sim export` use without camera options).
+/// Eye distance and near/far planes for views of a scene of bounding radius `radius`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewRange {
+    /// Distance of the eye from the scene's centre.
+    pub distance: f64,
+    /// Near plane.
+    pub near: f64,
+    /// Far plane.
+    pub far: f64,
+}
+
+impl ViewRange {
+    /// Given values are kept; the others follow from the scene's size. By default the eye is
+    /// at 3 × the radius, near = distance / 20 and far = distance × 4; when that far plane is
+    /// beyond the eye-space envelope (2^14 units), far shrinks to just behind the whole scene
+    /// (distance + 1.05 × radius), the eye comes closer if even that does not fit, and near is
+    /// raised where needed to keep far/near within the library's 2^20.
+    pub fn fit(
+        radius: f64,
+        distance: Option<f64>,
+        near: Option<f64>,
+        far: Option<f64>,
+    ) -> Result<ViewRange, String> {
+        let r = radius.max(1e-3);
+        let max = MAX_EYE_DISTANCE as f64;
+        let behind = 1.05 * r;
+        let distance = match distance {
+            Some(d) if d > 0.0 => d,
+            Some(d) => return Err(format!("distance {d} must be positive")),
+            None if 12.0 * r <= max => 3.0 * r,
+            None if 3.0 * r + behind <= max => 3.0 * r,
+            None if 1.2 * r + behind <= max => max - behind,
+            None => {
+                return Err(format!(
+                    "the scene's radius of {r:.0} units is too large to be seen whole within the eye-space envelope of {max} units: give --eye (with --target) or --distance"
+                ))
+            }
+        };
+        let far = far.unwrap_or(if 4.0 * distance <= max {
+            4.0 * distance
+        } else {
+            (distance + behind).min(max)
+        });
+        let near = near
+            .unwrap_or((distance / 20.0).max(far / scanline3d::scene::MAX_FAR_NEAR_RATIO as f64));
+        Ok(ViewRange {
+            distance,
+            near,
+            far,
+        })
+    }
+}
+
+/// The default sphere of views for a scene: `count` views at the [`ViewRange`] its size
+/// gives (3 × its bounding radius from its centre for scenes that fit), 50° field of view
+/// (what `sim analyze` and `sim export` use without camera options).
 pub fn default_views(spec: &SceneSpec, count: usize) -> Result<Vec<CameraSpec>, String> {
     let (centre, radius) = bounds(spec)?;
-    let distance = 3.0 * radius.max(1e-3);
-    Ok(sphere_views(
-        centre,
-        distance,
-        count,
-        50.0,
-        distance / 20.0,
-        distance * 4.0,
-    ))
+    let r = ViewRange::fit(radius, None, None, None)?;
+    Ok(sphere_views(centre, r.distance, count, 50.0, r.near, r.far))
 }
 
 /// Centre and radius of the scene's bounding sphere (around its bounding-box centre), in world

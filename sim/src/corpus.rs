@@ -253,7 +253,8 @@ pub fn all() -> Vec<CorpusScene> {
                 CameraSpec::looking_at([0.0, 4.0, 7.0], [0.0, -0.5, 0.0], 55.0, 0.2, 40.0),
                 CameraSpec::looking_at([6.0, 1.5, 3.0], [-1.0, 0.0, -1.0], 60.0, 0.2, 40.0),
             ],
-            cull_back_faces: true,
+            // Open: the second camera sees its underside past the near edge.
+            cull_back_faces: false,
         },
         CorpusScene {
             name: "near-plane",
@@ -333,5 +334,173 @@ mod tests {
         assert!(count("heightfield") >= 10_000);
         assert_eq!(count("slivers"), 240);
         assert!(all.iter().all(|s| s.cameras.len() >= 2));
+    }
+}
+
+/// Scenes like users bring (issue 20): generated, so every machine has the same ones.
+pub mod real_world {
+    use super::{mesh, palette};
+    use crate::meshgen;
+    use crate::scene::{CameraSpec, MeshData};
+    use crate::world::World;
+
+    /// 400 random triangles of about 0.5 units in `[−1, 1]³`, randomly wound, passing
+    /// through each other everywhere.
+    pub fn soup() -> MeshData {
+        let (v, f) = meshgen::soup(400, 1.0, 0.5, 20);
+        mesh(&v, f)
+    }
+
+    /// The soup seen from outside and from inside (the eye amid the triangles).
+    pub fn soup_cameras() -> [CameraSpec; 2] {
+        [
+            CameraSpec::looking_at([1.7, 1.1, 3.4], [0.0; 3], 50.0, 0.1, 20.0),
+            CameraSpec::looking_at([0.05, 0.1, 0.2], [0.6, -0.2, -1.0], 70.0, 0.01, 20.0),
+        ]
+    }
+
+    /// An open terrain (32 × 32 quads, 2048 triangles) with every triangle's winding chosen at
+    /// random, as files from the wild often are.
+    pub fn open_random_winding() -> MeshData {
+        let shape = meshgen::grid([32, 32], [4.0, 4.0], |x, z| {
+            0.6 * (0.9 * x).sin() * (0.7 * z).cos()
+        });
+        let (v, f) = meshgen::random_winding(shape, 7);
+        mesh(&v, f)
+    }
+
+    /// A camera above the terrain and one below it (open surfaces show their back side).
+    pub fn open_cameras() -> [CameraSpec; 2] {
+        [
+            CameraSpec::looking_at([0.0, 4.0, 7.0], [0.0, -0.5, 0.0], 55.0, 0.2, 40.0),
+            CameraSpec::looking_at([2.0, -3.0, 6.0], [0.0, 0.0, 0.0], 55.0, 0.2, 40.0),
+        ]
+    }
+
+    /// 40 × 40 closed boxes over 8,000 × 8,000 units (19,200 triangles, coordinates up to
+    /// 8,000): beyond the model envelope of ±4096.
+    pub fn city() -> World {
+        let (v, f) = meshgen::merge(meshgen::city(40, 8000.0, 3));
+        let n = f.len();
+        World::new(
+            v,
+            f.into_iter().map(|t| t.map(u32::from)).collect(),
+            palette(n),
+        )
+    }
+
+    /// Views of the city at near/far = 10^5: from a rooftop across the whole city, and at
+    /// street level down an avenue.
+    pub fn city_cameras() -> [CameraSpec; 2] {
+        [
+            CameraSpec::looking_at(
+                [-600.0, 900.0, -600.0],
+                [4000.0, 0.0, 4000.0],
+                50.0,
+                0.1,
+                10_000.0,
+            ),
+            CameraSpec::looking_at(
+                [4100.0, 30.0, 200.0],
+                [4100.0, 20.0, 7000.0],
+                60.0,
+                0.1,
+                10_000.0,
+            ),
+        ]
+    }
+
+    /// A scanned-looking closed mesh: 5,120 triangles, bumpy with jitter.
+    pub fn scanned() -> MeshData {
+        let (v, f) = meshgen::scanned(4, 0.01, 11);
+        mesh(&v, f)
+    }
+
+    /// Cameras around the scanned mesh.
+    pub fn scanned_cameras() -> [CameraSpec; 2] {
+        [
+            CameraSpec::looking_at([2.5, 1.2, 3.0], [0.0; 3], 50.0, 0.1, 20.0),
+            CameraSpec::looking_at([-3.2, -0.8, 1.5], [0.0; 3], 45.0, 0.1, 20.0),
+        ]
+    }
+
+    /// Closed meshes passing through each other (three spheres and two boxes, 264
+    /// triangles): a BSP tree must split many of their triangles, and every pixel inside the
+    /// union is covered.
+    pub fn bsp_split() -> MeshData {
+        let sphere = |c: [f64; 3], r: f64| {
+            let (v, f) = meshgen::icosphere(1);
+            (
+                v.into_iter()
+                    .map(|p| [0, 1, 2].map(|k| c[k] + r * p[k]))
+                    .collect(),
+                f,
+            )
+        };
+        let cuboid = |c: [f64; 3], s: [f64; 3], twist: f64| {
+            let (v, f) = meshgen::cube();
+            let (sn, cs) = twist.sin_cos();
+            let v = v
+                .into_iter()
+                .map(|p| {
+                    let [x, y, z] = [0, 1, 2].map(|k| p[k] * s[k]);
+                    [c[0] + cs * x + sn * z, c[1] + y, c[2] - sn * x + cs * z]
+                })
+                .collect();
+            (v, f)
+        };
+        let (v, f) = meshgen::merge([
+            sphere([-0.4, 0.0, 0.0], 0.8),
+            sphere([0.5, 0.2, 0.1], 0.7),
+            sphere([0.0, -0.3, 0.6], 0.5),
+            cuboid([0.0, 0.0, 0.0], [1.4, 0.25, 0.3], 0.4),
+            cuboid([0.2, 0.3, -0.2], [0.3, 1.2, 0.3], -0.3),
+        ]);
+        let mut m = mesh(&v, f);
+        m.colors = palette(m.triangles.len());
+        m
+    }
+
+    /// Cameras around the split scene.
+    pub fn bsp_split_cameras() -> [CameraSpec; 2] {
+        [
+            CameraSpec::looking_at([0.8, 1.6, 3.8], [0.0; 3], 50.0, 0.1, 20.0),
+            CameraSpec::looking_at([-3.0, -1.0, -2.5], [0.0; 3], 50.0, 0.1, 20.0),
+        ]
+    }
+
+    /// A cube as OBJ text whose faces use three materials of `materials.mtl` (returned too),
+    /// with a vertex normal per corner: `(obj, mtl, Kd colour of each material in face order)`.
+    pub fn materials_obj() -> (String, String, [[u8; 3]; 3]) {
+        let (v, f) = meshgen::cube();
+        let mut obj = String::from("mtllib materials.mtl\n");
+        for p in &v {
+            obj += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+        }
+        // Normals leaning towards ±y (not what area weighting gives), so a test can tell them
+        // from computed ones.
+        for p in &v {
+            let n = [p[0], 2.0 * p[1], p[2]];
+            let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            obj += &format!("vn {} {} {}\n", n[0] / l, n[1] / l, n[2] / l);
+        }
+        let names = ["brick", "glass", "roof"];
+        for (k, t) in f.iter().enumerate() {
+            if k % 4 == 0 {
+                obj += &format!("usemtl {}\n", names[k / 4]);
+            }
+            let c = t.map(|i| i + 1);
+            obj += &format!(
+                "f {}//{} {}//{} {}//{}\n",
+                c[0], c[0], c[1], c[1], c[2], c[2]
+            );
+        }
+        let colors = [[178, 76, 51], [102, 153, 229], [76, 76, 76]];
+        let mut mtl = String::new();
+        for (name, c) in names.iter().zip(colors) {
+            let kd = c.map(|x| x as f64 / 255.0);
+            mtl += &format!("newmtl {name}\nKd {} {} {}\n\n", kd[0], kd[1], kd[2]);
+        }
+        (obj, mtl, colors)
     }
 }

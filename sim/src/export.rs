@@ -20,7 +20,8 @@ pub struct Export<'a> {
     pub cull_back_faces: bool,
     /// Safety margin on the capacities, percent.
     pub margin_percent: u32,
-    /// Also export area-weighted unit vertex normals (only Gouraud shading reads them).
+    /// Also export unit vertex normals: the OBJ file's, else area-weighted ones (only Gouraud
+    /// shading reads them).
     pub normals: bool,
     /// The command that produced the file (recorded in its header).
     pub command: String,
@@ -29,8 +30,12 @@ pub struct Export<'a> {
     pub bsp: Option<&'a crate::bsp::Bsp>,
 }
 
-/// Area-weighted vertex normals, unit length, rounded to I16F16 bits.
+/// The mesh's own vertex normals (from the OBJ file) in I16F16 bits when it has them, else
+/// area-weighted vertex normals, unit length, rounded to I16F16 bits.
 fn vertex_normals(mesh: &MeshData) -> Vec<[i32; 3]> {
+    if let Some(n) = &mesh.normals {
+        return n.iter().map(|v| v.map(|c| c.to_bits())).collect();
+    }
     let p = |i: u16| mesh.vertices[i as usize].map(|c| c.to_num::<f64>());
     let mut acc = vec![[0.0f64; 3]; mesh.vertices.len()];
     for t in &mesh.triangles {

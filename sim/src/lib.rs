@@ -26,6 +26,8 @@ pub mod metrics;
 #[cfg(all(not(target_os = "none"), feature = "peers"))]
 pub mod peers;
 #[cfg(not(target_os = "none"))]
+pub mod progress;
+#[cfg(not(target_os = "none"))]
 pub mod reference;
 #[cfg(not(target_os = "none"))]
 pub mod scene;
@@ -33,6 +35,8 @@ pub mod scene;
 pub mod trace;
 #[cfg(not(target_os = "none"))]
 pub mod tradeoff;
+#[cfg(not(target_os = "none"))]
+pub mod world;
 
 #[cfg(not(target_os = "none"))]
 use metrics::{ErrorBound, Metrics};
@@ -65,6 +69,29 @@ pub fn accuracy_with(
 }
 
 #[cfg(not(target_os = "none"))]
+/// [`accuracy`] against a reference that culls back faces exactly when `spec` does: it
+/// measures the renderer alone, where [`accuracy`] (whose reference sees every face) also
+/// counts the faces that culling wrongly removed.
+pub fn accuracy_same_culling(
+    spec: &SceneSpec,
+    w: usize,
+    h: usize,
+    sub_bits: u32,
+) -> Result<(Metrics, scene::FixedRender, reference::Image), String> {
+    let fixed = spec.render_fixed(w, h, sub_bits)?;
+    let mut reference = spec.reference()?;
+    reference.cull_back_faces = spec.cull_back_faces;
+    compare_with(
+        spec,
+        w,
+        h,
+        scene::Precision::bits(sub_bits),
+        fixed,
+        reference,
+    )
+}
+
+#[cfg(not(target_os = "none"))]
 /// [`accuracy_with`] with the precision choices of a preset.
 pub fn accuracy_preset(
     spec: &SceneSpec,
@@ -86,7 +113,19 @@ fn judge(
     precision: scene::Precision,
     fixed: scene::FixedRender,
 ) -> Result<(Metrics, scene::FixedRender, reference::Image), String> {
-    let reference = spec.reference()?;
+    compare_with(spec, w, h, precision, fixed, spec.reference()?)
+}
+
+#[cfg(not(target_os = "none"))]
+/// Compares a fixed-point render with `reference` under the error bound of `precision`.
+fn compare_with(
+    spec: &SceneSpec,
+    w: usize,
+    h: usize,
+    precision: scene::Precision,
+    fixed: scene::FixedRender,
+    reference: reference::Scene,
+) -> Result<(Metrics, scene::FixedRender, reference::Image), String> {
     let ref_image = reference.render(w, h);
     let bound = ErrorBound {
         sub_bits: precision.sub_bits,

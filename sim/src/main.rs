@@ -8,8 +8,9 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use scanline3d_sim::metrics::{self, ErrorBound};
 use scanline3d_sim::reference::Image;
 use scanline3d_sim::scene::{
-    self, Algorithm, CameraSpec, LightSpec, MeshData, PresetChoice, SceneSpec, SetupArith,
+    self, Algorithm, CameraSpec, LightSpec, PresetChoice, SceneSpec, SetupArith,
 };
+use scanline3d_sim::world::{Culling, Loaded};
 use scanline3d_sim::{accuracy, accuracy_preset, accuracy_with, analyze, corpus};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -224,9 +225,8 @@ struct View {
     /// arithmetic of fast and balanced is built for span-zbuffer only.
     #[arg(long, conflicts_with = "sub_pixel_bits")]
     preset: Option<PresetChoice>,
-    /// Draw back faces too (open surfaces).
-    #[arg(long)]
-    no_cull: bool,
+    #[command(flatten)]
+    faces: Faces,
     /// Hidden-surface method: span-zbuffer (default), zbuffer, band:N (N = 1, 2, 4, ..., 128),
     /// depth-sort, newell, bsp, span-sort, warnock, or raycast (the f64 reference ray caster).
     #[arg(long, value_parser = method, default_value = "span-zbuffer")]
@@ -237,6 +237,28 @@ impl View {
     /// The sub-pixel bits in effect (the preset's, if one was chosen).
     fn sub_bits(&self) -> u32 {
         self.preset.map_or(self.sub_pixel_bits, |p| p.sub_bits())
+    }
+}
+
+/// Which faces are drawn.
+#[derive(Args, Debug, Clone)]
+struct Faces {
+    /// Cull back faces. Default: only where culling cannot change the image (a closed mesh
+    /// wound counter-clockwise from outside, every eye outside it); otherwise two-sided.
+    #[arg(long, conflicts_with = "no_cull")]
+    cull: bool,
+    /// Draw back faces too, always.
+    #[arg(long)]
+    no_cull: bool,
+    /// Flip the faces of a mesh with inconsistent winding so that every face is wound
+    /// counter-clockwise from outside (then culling can apply).
+    #[arg(long)]
+    orient: bool,
+}
+
+impl Faces {
+    fn culling(&self) -> Culling {
+        Culling::from_flags(self.cull, self.no_cull)
     }
 }
 
@@ -327,9 +349,8 @@ struct Views {
     /// Image size WxH.
     #[arg(long, value_parser = size, default_value = "240x240")]
     size: (usize, usize),
-    /// Draw back faces too (open surfaces).
-    #[arg(long)]
-    no_cull: bool,
+    #[command(flatten)]
+    faces: Faces,
     /// Safety margin on the capacities, in percent: room for views between the analysed ones
     /// (an overfull frame is still reported in its statistics, never silent).
     #[arg(long, default_value_t = 25)]
@@ -337,45 +358,56 @@ struct Views {
 }
 
 impl Views {
-    /// The scene (camera unused) and the cameras to analyse.
-    fn resolve(&self) -> Result<(SceneSpec, Vec<CameraSpec>), String> {
+    /// The scene (its camera unused; culling decided for the cameras), the cameras to
+    /// analyse, and the loaded OBJ file (none for the demo).
+    fn resolve(&self) -> Result<(SceneSpec, Vec<CameraSpec>, Option<Loaded>), String> {
         if self.demo {
             let frames = scanline3d_demo::ORBIT_FRAMES;
             let cams = (0..frames)
                 .map(|f| SceneSpec::demo(f).map(|s| s.camera))
                 .collect::<Result<Vec<_>, _>>()?;
-            return Ok((SceneSpec::demo(0)?, cams));
+            return Ok((SceneSpec::demo(0)?, cams, None));
         }
         let path = self.scene.as_ref().ok_or("give an OBJ scene or --demo")?;
-        let mesh = MeshData::load_obj(path)?;
+        let loaded = Loaded::load(path, self.faces.orient)?;
         let placeholder = CameraSpec::looking_at([0.0, 0.0, 1.0], [0.0; 3], 50.0, 0.1, 100.0);
-        let spec = SceneSpec::single(mesh, placeholder, LightSpec::default(), !self.no_cull);
+        let mut spec = SceneSpec {
+            instances: loaded.instances.clone(),
+            camera: placeholder,
+            light: LightSpec::default(),
+            cull_back_faces: false,
+        };
         let (centre, radius) = analyze::bounds(&spec)?;
         let target = self.target.unwrap_or(centre);
-        let distance = self.distance.unwrap_or(3.0 * radius.max(1e-3));
-        if distance <= 0.0 {
-            return Err(format!("distance {distance} must be positive"));
-        }
         if self.views == 0 || self.views > 1000 {
             return Err(format!("--views {} must be 1..=1000", self.views));
         }
-        let near = self.near.unwrap_or(distance / 20.0);
-        let far = self.far.unwrap_or(distance * 4.0);
+        let range = analyze::ViewRange::fit(radius, self.distance, self.near, self.far)?;
         let cams = match self.eye {
             Some(eye) => vec![CameraSpec {
                 eye,
                 target,
                 up: self.up,
                 fovy: self.fov,
-                near,
-                far,
+                near: range.near,
+                far: range.far,
             }],
-            None => analyze::sphere_views(target, distance, self.views, self.fov, near, far),
+            None => analyze::sphere_views(
+                target,
+                range.distance,
+                self.views,
+                self.fov,
+                range.near,
+                range.far,
+            ),
         };
         for c in &cams {
             c.fixed()?;
         }
-        Ok((spec, cams))
+        let (w, h) = self.size;
+        let decision = loaded.culling(self.faces.culling(), &cams, w as f64 / h as f64);
+        spec.cull_back_faces = decision.cull;
+        Ok((spec, cams, Some(loaded)))
     }
 }
 
@@ -396,7 +428,8 @@ struct ExportArgs {
     /// Output Rust file.
     #[arg(long)]
     out: PathBuf,
-    /// Also export vertex normals (only Gouraud shading uses them).
+    /// Also export vertex normals: the OBJ file's when it has them, else area-weighted ones
+    /// (only Gouraud shading uses them).
     #[arg(long)]
     normals: bool,
     /// Also build a BSP tree and export it (`BSP_TREE`, `SceneBspWorkspace`): the mesh becomes
@@ -405,15 +438,25 @@ struct ExportArgs {
     bsp: bool,
 }
 
-fn run_analysis(v: &Views) -> Result<(SceneSpec, Vec<CameraSpec>, analyze::Analysis), String> {
-    let (spec, cams) = v.resolve()?;
-    let (w, h) = v.size;
-    let a = analyze::analyze(&spec, &cams, w, h)?;
-    Ok((spec, cams, a))
-}
-
 fn analyze_command(a: AnalyzeArgs) -> Result<(), String> {
-    let (_, _, analysis) = run_analysis(&a.views)?;
+    let (spec, cams, loaded) = a.views.resolve()?;
+    let (w, h) = a.views.size;
+    let analysis = analyze::analyze(&spec, &cams, w, h)?;
+    if let Some(l) = &loaded {
+        say!("winding: {}", l.orientation);
+        say!(
+            "culling: {}",
+            l.culling(a.views.faces.culling(), &cams, w as f64 / h as f64)
+                .reason
+        );
+        if l.instances.len() > 1 {
+            say!(
+                "placement: {} chunks, each around its own origin (coordinates beyond ±{} units or more than 65535 vertices)",
+                l.instances.len(),
+                scanline3d::scene::MAX_MODEL_COORD
+            );
+        }
+    }
     say!("{analysis}");
     let margin = a.views.margin;
     say!(
@@ -479,7 +522,14 @@ fn export_command(a: ExportArgs) -> Result<(), String> {
     if a.views.demo {
         return Err("export takes an OBJ scene (the demo is already built in)".into());
     }
-    let (mut spec, cams) = a.views.resolve()?;
+    let (mut spec, cams, _) = a.views.resolve()?;
+    if spec.instances.len() > 1 {
+        return Err(format!(
+            "export writes one mesh, and this scene is placed in {} chunks (coordinates beyond ±{} units or more than 65535 vertices): see docs/large-worlds.md for building such a world on firmware",
+            spec.instances.len(),
+            scanline3d::scene::MAX_MODEL_COORD
+        ));
+    }
     let bsp = if a.bsp {
         let b = scanline3d_sim::bsp::build(&spec.instances[0].mesh)?;
         spec.instances[0].mesh = b.mesh.clone();
@@ -527,8 +577,9 @@ fn export_command(a: ExportArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn spec_from(path: &Path, v: &View) -> Result<SceneSpec, String> {
-    let mesh = MeshData::load_obj(path)?;
+/// The scene of an OBJ file seen with `v`, culling decided for that view, and the loaded file.
+fn spec_from(path: &Path, v: &View) -> Result<(SceneSpec, Loaded), String> {
+    let loaded = Loaded::load(path, v.faces.orient)?;
     let camera = CameraSpec {
         eye: v.eye,
         target: v.target,
@@ -539,22 +590,36 @@ fn spec_from(path: &Path, v: &View) -> Result<SceneSpec, String> {
     };
     // Validate the camera with the library's rules (one clear message instead of a bad image).
     camera.fixed()?;
-    Ok(SceneSpec::single(
-        mesh,
+    let (w, h) = v.size;
+    let decision = loaded.culling(v.faces.culling(), &[camera], w as f64 / h as f64);
+    let spec = SceneSpec {
+        instances: loaded.instances.clone(),
         camera,
-        LightSpec::default(),
-        !v.no_cull,
-    ))
+        light: LightSpec::default(),
+        cull_back_faces: decision.cull,
+    };
+    Ok((spec, loaded))
+}
+
+/// Says on standard error when a frame shows nothing at all.
+fn report_empty(ids: &[i32], camera: &CameraSpec) {
+    if ids.iter().all(|&i| i < 0) {
+        let _ = writeln!(
+            std::io::stderr(),
+            "sim: nothing drawn: no surface between near {} and far {} in view of the eye at {:?} (inside or beyond everything?)",
+            camera.near, camera.far, camera.eye
+        );
+    }
 }
 
 fn render(a: RenderArgs) -> Result<(), String> {
-    let spec = spec_from(&a.scene, &a.view)?;
+    let (spec, loaded) = spec_from(&a.scene, &a.view)?;
     let (w, h) = a.view.size;
     let renderer = match (a.renderer, a.view.algorithm) {
         (Renderer::Reference, _) | (_, Method::Raycast) => None,
         (Renderer::Fixed, Method::Fixed(algorithm)) => Some(algorithm),
     };
-    let (image, stats_json) = match renderer {
+    let (mut image, stats_json) = match renderer {
         Some(algorithm) => {
             let r = match a.view.preset {
                 Some(p) => spec.render_fixed_preset(w, h, p, algorithm)?,
@@ -588,6 +653,8 @@ fn render(a: RenderArgs) -> Result<(), String> {
             (img, json)
         }
     };
+    report_empty(&image.ids, &spec.camera);
+    loaded.file_ids(&mut image.ids);
     scene::write_png(&a.out, w, h, &image.color)?;
     say!("wrote {}", a.out.display());
     if let Some(p) = &a.ids {
@@ -764,7 +831,7 @@ fn side_by_side(path: &Path, fixed: &Image, reference: &Image) -> Result<(), Str
 fn compare(a: CompareArgs) -> Result<(), String> {
     let (w, h) = a.view.size;
     if let Some(path) = &a.scene {
-        let spec = spec_from(path, &a.view)?;
+        let (spec, _) = spec_from(path, &a.view)?;
         let Method::Fixed(algorithm) = a.view.algorithm else {
             return Err("raycast is the reference itself: choose a fixed-point --algorithm".into());
         };
@@ -781,6 +848,7 @@ fn compare(a: CompareArgs) -> Result<(), String> {
             path.display(),
             a.view.sub_bits()
         );
+        report_empty(&reference.ids, &spec.camera);
         say!("{m}");
         if let Some(p) = &a.side_by_side {
             side_by_side(p, &fixed.image, &reference)?;

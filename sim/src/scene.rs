@@ -19,6 +19,7 @@ use scanline3d::resolve::{
     warnock, BandWorkspace, DepthSortWorkspace, NewellWorkspace, SpanSortWorkspace,
     WarnockWorkspace, ZBufferWorkspace,
 };
+use scanline3d::scene::MAX_SCENE_TRIANGLES;
 use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, Transform, Vertex};
 use scanline3d::sink::{FnSink, Row, RowPixel, RowSink, TriangleId};
 use scanline3d::{Depth, Flat, FrameStats, RenderOptions, Workspace};
@@ -73,6 +74,8 @@ pub struct MeshData {
     pub triangles: Vec<[u16; 3]>,
     /// One colour per triangle.
     pub colors: Vec<Rgb888>,
+    /// Unit vertex normals (I16F16), for Gouraud shading: from the OBJ file when it has them.
+    pub normals: Option<Vec<Vertex>>,
 }
 
 impl MeshData {
@@ -99,6 +102,7 @@ impl MeshData {
             vertices,
             triangles,
             colors,
+            normals: None,
         };
         data.mesh()?;
         Ok(data)
@@ -110,7 +114,7 @@ impl MeshData {
             &self.vertices,
             &self.triangles,
             MeshColors::PerFace(&self.colors),
-            None,
+            self.normals.as_deref(),
         )
         .map_err(|e| e.to_string())
     }
@@ -135,50 +139,21 @@ impl MeshData {
         Self::load_obj_bytes(&bytes, &path.display().to_string())
     }
 
-    /// [`MeshData::load_obj`] from OBJ text in memory; `name` labels error messages. Materials
-    /// are ignored.
+    /// [`MeshData::load_obj`] from OBJ text in memory; `name` labels error messages. Faces
+    /// take the default colour (no `.mtl` file is read); a mesh beyond the model envelope or
+    /// 16-bit indices is refused here ([`crate::world::World`] places such meshes in chunks).
     pub fn load_obj_bytes(bytes: &[u8], name: &str) -> Result<Self, String> {
-        let opts = tobj::LoadOptions {
-            triangulate: true,
-            single_index: false,
-            ..Default::default()
-        };
-        let mut reader = std::io::BufReader::new(bytes);
-        let (models, _) =
-            tobj::load_obj_buf(&mut reader, &opts, |_| Err(tobj::LoadError::OpenFileFailed))
-                .map_err(|e| format!("{name}: {e}"))?;
-        let path = Path::new(name);
-        let mut positions = Vec::new();
-        let mut triangles = Vec::new();
-        for m in &models {
-            let base = positions.len();
-            let mesh = &m.mesh;
-            if mesh.positions.len() % 3 != 0 || mesh.indices.len() % 3 != 0 {
-                return Err(format!("{}: malformed mesh '{}'", path.display(), m.name));
-            }
-            // Parsed as f64 (tobj's use_f64 feature), so every I16F16 coordinate round-trips.
-            positions.extend(mesh.positions.chunks(3).map(|p| [p[0], p[1], p[2]]));
-            for t in mesh.indices.chunks(3) {
-                let idx = |k: usize| -> Result<u16, String> {
-                    let i = base + t[k] as usize;
-                    if i >= positions.len() {
-                        return Err(format!(
-                            "{}: face index {} out of range",
-                            path.display(),
-                            t[k] + 1
-                        ));
-                    }
-                    u16::try_from(i)
-                        .map_err(|_| format!("{}: more than 65535 vertices", path.display()))
-                };
-                triangles.push([idx(0)?, idx(1)?, idx(2)?]);
-            }
+        let world = crate::world::World::load_obj_bytes(bytes, name)?;
+        if !world.fits_one_mesh() {
+            return Err(format!(
+                "{name}: beyond one mesh's envelope (±{} units, 65535 vertices): load it as a World",
+                scanline3d::scene::MAX_MODEL_COORD
+            ));
         }
-        if triangles.is_empty() {
-            return Err(format!("{}: no faces", path.display()));
-        }
-        MeshData::new(&positions, triangles, Rgb888::new(205, 200, 190))
-            .map_err(|e| format!("{}: {e}", path.display()))
+        let (mut instances, _) = world.instances()?;
+        let mut mesh = instances.pop().ok_or("no mesh")?.mesh;
+        mesh.colors = vec![crate::world::DEFAULT_COLOR; mesh.triangles.len()];
+        Ok(mesh)
     }
 
     /// Writes the mesh as OBJ (one `v` per vertex, one `f` per triangle).
@@ -336,6 +311,7 @@ impl SceneSpec {
                         vertices: m.vertices().to_vec(),
                         triangles: m.triangles().to_vec(),
                         colors,
+                        normals: None,
                     },
                     transform: inst.transform,
                 }
@@ -376,6 +352,7 @@ impl SceneSpec {
                         .collect(),
                     colors: vec![Rgb888::new(r, g, b); triangles.len()],
                     triangles,
+                    normals: None,
                 },
                 transform: Transform::IDENTITY,
             })
@@ -449,7 +426,9 @@ impl SceneSpec {
             .fold(0.0, f64::max)
     }
 
-    /// The float reference for this scene (transforms applied in f64).
+    /// The float reference for this scene (transforms applied in f64). It sees every face,
+    /// whatever [`Self::cull_back_faces`] says, so a renderer that culls a face that shows is
+    /// measured as wrong.
     pub fn reference(&self) -> Result<reference::Scene, String> {
         let mut tris = Vec::new();
         for inst in &self.instances {
@@ -471,7 +450,7 @@ impl SceneSpec {
             tris,
             self.light.reference()?,
             self.camera.reference()?,
-            self.cull_back_faces,
+            false,
         ))
     }
 
@@ -522,12 +501,161 @@ impl SceneSpec {
             std::thread::Builder::new()
                 .stack_size(256 << 20)
                 .spawn_scoped(scope, || {
-                    self.render_fixed_on_this_thread(w, h, precision, algorithm)
+                    if self.fits_one_pass() {
+                        self.render_fixed_on_this_thread(w, h, precision, algorithm)
+                    } else {
+                        self.render_passes(w, h, precision, algorithm)
+                    }
                 })
                 .map_err(|e| format!("cannot start render thread: {e}"))?
                 .join()
                 .map_err(|_| "render thread panicked".to_string())?
         })
+    }
+
+    /// Whether the library renders the scene in one frame: at most `MAX_INSTANCES` instances
+    /// and `MAX_SCENE_TRIANGLES` triangles.
+    pub fn fits_one_pass(&self) -> bool {
+        self.instances.len() <= MAX_INSTANCES
+            && self
+                .instances
+                .iter()
+                .map(|i| i.mesh.triangles.len())
+                .sum::<usize>()
+                <= MAX_SCENE_TRIANGLES
+    }
+
+    /// Whether instance `i` may show in the camera's view: some corner of its bounding box is
+    /// between the near and far planes and no side plane of the view has the whole box beyond
+    /// it. Instances that cannot show are left out of multi-pass frames (where they would also
+    /// cost eye-space envelope they do not need).
+    fn may_show(&self, i: &MeshInstance, cam: &reference::Camera, aspect: f64) -> bool {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for v in &i.mesh.vertices {
+            for k in 0..3 {
+                lo[k] = lo[k].min(v[k].to_num::<f64>());
+                hi[k] = hi[k].max(v[k].to_num::<f64>());
+            }
+        }
+        let m = i.transform.m.map(|row| row.map(f64::from));
+        let corners: Vec<[f64; 3]> = (0..8)
+            .map(|c| {
+                let p = [0, 1, 2].map(|k| if c >> k & 1 == 1 { hi[k] } else { lo[k] });
+                let w =
+                    [0, 1, 2].map(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3]);
+                cam.eye_coords(w)
+            })
+            .collect();
+        let ty = (self.camera.fovy.to_radians() / 2.0).tan();
+        let tx = ty * aspect;
+        let all = |f: &dyn Fn(&[f64; 3]) -> bool| corners.iter().all(f);
+        !(all(&|e| e[2] < self.camera.near)
+            || all(&|e| e[2] > self.camera.far)
+            || all(&|e| e[0] > tx * e[2])
+            || all(&|e| e[0] < -tx * e[2])
+            || all(&|e| e[1] > ty * e[2])
+            || all(&|e| e[1] < -ty * e[2]))
+    }
+
+    /// Renders a scene beyond one frame's limits in passes of at most `MAX_INSTANCES`
+    /// instances and `MAX_SCENE_TRIANGLES` triangles (leaving out instances that cannot show),
+    /// composited per pixel by depth, the earlier pass winning a tie. Only methods that keep
+    /// depth can be composited.
+    fn render_passes(
+        &self,
+        w: usize,
+        h: usize,
+        precision: Precision,
+        algorithm: Algorithm,
+    ) -> Result<FixedRender, String> {
+        if !matches!(
+            algorithm,
+            Algorithm::SpanZBuffer | Algorithm::ZBuffer | Algorithm::Band(_)
+        ) {
+            return Err(format!(
+                "this scene needs several passes ({} instances, {} triangles; one frame holds {MAX_INSTANCES} and {MAX_SCENE_TRIANGLES}), which only the depth-buffer methods composite, not {algorithm}",
+                self.instances.len(),
+                self.instances.iter().map(|i| i.mesh.triangles.len()).sum::<usize>()
+            ));
+        }
+        let cam = self.camera.reference()?;
+        let aspect = w as f64 / h as f64;
+        // Triangle id of each instance's first triangle in the whole scene.
+        let mut base = Vec::with_capacity(self.instances.len());
+        let mut n = 0usize;
+        for i in &self.instances {
+            base.push(n);
+            n += i.mesh.triangles.len();
+        }
+        let mut passes: Vec<Vec<usize>> = Vec::new();
+        let mut tris = 0usize;
+        for (k, inst) in self.instances.iter().enumerate() {
+            if !self.may_show(inst, &cam, aspect) {
+                continue;
+            }
+            let t = inst.mesh.triangles.len();
+            match passes.last_mut() {
+                Some(p) if p.len() < MAX_INSTANCES && tris + t <= MAX_SCENE_TRIANGLES => {
+                    p.push(k);
+                    tris += t;
+                }
+                _ => {
+                    passes.push(vec![k]);
+                    tris = t;
+                }
+            }
+        }
+        let mut image = Image {
+            width: w,
+            height: h,
+            ids: vec![-1; w * h],
+            depth: vec![f32::INFINITY; w * h],
+            color: vec![[0; 3]; w * h],
+        };
+        let mut stats = FrameStats::default();
+        for pass in &passes {
+            let spec = SceneSpec {
+                instances: pass.iter().map(|&k| self.instances[k].clone()).collect(),
+                camera: self.camera,
+                light: self.light,
+                cull_back_faces: self.cull_back_faces,
+            };
+            let r = spec.render_fixed_on_this_thread(w, h, precision, algorithm)?;
+            // Pass-local id -> scene id.
+            let mut starts = Vec::new();
+            let mut local = 0usize;
+            for &k in pass {
+                starts.push((local, base[k]));
+                local += self.instances[k].mesh.triangles.len();
+            }
+            for p in 0..w * h {
+                let (id, d) = (r.image.ids[p], r.image.depth[p]);
+                // NaN depth (none kept) never wins; an equal depth keeps the earlier pass.
+                if id < 0 || d.partial_cmp(&image.depth[p]) != Some(std::cmp::Ordering::Less) {
+                    continue;
+                }
+                let at = starts.partition_point(|s| s.0 <= id as usize) - 1;
+                let (first_local, first_scene) = starts[at];
+                image.ids[p] = (id as usize - first_local + first_scene) as i32;
+                image.depth[p] = d;
+                image.color[p] = r.image.color[p];
+            }
+            let s = r.stats;
+            stats.triangles_in += s.triangles_in;
+            stats.culled += s.culled;
+            stats.clipped += s.clipped;
+            stats.rejected += s.rejected;
+            stats.bucketed = stats.bucketed.max(s.bucketed);
+            stats.activated += s.activated;
+            stats.spans += s.spans;
+            stats.fragments += s.fragments;
+            stats.pixels_written = stats.pixels_written.max(s.pixels_written);
+            stats.peak_active = stats.peak_active.max(s.peak_active);
+            stats.peak_spans = stats.peak_spans.max(s.peak_spans);
+            stats.dropped += s.dropped;
+        }
+        Ok(FixedRender { image, stats })
     }
 
     /// The library's view of each instance's mesh (validated).

@@ -56,7 +56,12 @@
 //! An unmarked piece is moved at most once, splits are bounded by `PIECES` (each needs a free
 //! store entry, and running out is a [`RenderError::Capacity`] error with
 //! [`CapacityKind::Pieces`]), and a marked piece that neither splitting plane cuts (a cycle
-//! closed by other pieces) is moved again at most `PIECES` times in a frame. On top of that
+//! closed by other pieces) is moved again at most `PIECES` times in a frame. When, at one head
+//! position, more pieces are moved again than were moved there in all (every piece of the
+//! cycle went round once more and no plane of the pair cut the other beyond the rounding
+//! cell), the cycle is one of pieces of interpenetrating triangles meeting within that cell:
+//! the head is drawn and the search goes on ([`SortStats::cycles_within_rounding`]) instead of
+//! re-testing the same cycle until the step limit. On top of that
 //! the search takes at most [`step_limit`]`(PIECES)` steps (each scans part of the list),
 //! after which the frame fails with [`CapacityKind::SortSteps`] instead of looping. Nothing
 //! reaches the sink before the order is complete.
@@ -125,6 +130,9 @@ pub struct SortStats {
     pub dropped_slivers: u32,
     /// Search steps taken.
     pub steps: u32,
+    /// Cycles that no plane of their pieces cuts beyond the rounding cell (pieces of
+    /// interpenetrating triangles meeting within it), broken by drawing the head first.
+    pub cycles_within_rounding: u32,
 }
 
 /// Depth sort after Newell, Newell and Sancha: pieces are ordered far to near, overlapping
@@ -219,6 +227,7 @@ impl<
                 splits: 0,
                 dropped_slivers: 0,
                 steps: 0,
+                cycles_within_rounding: 0,
             },
         }
     }
@@ -559,6 +568,8 @@ impl Sort<'_> {
     fn run<E>(&mut self) -> Result<(), RenderError<E>> {
         let limit = step_limit(self.store.len());
         let (mut done, mut front) = (0usize, 0usize);
+        // Re-moves since the head position `done` was last reached: (position, count).
+        let mut re_moved_at = (usize::MAX, 0usize);
         // `list[done..front]` holds moved pieces in no particular order; `list[front..len]`
         // is sorted far first, so its scan stops at the first piece wholly nearer than P.
         while done < self.len {
@@ -614,9 +625,24 @@ impl Sort<'_> {
                         (_, Some(qp)) if qp.straddled_by(&pt) => {
                             self.split(done, qp, &mut front)?;
                         }
+                        _ if order == Order::OtherFirst
+                            && re_moved_at.0 == done
+                            && re_moved_at.1 > front.saturating_sub(done) =>
+                        {
+                            // Every piece of the cycle has been moved again and no plane of
+                            // theirs cuts another beyond the rounding cell: the order among
+                            // them is only decided within it. Draw the head now.
+                            self.stats.cycles_within_rounding += 1;
+                            done += 1;
+                            front = front.max(done);
+                        }
                         _ if order == Order::OtherFirst => {
                             // A cycle closed by other pieces: move it again (bounded).
                             self.stats.re_moves += 1;
+                            re_moved_at = match re_moved_at {
+                                (at, n) if at == done => (at, n + 1),
+                                _ => (done, 1),
+                            };
                             if self.stats.re_moves as usize > self.store.len() {
                                 return Err(RenderError::Capacity {
                                     what: CapacityKind::SortSteps,
