@@ -23,6 +23,8 @@ pub mod interpolation;
 pub use scanline3d_meshgen as meshgen;
 #[cfg(not(target_os = "none"))]
 pub mod metrics;
+#[cfg(not(target_os = "none"))]
+pub mod metaball;
 #[cfg(all(not(target_os = "none"), feature = "peers"))]
 pub mod peers;
 #[cfg(not(target_os = "none"))]

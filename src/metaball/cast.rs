@@ -141,7 +141,7 @@ pub struct CastStats {
 pub enum CastError<E> {
     /// The scene holds more balls than the caster's `N`.
     Capacity,
-    /// The camera's width is not the caster's `W`.
+    /// The camera is wider than the caster's `W`.
     Width,
     /// The sink failed; rows after the failing one were not sent.
     Sink(E),
@@ -261,7 +261,8 @@ impl<P: RowPixel, const W: usize, const N: usize> Caster<P, W, N> {
         light: &Light,
         sink: &mut S,
     ) -> Result<CastStats, CastError<S::Error>> {
-        if usize::from(camera.width) != W {
+        let width = usize::from(camera.width);
+        if width > W {
             return Err(CastError::Width);
         }
         let count = scene.balls().len();
@@ -300,8 +301,8 @@ impl<P: RowPixel, const W: usize, const N: usize> Caster<P, W, N> {
             }
             sink.write_row(Row {
                 y: row,
-                pixels: &self.pixels,
-                depth: DepthRow::Q30(&self.depth),
+                pixels: self.pixels.get(..width).unwrap_or(&[]),
+                depth: DepthRow::Q30(self.depth.get(..width).unwrap_or(&[])),
                 complete: true,
             })
             .map_err(CastError::Sink)?;
@@ -404,14 +405,13 @@ impl Frame<'_> {
                     None => break,
                 }
             }
-            let mut step = s.g.abs().checked_div(s.lipschitz).unwrap_or(Wide::MAX);
-            if let Some(next) = s.next_entry {
-                step = step.min(next - t);
-            }
-            if step < EPSILON_T {
+            let safe = s.g.abs().checked_div(s.lipschitz).unwrap_or(Wide::MAX);
+            if safe < EPSILON_T {
                 found = true;
                 break;
             }
+            // Stopping at the next entry keeps that ball's slope out of this step.
+            let step = s.next_entry.map_or(safe, |next| safe.min(next - t));
             t = t.saturating_add(step);
         }
         stats.steps += u64::from(steps);
