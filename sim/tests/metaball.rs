@@ -73,7 +73,7 @@ fn reference_matches_bisection_on_random_scenes() {
         let camera = Camera::new([0.3, 0.2, 4.0], [0.0; 3], [0.0, 1.0, 0.0], 50.0, 0.1, 20.0).unwrap();
         let r = Reference::new(&scene, 0, camera).unwrap();
         for _ in 0..40 {
-            let (x, y) = (rng.range(0.0, 64.0), rng.range(0.0, 64.0));
+            let (x, y) = (rng.range(16.0, 48.0), rng.range(16.0, 48.0));
             let d = camera.ray(x, y, 64, 64);
             let (root, iterations) = r.nearest_root(d, camera.near, camera.far);
             let expected = bisection(&r, d, camera.near, camera.far);
