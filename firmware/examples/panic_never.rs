@@ -13,7 +13,8 @@
 //! span z-buffer and the row sink, with the default arithmetic and the fast preset's narrow one,
 //! and every other hidden-surface method (`scanline3d::resolve`: band and full-frame z-buffer,
 //! span sorting, depth sort, Newell's sort, BSP order, Warnock's subdivision) with flat and
-//! perspective-correct Gouraud shading, on a 64×48 target so that their memory stays small.
+//! perspective-correct Gouraud shading, on a 64×48 target so that their memory stays small, and
+//! the fixed-point metaball ray caster (`scanline3d::metaball`).
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -126,9 +127,14 @@ mod firmware {
         let mut per_pixel = Ws::<Gouraud<PerPixel>, Depth>::new(Rgb565::new(0, 0, 0));
         let mut cached =
             Workspace::<Rgb565, Flat, 240, 240, 640, 80, 3, Depth, 1024>::new(Rgb565::new(0, 0, 0));
+        let mut metaballs = demo::metaballs::PanelCaster::new(Rgb565::new(0, 0, 0));
         let instances = demo::instances();
         let mut frame = 0;
         loop {
+            // The fixed-point metaball ray caster.
+            let mut sink = scanline3d::sink::HashSink::new();
+            let cast = demo::metaballs::render_frame(&mut metaballs, black_box(frame), &mut sink);
+            core::hint::black_box((&cast, sink.hash()));
             if let Ok(scene) = demo::scene(&instances, frame, demo::ORBIT_FRAMES) {
                 let out = demo::render_panel_frame(&mut ws, &scene);
                 core::hint::black_box(&out);

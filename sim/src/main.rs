@@ -590,7 +590,8 @@ fn metaball_command(a: MetaballArgs) -> Result<(), String> {
         MetaMethod::Reference => {
             let reference = Reference::new(&scene, a.frame, camera.reference()?)?;
             let (image, iterations) = reference.render(w, h);
-            let mean = iterations.iter().map(|&i| f64::from(i)).sum::<f64>() / iterations.len().max(1) as f64;
+            let mean = iterations.iter().map(|&i| f64::from(i)).sum::<f64>()
+                / iterations.len().max(1) as f64;
             let json = format!(
                 "{{\"renderer\": \"reference\", \"frame\": {}, \"width\": {w}, \"height\": {h}, \"hits\": {}, \"clipping_iterations_mean\": {mean:.3}, \"clipping_iterations_max\": {}, \"seconds\": {:.3}}}\n",
                 a.frame,

@@ -52,7 +52,11 @@ fn random_scene(rng: &mut Rng) -> MetaScene {
         .map(|_| BallSpec {
             centre: [0, 1, 2].map(|_| rng.range(-1.0, 1.0)),
             radius: rng.range(0.5, 1.5),
-            density: if rng.next() < 0.2 { -rng.range(0.3, 1.0) } else { rng.range(0.5, 1.5) },
+            density: if rng.next() < 0.2 {
+                -rng.range(0.3, 1.0)
+            } else {
+                rng.range(0.5, 1.5)
+            },
             color: [0.8; 3],
             keys: vec![],
         })
@@ -70,7 +74,8 @@ fn reference_matches_bisection_on_random_scenes() {
     let (mut rays, mut hits, mut total_iterations, mut max_iterations) = (0, 0, 0u64, 0);
     for _ in 0..40 {
         let scene = random_scene(&mut rng);
-        let camera = Camera::new([0.3, 0.2, 4.0], [0.0; 3], [0.0, 1.0, 0.0], 50.0, 0.1, 20.0).unwrap();
+        let camera =
+            Camera::new([0.3, 0.2, 4.0], [0.0; 3], [0.0, 1.0, 0.0], 50.0, 0.1, 20.0).unwrap();
         let r = Reference::new(&scene, 0, camera).unwrap();
         for _ in 0..40 {
             let (x, y) = (rng.range(16.0, 48.0), rng.range(16.0, 48.0));
@@ -86,7 +91,9 @@ fn reference_matches_bisection_on_random_scenes() {
                     assert!((t - e).abs() <= 1e-9, "root {t} vs bisection {e}");
                 }
                 (None, None) => {}
-                other => panic!("reference {other:?} disagrees with bisection, ray {d:?} in {scene:?}"),
+                other => {
+                    panic!("reference {other:?} disagrees with bisection, ray {d:?} in {scene:?}")
+                }
             }
         }
     }
@@ -112,19 +119,41 @@ fn reference_on_touching_balls_and_grazes() {
         let d = d.map(|c| c / 5.0);
         let (root, _) = r.nearest_root(d, 0.1, 20.0);
         // Exact: |e + t d|² = 1.
-        let (a, b, c) = (dot(d, d), 2.0 * dot(camera.eye, d), dot(camera.eye, camera.eye) - 1.0);
+        let (a, b, c) = (
+            dot(d, d),
+            2.0 * dot(camera.eye, d),
+            dot(camera.eye, camera.eye) - 1.0,
+        );
         let exact = (-b - (b * b - 4.0 * a * c).sqrt()) / (2.0 * a);
         let t = root.expect("graze hit");
-        assert!((t - exact).abs() <= 1e-9 * (1.0 + 1.0 / (b * b - 4.0 * a * c).sqrt()).min(1e3), "offset {offset}: {t} vs {exact}");
+        assert!(
+            (t - exact).abs() <= 1e-9 * (1.0 + 1.0 / (b * b - 4.0 * a * c).sqrt()).min(1e3),
+            "offset {offset}: {t} vs {exact}"
+        );
     }
     // Two balls whose influence spheres touch at the origin: the field is 0 there, no surface.
-    one.balls.push(BallSpec { centre: [4.0, 0.0, 0.0], ..one.balls[0].clone() });
-    let camera = Camera::new([2.0, 0.0, 5.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], 80.0, 0.1, 20.0).unwrap();
+    one.balls.push(BallSpec {
+        centre: [4.0, 0.0, 0.0],
+        ..one.balls[0].clone()
+    });
+    let camera = Camera::new(
+        [2.0, 0.0, 5.0],
+        [2.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        80.0,
+        0.1,
+        20.0,
+    )
+    .unwrap();
     let r = Reference::new(&one, 0, camera).unwrap();
     for x in 0..64 {
         let d = camera.ray(x as f64 + 0.5, 32.5, 64, 64);
         let (root, _) = r.nearest_root(d, 0.1, 20.0);
-        assert_eq!(root.is_some(), bisection(&r, d, 0.1, 20.0).is_some(), "column {x}");
+        assert_eq!(
+            root.is_some(),
+            bisection(&r, d, 0.1, 20.0).is_some(),
+            "column {x}"
+        );
         if let (Some(t), Some(e)) = (root, bisection(&r, d, 0.1, 20.0)) {
             assert!((t - e).abs() <= 1e-9);
         }

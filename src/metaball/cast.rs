@@ -8,7 +8,7 @@
 //! passes a root. The hit is where the step falls below [`EPSILON_T`]; a ray still marching after
 //! [`MAX_STEPS`] (a near-tangent graze) is counted as a miss and reported in [`CastStats::capped`].
 
-use super::{field, field_slope, Ball, MetaballError, Metaballs, Wide, FIELD_LIPSCHITZ};
+use super::{field, field_slope, mul, Ball, MetaballError, Metaballs, Wide, FIELD_LIPSCHITZ};
 use super::{MAX_COORD, MAX_FAR, MIN_NEAR};
 use crate::depth::{Depth, DepthRow};
 use crate::scene::Light;
@@ -152,6 +152,7 @@ pub enum CastError<E> {
 struct FrameBall {
     /// Centre minus eye.
     offset: [Wide; 3],
+    r2: Wide,
     inv_r2: Wide,
     density: Wide,
     /// `|q|·FIELD_LIPSCHITZ/R`: the slope bound per unit of ray length.
@@ -162,6 +163,7 @@ struct FrameBall {
 impl FrameBall {
     const EMPTY: FrameBall = FrameBall {
         offset: [Wide::ZERO; 3],
+        r2: Wide::ZERO,
         inv_r2: Wide::ZERO,
         density: Wide::ZERO,
         slope_bound: Wide::ZERO,
@@ -195,11 +197,12 @@ impl RayBall {
     /// `s(t)`, or `None` outside the influence sphere.
     #[inline]
     fn s(&self, t: Wide) -> Option<Wide> {
+        // Inside the (padded) interval A·u² ≤ 1 + 2^-12, so the products stay small.
+        if t < self.enter || t >= self.exit {
+            return None;
+        }
         let u = t - self.closest;
-        let s = self
-            .a
-            .saturating_mul(u.saturating_mul(u))
-            .saturating_add(self.s_min);
+        let s = mul(self.a, mul(u, u)) + self.s_min;
         (s < Wide::ONE).then_some(s)
     }
 }
@@ -230,7 +233,7 @@ fn sqrt_wide(x: Wide) -> Wide {
 }
 
 fn dot(a: [Wide; 3], b: [Wide; 3]) -> Wide {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    mul(a[0], b[0]) + mul(a[1], b[1]) + mul(a[2], b[2])
 }
 
 /// The ray caster's memory: one row of pixels and depth, per-frame ball data for up to `N`
@@ -318,6 +321,7 @@ fn frame_ball(ball: &Ball, camera: &MetaCamera) -> FrameBall {
     let centre = ball.centre.map(Wide::from);
     FrameBall {
         offset: [0, 1, 2].map(|i| centre[i] - camera.eye[i]),
+        r2: radius * radius,
         inv_r2: Wide::ONE.checked_div(radius * radius).unwrap_or(Wide::ZERO),
         density,
         slope_bound: (density.abs() * Wide::saturating_from_num(FIELD_LIPSCHITZ))
@@ -372,10 +376,11 @@ impl Frame<'_> {
         let d = self.camera.direction(column, row);
         let dd = dot(d, d);
         let length = sqrt_wide(dd);
+        let inv_dd = quotient(Wide::ONE, dd)?;
         let mut rays = [RayBall::EMPTY; N];
         let mut count = 0usize;
         for (index, ball) in self.balls.iter().enumerate() {
-            if let Some(ray) = ray_ball(ball, index, d, dd, length) {
+            if let Some(ray) = ray_ball(ball, index, d, dd, inv_dd, length) {
                 if let Some(slot) = rays.get_mut(count) {
                     *slot = ray;
                     count += 1;
@@ -405,7 +410,7 @@ impl Frame<'_> {
                     None => break,
                 }
             }
-            let safe = s.g.abs().checked_div(s.lipschitz).unwrap_or(Wide::MAX);
+            let safe = quotient(s.g.abs(), s.lipschitz).unwrap_or(Wide::MAX);
             if safe < EPSILON_T {
                 found = true;
                 break;
@@ -451,7 +456,7 @@ impl Frame<'_> {
                 sample.positive += ball.density;
             }
             if let Some(s) = ray.s(t) {
-                sample.g += ball.density * field(s);
+                sample.g += mul(ball.density, field(s));
             }
         }
         sample
@@ -487,11 +492,10 @@ impl Frame<'_> {
         let mut intensity = self.light.ambient;
         if largest > Wide::ZERO {
             // The outward normal is −∇g; seen from inside the surface, +∇g faces the eye.
-            let n = gradient.map(|g| g.checked_div(largest).unwrap_or(Wide::ZERO));
+            let inv_largest = quotient(Wide::ONE, largest).unwrap_or(Wide::ZERO);
+            let n = gradient.map(|g| g * inv_largest);
             let length = sqrt_wide(dot(n, n));
-            let mut n_dot_l = dot(n, self.light.direction)
-                .checked_div(length)
-                .unwrap_or(Wide::ZERO);
+            let mut n_dot_l = quotient(dot(n, self.light.direction), length).unwrap_or(Wide::ZERO);
             if !inside {
                 n_dot_l = -n_dot_l;
             }
@@ -504,10 +508,12 @@ impl Frame<'_> {
             .balls
             .get(usize::from(best.1))
             .map_or(Rgb888::BLACK, |b| b.color);
+        let inv_weight = quotient(Wide::ONE, weight);
         let channel = |i: usize, fallback: u8| -> u8 {
             let base = rgb
                 .get(i)
-                .and_then(|acc| acc.checked_div(weight))
+                .zip(inv_weight)
+                .map(|(acc, inv)| *acc * inv)
                 .unwrap_or(Wide::from_num(fallback));
             let v = (base * intensity).round().to_num::<i64>();
             v.clamp(0, 255) as u8
@@ -517,11 +523,7 @@ impl Frame<'_> {
             channel(1, fallback.g()),
             channel(2, fallback.b()),
         );
-        let depth = self
-            .camera
-            .near
-            .checked_div(t)
-            .map_or(Depth::ZERO, Depth::saturating_from_num);
+        let depth = quotient(self.camera.near, t).map_or(Depth::ZERO, Depth::saturating_from_num);
         Some(Hit {
             color,
             ball: best.1,
@@ -531,27 +533,30 @@ impl Frame<'_> {
 }
 
 /// The ray's quadratic for one ball, or `None` if the ray misses its influence sphere.
+/// `inv_dd = 1/|d|²` is the ray's one division.
 fn ray_ball(
     ball: &FrameBall,
     index: usize,
     d: [Wide; 3],
     dd: Wide,
+    inv_dd: Wide,
     length: Wide,
 ) -> Option<RayBall> {
     let w = ball.offset;
-    let closest = dot(w, d).checked_div(dd)?;
+    let closest = mul(dot(w, d), inv_dd);
     let cross = [
-        w[1] * d[2] - w[2] * d[1],
-        w[2] * d[0] - w[0] * d[2],
-        w[0] * d[1] - w[1] * d[0],
+        mul(w[1], d[2]) - mul(w[2], d[1]),
+        mul(w[2], d[0]) - mul(w[0], d[2]),
+        mul(w[0], d[1]) - mul(w[1], d[0]),
     ];
-    let s_min = dot(cross, cross).checked_div(dd)? * ball.inv_r2;
+    let s_min = mul(mul(dot(cross, cross), inv_dd), ball.inv_r2);
     if s_min >= Wide::ONE {
         return None;
     }
-    let a = dd * ball.inv_r2;
-    // Padded by 2^-16 so rounding of the square root never shortens the interval.
-    let half = sqrt_wide((Wide::ONE - s_min).checked_div(a)?) + Wide::from_bits(1 << 16);
+    let a = mul(dd, ball.inv_r2);
+    // (1 − s_min)/A = (1 − s_min)·R²/|d|²; padded by 2^-16 so the rounding of the square root
+    // never shortens the interval.
+    let half = sqrt_wide(mul(mul(Wide::ONE - s_min, ball.r2), inv_dd)) + Wide::from_bits(1 << 16);
     Some(RayBall {
         ball: u8::try_from(index).ok()?,
         closest,
@@ -561,4 +566,21 @@ fn ray_ball(
         exit: closest + half,
         lipschitz: ball.slope_bound * length,
     })
+}
+
+/// `numerator / denominator` for a positive denominator in one `i64` division (I32F32's own
+/// division widens to `i128`, a slow library call on the targets): the denominator keeps 16
+/// fractional bits and is rounded up, so the quotient's magnitude never exceeds the exact one
+/// (the march's step stays safe); relative error ≤ 2^-16 / denominator. `None` for a
+/// denominator below 2^-16 or `|numerator| ≥ 2^15` (the field sum is below 2^12, normals ≤ 1).
+fn quotient(numerator: Wide, denominator: Wide) -> Option<Wide> {
+    let den = (denominator.to_bits() >> 16) + 1;
+    if den <= 1 {
+        return None;
+    }
+    numerator
+        .to_bits()
+        .checked_mul(1 << 16)?
+        .checked_div(den)
+        .map(Wide::from_bits)
 }

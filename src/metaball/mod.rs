@@ -169,29 +169,54 @@ impl<'a> Metaballs<'a> {
     }
 }
 
+/// The I32F32 product, rounded down as `fixed`'s `*` rounds it, from 32×32-bit partial
+/// products: `fixed` widens I32F32 products to `i128`, a slow library call on 32-bit targets.
+/// Wraps where `*` would overflow; the module's bit budget keeps every product in range.
+#[inline(always)]
+pub(crate) fn mul(a: Wide, b: Wide) -> Wide {
+    let (a, b) = (a.to_bits(), b.to_bits());
+    let (a_high, a_low) = (a >> 32, i64::from(a as u32));
+    let (b_high, b_low) = (b >> 32, i64::from(b as u32));
+    // a·b = a_high·b_high·2^64 + (a_high·b_low + a_low·b_high)·2^32 + a_low·b_low.
+    let low = ((a_low as u64).wrapping_mul(b_low as u64) >> 32) as i64;
+    Wide::from_bits(
+        (a_high.wrapping_mul(b_high) << 32)
+            .wrapping_add(a_high.wrapping_mul(b_low))
+            .wrapping_add(a_low.wrapping_mul(b_high))
+            .wrapping_add(low),
+    )
+}
+
 /// `f(s)` in I32F32 for `0 ≤ s < 1` (Horner; every partial sum within ±3).
 #[inline]
 fn field(s: Wide) -> Wide {
     let c = field_coefficients();
-    ((c[3] * s + c[2]) * s + c[1]) * s + c[0]
+    mul(mul(mul(c[3], s) + c[2], s) + c[1], s) + c[0]
 }
 
 /// `df/ds` in I32F32 for `0 ≤ s < 1`.
 #[inline]
 fn field_slope(s: Wide) -> Wide {
     let c = field_coefficients();
-    (c[3] * Wide::from_num(3) * s + c[2] * Wide::from_num(2)) * s + c[1]
+    mul(
+        mul(c[3], Wide::from_num(3) * s) + c[2] * Wide::from_num(2),
+        s,
+    ) + c[1]
 }
 
-/// [`FIELD_COEFFICIENTS`] in I32F32 (constant-folded).
+/// [`FIELD_COEFFICIENTS`] in I32F32. A `const`, so the literals are parsed at compile time
+/// (`lit` in a plain function body would parse them on every call).
+const FIELD_WIDE: [Wide; 4] = [
+    Wide::ONE,
+    Wide::lit("-2.444444444444444444"),
+    Wide::lit("1.888888888888888889"),
+    Wide::lit("-0.444444444444444444"),
+];
+
+/// [`FIELD_COEFFICIENTS`] in I32F32.
 #[inline(always)]
 fn field_coefficients() -> [Wide; 4] {
-    [
-        Wide::ONE,
-        Wide::lit("-2.444444444444444444"),
-        Wide::lit("1.888888888888888889"),
-        Wide::lit("-0.444444444444444444"),
-    ]
+    FIELD_WIDE
 }
 
 #[cfg(test)]
@@ -244,6 +269,24 @@ mod tests {
                 + 2.0 * FIELD_COEFFICIENTS[2] * s
                 + 3.0 * FIELD_COEFFICIENTS[3] * s * s;
             assert!((field_slope(Wide::from_num(s)).to_num::<f64>() - dfds).abs() < 1e-8);
+        }
+    }
+
+    #[test]
+    fn mul_is_fixeds_product() {
+        let mut x = 0x1234_5678_9abc_def1u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            // Magnitudes from 2^-32 to 2^15, both signs.
+            (x as i64) >> (x % 48)
+        };
+        for _ in 0..100_000 {
+            let (a, b) = (Wide::from_bits(next()), Wide::from_bits(next()));
+            if let Some(exact) = a.checked_mul(b) {
+                assert_eq!(mul(a, b), exact, "{a} × {b}");
+            }
         }
     }
 

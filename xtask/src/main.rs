@@ -11,6 +11,7 @@ mod fuzz;
 mod hsr_table;
 mod install;
 mod lean;
+mod metaball;
 mod package;
 mod peers;
 mod profile;
@@ -159,6 +160,7 @@ fn main() -> ExitCode {
         "test" => test(),
         "firmware" => install().and_then(|_| firmware()),
         "lean" => install().and_then(|_| lean()),
+        "metaball" => install().and_then(|_| metaball::metaball()),
         "package" => install().and_then(|_| package()),
         "peers" => peers(),
         // The trade table and, in the same command, the peers (`docs/peers.md`).
@@ -188,7 +190,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | metaball | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }

@@ -100,6 +100,7 @@ pub(crate) fn test() -> Result<(), String> {
     let fuzz_build = start_fuzz_build()?;
     package()?;
     firmware()?;
+    crate::metaball::metaball()?;
     lean()?;
     fuzz_with(fuzz_build, FUZZ_SECONDS_IN_TEST)?;
     println!("\nxtask: {} passed, {} failed", totals.0, totals.1);

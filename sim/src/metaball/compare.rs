@@ -58,26 +58,38 @@ pub fn render_fixed(
     let stats = {
         let mut caster: Box<Caster<Rgb888, MAX_WIDTH, MAX_BALLS>> =
             Box::new(Caster::new(Rgb888::BLACK));
-        render_rows(&mut caster, &metaballs, &cam, &light, |y, row: Row<'_, Rgb888>| {
-            for (x, p) in row.pixels.iter().take(w).enumerate() {
-                image.color[y * w + x] = [p.r(), p.g(), p.b()];
-            }
-            if let DepthRow::Q30(q) = row.depth {
-                for (x, q) in q.iter().take(w).enumerate() {
-                    if *q > 0 {
-                        image.depth[y * w + x] = (near / q.to_num::<f64>()) as f32;
+        render_rows(
+            &mut caster,
+            &metaballs,
+            &cam,
+            &light,
+            |y, row: Row<'_, Rgb888>| {
+                for (x, p) in row.pixels.iter().take(w).enumerate() {
+                    image.color[y * w + x] = [p.r(), p.g(), p.b()];
+                }
+                if let DepthRow::Q30(q) = row.depth {
+                    for (x, q) in q.iter().take(w).enumerate() {
+                        if *q > 0 {
+                            image.depth[y * w + x] = (near / q.to_num::<f64>()) as f32;
+                        }
                     }
                 }
-            }
-        })?
+            },
+        )?
     };
     let mut ids: Box<Caster<TriangleId, MAX_WIDTH, MAX_BALLS>> =
         Box::new(Caster::new(TriangleId::NONE));
-    render_rows(&mut ids, &metaballs, &cam, &light, |y, row: Row<'_, TriangleId>| {
-        for (x, p) in row.pixels.iter().take(w).enumerate() {
-            image.ids[y * w + x] = p.0;
-        }
-    })?;
+    render_rows(
+        &mut ids,
+        &metaballs,
+        &cam,
+        &light,
+        |y, row: Row<'_, TriangleId>| {
+            for (x, p) in row.pixels.iter().take(w).enumerate() {
+                image.ids[y * w + x] = p.0;
+            }
+        },
+    )?;
     Ok((image, stats))
 }
 
@@ -188,8 +200,8 @@ pub fn compare(fixed: &Image, reference: &Image, reference_scene: &Reference) ->
                     slope = slope.min(hit.slope);
                     lipschitz = lipschitz.max(hit.lipschitz);
                 }
-                let bound = EPSILON_T.to_num::<f64>() * lipschitz / slope.max(1e-300)
-                    + DEPTH_SLACK * t;
+                let bound =
+                    EPSILON_T.to_num::<f64>() * lipschitz / slope.max(1e-300) + DEPTH_SLACK * t;
                 if error > bound {
                     m.depth_over_bound += 1;
                 }

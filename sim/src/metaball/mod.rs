@@ -233,10 +233,19 @@ mod tests {
             ("threshold 0.5\nmetaball 0 0 0 1\n", "t:2: metaball takes"),
             ("threshold x\n", "t:1: 'x' is not a finite number"),
             ("threshold 1\nkey 1 0 0 0\n", "t:2: key before any metaball"),
-            ("threshold 1\nmetaball 0 0 0 1 1\nkey 2 0 0 0\nkey 2 1 1 1\n", "t:4: key frames must increase"),
-            ("threshold 1\nsphere 0 0 0 1\n", "t:2: unknown keyword 'sphere'"),
+            (
+                "threshold 1\nmetaball 0 0 0 1 1\nkey 2 0 0 0\nkey 2 1 1 1\n",
+                "t:4: key frames must increase",
+            ),
+            (
+                "threshold 1\nsphere 0 0 0 1\n",
+                "t:2: unknown keyword 'sphere'",
+            ),
             ("metaball 0 0 0 1 1\n", "t: no 'threshold' line"),
-            ("threshold 1\nmetaball 0 0 0 -1 1\n", "t:2: radius must be positive"),
+            (
+                "threshold 1\nmetaball 0 0 0 -1 1\n",
+                "t:2: radius must be positive",
+            ),
         ];
         for (text, want) in cases {
             let e = MetaScene::parse(text, "t").unwrap_err();

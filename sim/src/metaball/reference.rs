@@ -66,7 +66,10 @@ pub fn field(s: f64) -> f64 {
     if s >= 1.0 {
         return 0.0;
     }
-    FIELD_COEFFICIENTS.iter().rev().fold(0.0, |acc, c| acc * s + c)
+    FIELD_COEFFICIENTS
+        .iter()
+        .rev()
+        .fold(0.0, |acc, c| acc * s + c)
 }
 
 fn field_slope(s: f64) -> f64 {
@@ -269,7 +272,11 @@ impl Reference {
             for r in rays.iter().filter(|r| r.enter <= mid && mid < r.exit) {
                 let q = self.balls[r.index].density;
                 let o = a - r.closest;
-                let s = [r.a * o * o + r.s_min, 2.0 * r.a * o * span, r.a * span * span];
+                let s = [
+                    r.a * o * o + r.s_min,
+                    2.0 * r.a * o * span,
+                    r.a * span * span,
+                ];
                 let mut s_power = vec![1.0];
                 for (k, c) in FIELD_COEFFICIENTS.iter().enumerate() {
                     if k > 0 {
@@ -304,7 +311,8 @@ impl Reference {
             if s >= 1.0 {
                 continue;
             }
-            lipschitz += b.density.abs() * scanline3d::metaball::FIELD_LIPSCHITZ / b.radius * length;
+            lipschitz +=
+                b.density.abs() * scanline3d::metaball::FIELD_LIPSCHITZ / b.radius * length;
             let contribution = b.density * field(s);
             if contribution > best {
                 (best, ball) = (contribution, i);
