@@ -252,6 +252,11 @@ struct MetaballArgs {
     /// Statistics as JSON, to this file (`-` for standard output).
     #[arg(long)]
     stats: Option<PathBuf>,
+    /// Also render with the other method and write caster | reference | mismatch map (red:
+    /// coverage or id differs) to this PNG, and print the comparison (coverage mismatches,
+    /// depth error against its bound, PSNR).
+    #[arg(long)]
+    beside: Option<PathBuf>,
 }
 
 #[derive(Args, Debug)]
@@ -602,6 +607,22 @@ fn metaball_command(a: MetaballArgs) -> Result<(), String> {
             (image, json)
         }
     };
+    if let Some(path) = &a.beside {
+        let reference = Reference::new(&scene, a.frame, camera.reference()?)?;
+        let (caster, expected) = match a.method {
+            MetaMethod::Raycast => (image.clone(), reference.render(w, h).0),
+            MetaMethod::Reference => (
+                render_fixed(&scene, a.frame, &camera, w, h)?.0,
+                image.clone(),
+            ),
+        };
+        side_by_side(path, &caster, &expected)?;
+        say!("wrote {}", path.display());
+        say!(
+            "{}",
+            scanline3d_sim::metaball::compare::compare(&caster, &expected, &reference)
+        );
+    }
     scene::write_png(&a.out, w, h, &image.color)?;
     say!("wrote {}", a.out.display());
     if let Some(p) = &a.ids {

@@ -8,7 +8,10 @@
 //! passes a root. The hit is where the step falls below [`EPSILON_T`]; a ray still marching after
 //! [`MAX_STEPS`] (a near-tangent graze) is counted as a miss and reported in [`CastStats::capped`].
 
-use super::{field, field_slope, mul, Ball, MetaballError, Metaballs, Wide, FIELD_LIPSCHITZ};
+use super::{
+    field, field_slope, mul, wide_from_f32, Ball, MetaballError, Metaballs, Wide,
+    FIELD_LIPSCHITZ_WIDE,
+};
 use super::{MAX_COORD, MAX_FAR, MIN_NEAR};
 use crate::depth::{Depth, DepthRow};
 use crate::scene::Light;
@@ -19,7 +22,7 @@ use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 /// at most `EPSILON_T · L / |g'|` in front of the surface (see `docs/metaballs.md`).
 pub const EPSILON_T: Wide = Wide::from_bits(1 << (32 - 14));
 /// Most march steps per ray.
-pub const MAX_STEPS: u32 = 160;
+pub const MAX_STEPS: u32 = 400;
 
 /// A perspective camera for the caster (`gluLookAt` + `gluPerspective`, pixel centres at
 /// `(c + ½, r + ½)`); the ray direction's component along the view axis is 1, so the ray
@@ -53,7 +56,7 @@ fn unit3(a: [f32; 3]) -> Option<[f32; 3]> {
     (l > 1e-6 && l.is_finite()).then(|| a.map(|c| c / l))
 }
 fn wide3(a: [f32; 3]) -> [Wide; 3] {
-    a.map(Wide::saturating_from_num)
+    a.map(wide_from_f32)
 }
 
 impl MetaCamera {
@@ -94,8 +97,8 @@ impl MetaCamera {
             corner: wide3(corner),
             per_column: wide3(side.map(|c| c * sx)),
             per_row: wide3(up.map(|c| -c * sy)),
-            near: Wide::saturating_from_num(near),
-            far: Wide::saturating_from_num(far),
+            near: wide_from_f32(near),
+            far: wide_from_f32(far),
             width,
             height,
         })
@@ -324,7 +327,7 @@ fn frame_ball(ball: &Ball, camera: &MetaCamera) -> FrameBall {
         r2: radius * radius,
         inv_r2: Wide::ONE.checked_div(radius * radius).unwrap_or(Wide::ZERO),
         density,
-        slope_bound: (density.abs() * Wide::saturating_from_num(FIELD_LIPSCHITZ))
+        slope_bound: (density.abs() * FIELD_LIPSCHITZ_WIDE)
             .checked_div(radius)
             .unwrap_or(Wide::MAX),
         color: ball.color,
@@ -342,8 +345,8 @@ impl Lighting {
     fn new(light: &Light) -> Self {
         Lighting {
             direction: wide3(light.direction()),
-            ambient: Wide::saturating_from_num(light.ambient()),
-            diffuse: Wide::saturating_from_num(light.diffuse()),
+            ambient: wide_from_f32(light.ambient()),
+            diffuse: wide_from_f32(light.diffuse()),
         }
     }
 }

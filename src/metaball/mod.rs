@@ -66,6 +66,9 @@ pub const FIELD_COEFFICIENTS: [f64; 4] = [1.0, -22.0 / 9.0, 17.0 / 9.0, -4.0 / 9
 /// constant in units of `1/R`.
 pub const FIELD_LIPSCHITZ: f64 = 1.59375;
 
+/// [`FIELD_LIPSCHITZ`] in I32F32 (exact: 51/32).
+const FIELD_LIPSCHITZ_WIDE: Wide = Wide::lit("1.59375");
+
 /// One ball.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ball {
@@ -80,15 +83,38 @@ pub struct Ball {
 }
 
 impl Ball {
-    /// A ball from `f32` values (converted to I16F16, rounding to nearest).
+    /// A ball from `f32` values (converted to I16F16, rounding to nearest; out-of-range values
+    /// saturate and NaN becomes 0, so [`Metaballs::new`] rejects them or sees a valid number).
     pub fn new(centre: [f32; 3], radius: f32, density: f32, color: Rgb888) -> Self {
         Ball {
-            centre: centre.map(Coord::saturating_from_num),
-            radius: Coord::saturating_from_num(radius),
-            density: Coord::saturating_from_num(density),
+            centre: centre.map(coord_from_f32),
+            radius: coord_from_f32(radius),
+            density: coord_from_f32(density),
             color,
         }
     }
+}
+
+/// `f32` to I16F16 without a panic path (`saturating_from_num` panics on NaN).
+fn coord_from_f32(v: f32) -> Coord {
+    Coord::checked_from_num(v).unwrap_or(if v > 0.0 {
+        Coord::MAX
+    } else if v < 0.0 {
+        Coord::MIN
+    } else {
+        Coord::ZERO
+    })
+}
+
+/// `f32` to I32F32 without a panic path (`saturating_from_num` panics on NaN).
+pub(crate) fn wide_from_f32(v: f32) -> Wide {
+    Wide::checked_from_num(v).unwrap_or(if v > 0.0 {
+        Wide::MAX
+    } else if v < 0.0 {
+        Wide::MIN
+    } else {
+        Wide::ZERO
+    })
 }
 
 /// Why a metaball scene was rejected.
@@ -244,6 +270,7 @@ mod tests {
 
     #[test]
     fn lipschitz_constant_bounds_the_slope() {
+        assert_eq!(FIELD_LIPSCHITZ_WIDE.to_num::<f64>(), FIELD_LIPSCHITZ);
         let mut max = 0.0f64;
         for i in 0..=100_000 {
             let x = i as f64 / 100_000.0;
