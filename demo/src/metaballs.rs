@@ -17,8 +17,11 @@ pub const FRAMES: u32 = 8;
 /// The iso-value.
 pub const THRESHOLD: f32 = 0.45;
 
-/// Per ball: centre at frame 0, centre at frame 4, radius, density, colour (0..1).
-const BALLS: [([f64; 3], [f64; 3], f64, f64, [f64; 3]); 6] = [
+/// One ball: centre at frame 0, centre at frame 4, radius, density, colour (0..1).
+type BallKeys = ([f64; 3], [f64; 3], f64, f64, [f64; 3]);
+
+/// The six balls of `six.meta`.
+const BALLS: [BallKeys; 6] = [
     (
         [-1.2, 0.0, 0.0],
         [-0.5, 0.3, 0.2],

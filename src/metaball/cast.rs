@@ -73,13 +73,16 @@ impl MetaCamera {
         height: u16,
     ) -> Result<Self, MetaballError> {
         let bad = MetaballError::Camera;
-        if !(fovy_degrees > 0.0 && fovy_degrees <= 120.0)
-            || !(near >= MIN_NEAR && near < far && far <= MAX_FAR)
-            || !(1..=2048).contains(&width)
-            || !(1..=2048).contains(&height)
-            || u32::from(width) > 4 * u32::from(height)
-            || eye.iter().any(|c| !(c.abs() <= MAX_COORD))
-        {
+        let in_envelope = fovy_degrees > 0.0
+            && fovy_degrees <= 120.0
+            && near >= MIN_NEAR
+            && near < far
+            && far <= MAX_FAR
+            && (1..=2048).contains(&width)
+            && (1..=2048).contains(&height)
+            && u32::from(width) <= 4 * u32::from(height)
+            && eye.iter().all(|c| c.abs() <= MAX_COORD);
+        if !in_envelope {
             return Err(bad);
         }
         let forward = unit3(sub3(target, eye)).ok_or(bad)?;

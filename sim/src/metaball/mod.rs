@@ -208,52 +208,6 @@ impl MetaScene {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn parses_and_animates() {
-        let s = MetaScene::parse(
-            "threshold 0.5\nlight 0 0 1 0.1 0.9\nmetaball 0 0 0 1 1  # comment\nkey 10 1 0 0\nmetaball 1 1 1 2 -0.5 1 0 0\n",
-            "t",
-        )
-        .unwrap();
-        assert_eq!(s.balls.len(), 2);
-        assert_eq!(s.balls[0].centre_at(5), [0.5, 0.0, 0.0]);
-        assert_eq!(s.balls[0].centre_at(20), [1.0, 0.0, 0.0]);
-        assert_eq!(s.balls[1].centre_at(7), [1.0, 1.0, 1.0]);
-        assert_eq!(s.balls[1].color, [1.0, 0.0, 0.0]);
-        assert_eq!(s.balls[0].color, [0.8; 3]);
-    }
-
-    #[test]
-    fn errors_name_the_line() {
-        let cases = [
-            ("threshold 0.5\nmetaball 0 0 0 1\n", "t:2: metaball takes"),
-            ("threshold x\n", "t:1: 'x' is not a finite number"),
-            ("threshold 1\nkey 1 0 0 0\n", "t:2: key before any metaball"),
-            (
-                "threshold 1\nmetaball 0 0 0 1 1\nkey 2 0 0 0\nkey 2 1 1 1\n",
-                "t:4: key frames must increase",
-            ),
-            (
-                "threshold 1\nsphere 0 0 0 1\n",
-                "t:2: unknown keyword 'sphere'",
-            ),
-            ("metaball 0 0 0 1 1\n", "t: no 'threshold' line"),
-            (
-                "threshold 1\nmetaball 0 0 0 -1 1\n",
-                "t:2: radius must be positive",
-            ),
-        ];
-        for (text, want) in cases {
-            let e = MetaScene::parse(text, "t").unwrap_err();
-            assert!(e.starts_with(want) && !e.contains('\n'), "{e}");
-        }
-    }
-}
-
 /// The test corpus: named scenes with their cameras (single ball, two merging, negative
 /// density, grazing, eye inside the surface, and the animated six-ball scene at frame 0).
 pub fn corpus() -> Vec<(&'static str, MetaScene, crate::scene::CameraSpec)> {
@@ -311,3 +265,49 @@ pub fn corpus() -> Vec<(&'static str, MetaScene, crate::scene::CameraSpec)> {
 
 /// The animated six-ball scene the firmware draws (8 frames of keys).
 pub const SIX_BALLS: &str = include_str!("six.meta");
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_and_animates() {
+        let s = MetaScene::parse(
+            "threshold 0.5\nlight 0 0 1 0.1 0.9\nmetaball 0 0 0 1 1  # comment\nkey 10 1 0 0\nmetaball 1 1 1 2 -0.5 1 0 0\n",
+            "t",
+        )
+        .unwrap();
+        assert_eq!(s.balls.len(), 2);
+        assert_eq!(s.balls[0].centre_at(5), [0.5, 0.0, 0.0]);
+        assert_eq!(s.balls[0].centre_at(20), [1.0, 0.0, 0.0]);
+        assert_eq!(s.balls[1].centre_at(7), [1.0, 1.0, 1.0]);
+        assert_eq!(s.balls[1].color, [1.0, 0.0, 0.0]);
+        assert_eq!(s.balls[0].color, [0.8; 3]);
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let cases = [
+            ("threshold 0.5\nmetaball 0 0 0 1\n", "t:2: metaball takes"),
+            ("threshold x\n", "t:1: 'x' is not a finite number"),
+            ("threshold 1\nkey 1 0 0 0\n", "t:2: key before any metaball"),
+            (
+                "threshold 1\nmetaball 0 0 0 1 1\nkey 2 0 0 0\nkey 2 1 1 1\n",
+                "t:4: key frames must increase",
+            ),
+            (
+                "threshold 1\nsphere 0 0 0 1\n",
+                "t:2: unknown keyword 'sphere'",
+            ),
+            ("metaball 0 0 0 1 1\n", "t: no 'threshold' line"),
+            (
+                "threshold 1\nmetaball 0 0 0 -1 1\n",
+                "t:2: radius must be positive",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = MetaScene::parse(text, "t").unwrap_err();
+            assert!(e.starts_with(want) && !e.contains('\n'), "{e}");
+        }
+    }
+}
