@@ -106,6 +106,7 @@ pub mod clip;
 pub mod config;
 pub mod depth;
 pub mod math;
+pub mod metaball;
 pub mod method;
 pub mod options;
 pub mod preset;

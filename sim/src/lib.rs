@@ -22,6 +22,8 @@ pub mod interpolation;
 #[cfg(not(target_os = "none"))]
 pub use scanline3d_meshgen as meshgen;
 #[cfg(not(target_os = "none"))]
+pub mod metaball;
+#[cfg(not(target_os = "none"))]
 pub mod metrics;
 #[cfg(all(not(target_os = "none"), feature = "peers"))]
 pub mod peers;

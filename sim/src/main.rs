@@ -53,6 +53,9 @@ enum Command {
     /// Ray-trace a traced scene (issue 21's text format) to PNG, with optional id, depth and
     /// shadow images.
     Trace(TraceArgs),
+    /// Render a metaball scene (.meta): the fixed-point ray caster or the f64 reference
+    /// (Bezier clipping), PNG plus optional id, depth and statistics files.
+    Metaball(MetaballArgs),
     /// Write the scene corpus as OBJ files (and list its cameras).
     Corpus {
         /// Output directory.
@@ -297,6 +300,66 @@ struct RenderArgs {
     /// Which renderer.
     #[arg(long, value_enum, default_value = "fixed")]
     renderer: Renderer,
+}
+
+/// How `sim metaball` renders.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq)]
+enum MetaMethod {
+    /// The library's fixed-point ray caster.
+    Raycast,
+    /// The f64 reference: Bernstein form and Bezier clipping.
+    Reference,
+}
+
+#[derive(Args, Debug)]
+struct MetaballArgs {
+    /// The metaball scene (.meta).
+    scene: PathBuf,
+    /// Animation frame (centres interpolated between keys).
+    #[arg(long, default_value_t = 0)]
+    frame: u32,
+    /// Renderer.
+    #[arg(long, value_enum, default_value = "raycast")]
+    method: MetaMethod,
+    /// Eye position X,Y,Z.
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true, default_value = "0,1.5,5")]
+    eye: [f64; 3],
+    /// Point looked at.
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true, default_value = "0,0,0")]
+    target: [f64; 3],
+    /// Up direction.
+    #[arg(long, value_parser = vec3, allow_hyphen_values = true, default_value = "0,1,0")]
+    up: [f64; 3],
+    /// Vertical field of view in degrees.
+    #[arg(long, value_parser = finite, default_value = "50")]
+    fov: f64,
+    /// Near plane distance.
+    #[arg(long, value_parser = finite, default_value = "0.1")]
+    near: f64,
+    /// Far plane distance.
+    #[arg(long, value_parser = finite, default_value = "100")]
+    far: f64,
+    /// Image size WxH.
+    #[arg(long, value_parser = size, default_value = "240x240")]
+    size: (usize, usize),
+    /// Output PNG.
+    #[arg(long, default_value = "frame.png")]
+    out: PathBuf,
+    /// Ball id image (W×H little-endian i32: the ball with the largest q·f at the hit, −1 =
+    /// background).
+    #[arg(long)]
+    ids: Option<PathBuf>,
+    /// Depth image (W×H little-endian f32 eye depth, +inf = background).
+    #[arg(long)]
+    depth: Option<PathBuf>,
+    /// Statistics as JSON, to this file (`-` for standard output).
+    #[arg(long)]
+    stats: Option<PathBuf>,
+    /// Also render with the other method and write caster | reference | mismatch map (red:
+    /// coverage or id differs) to this PNG, and print the comparison (coverage mismatches,
+    /// depth error against its bound, PSNR).
+    #[arg(long)]
+    beside: Option<PathBuf>,
 }
 
 #[derive(Args, Debug)]
@@ -807,6 +870,85 @@ fn trace(a: TraceArgs) -> Result<(), String> {
     Ok(())
 }
 
+fn metaball_command(a: MetaballArgs) -> Result<(), String> {
+    use scanline3d_sim::metaball::{compare::render_fixed, reference::Reference, MetaScene};
+    let scene = MetaScene::load(&a.scene)?;
+    scene
+        .check(a.frame)
+        .map_err(|e| format!("{}: {e}", a.scene.display()))?;
+    let camera = CameraSpec {
+        eye: a.eye,
+        target: a.target,
+        up: a.up,
+        fovy: a.fov,
+        near: a.near,
+        far: a.far,
+    };
+    let (w, h) = a.size;
+    let start = std::time::Instant::now();
+    let (image, json) = match a.method {
+        MetaMethod::Raycast => {
+            let (image, s) = render_fixed(&scene, a.frame, &camera, w, h)?;
+            let json = format!(
+                "{{\"renderer\": \"raycast\", \"frame\": {}, \"width\": {w}, \"height\": {h}, \"hits\": {}, \"steps\": {}, \"max_steps\": {}, \"capped\": {}}}\n",
+                a.frame, s.hits, s.steps, s.max_steps, s.capped
+            );
+            (image, json)
+        }
+        MetaMethod::Reference => {
+            let reference = Reference::new(&scene, a.frame, camera.reference()?)?;
+            let (image, iterations) = reference.render(w, h);
+            let mean = iterations.iter().map(|&i| f64::from(i)).sum::<f64>()
+                / iterations.len().max(1) as f64;
+            let json = format!(
+                "{{\"renderer\": \"reference\", \"frame\": {}, \"width\": {w}, \"height\": {h}, \"hits\": {}, \"clipping_iterations_mean\": {mean:.3}, \"clipping_iterations_max\": {}, \"seconds\": {:.3}}}\n",
+                a.frame,
+                image.ids.iter().filter(|&&i| i >= 0).count(),
+                iterations.iter().max().copied().unwrap_or(0),
+                start.elapsed().as_secs_f64()
+            );
+            (image, json)
+        }
+    };
+    if let Some(path) = &a.beside {
+        let reference = Reference::new(&scene, a.frame, camera.reference()?)?;
+        let (caster, expected) = match a.method {
+            MetaMethod::Raycast => (image.clone(), reference.render(w, h).0),
+            MetaMethod::Reference => (
+                render_fixed(&scene, a.frame, &camera, w, h)?.0,
+                image.clone(),
+            ),
+        };
+        side_by_side(path, &caster, &expected)?;
+        say!("wrote {}", path.display());
+        say!(
+            "{}",
+            scanline3d_sim::metaball::compare::compare(&caster, &expected, &reference)
+        );
+    }
+    scene::write_png(&a.out, w, h, &image.color)?;
+    say!("wrote {}", a.out.display());
+    if let Some(p) = &a.ids {
+        scene::write_ids(p, &image.ids)?;
+        say!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.depth {
+        scene::write_depth(p, &image.depth)?;
+        say!("wrote {}", p.display());
+    }
+    match &a.stats {
+        Some(p) if p.as_os_str() == "-" => {
+            let _ = std::io::stdout().write_all(json.as_bytes());
+        }
+        Some(p) => {
+            std::fs::write(p, &json).map_err(|e| format!("{}: {e}", p.display()))?;
+            say!("wrote {}", p.display());
+        }
+        None => {}
+    }
+    Ok(())
+}
+
 /// fixed | reference | mismatch map (red: real, yellow: explained) as one PNG.
 fn side_by_side(path: &Path, fixed: &Image, reference: &Image) -> Result<(), String> {
     let (w, h) = (fixed.width, fixed.height);
@@ -985,6 +1127,7 @@ fn main() -> ExitCode {
         Some(Command::Compare(a)) => compare(a),
         Some(Command::Analyze(a)) => analyze_command(a),
         Some(Command::Export(a)) => export_command(a),
+        Some(Command::Metaball(a)) => metaball_command(a),
         Some(Command::Trace(a)) => trace(a),
         Some(Command::Corpus { out }) => write_corpus(&out),
     };

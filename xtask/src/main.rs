@@ -11,6 +11,7 @@ mod fuzz;
 mod hsr_table;
 mod install;
 mod lean;
+mod metaball;
 mod package;
 mod peers;
 mod profile;
@@ -161,6 +162,7 @@ fn main() -> ExitCode {
         "firmware" => install().and_then(|_| firmware()),
         "trace" => install().and_then(|_| trace::trace()),
         "lean" => install().and_then(|_| lean()),
+        "metaball" => install().and_then(|_| metaball::metaball()),
         "package" => install().and_then(|_| package()),
         "peers" => peers(),
         // The trade table and, in the same command, the peers (`docs/peers.md`).
@@ -190,7 +192,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | trace | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | trace | metaball | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }

@@ -79,8 +79,11 @@ pub(crate) fn test() -> Result<(), String> {
     // handler calls an undefined symbol, so the link fails if any panic is reachable. It also
     // builds the library for each target: no_std, no allocator. The firmware examples run below
     // are built here too, the three targets side by side.
-    step("library for every target: no_std, the panic-never link check, the demo and traced firmware");
-    build_firmware_examples("firmware", &["panic_never", "firmware", "trace"])?;
+    step("library for every target: no_std, the panic-never link check, the firmware examples");
+    build_firmware_examples(
+        "firmware",
+        &["panic_never", "firmware", "trace", "metaball"],
+    )?;
     // The instrumented fuzz build runs beside the package checks and the firmware, whose QEMU
     // runs leave a core free.
     step("fuzz target: AFL-instrumented build started in the background");
@@ -88,6 +91,7 @@ pub(crate) fn test() -> Result<(), String> {
     package()?;
     firmware()?;
     crate::trace::trace()?;
+    crate::metaball::metaball()?;
     lean()?;
     fuzz_with(fuzz_build, FUZZ_SECONDS_IN_TEST)?;
     println!("\nxtask: {} passed, {} failed", totals.0, totals.1);

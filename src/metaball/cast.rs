@@ -1,0 +1,592 @@
+//! The fixed-point metaball ray caster: one pixel-centre ray per pixel, rows to a sink.
+//!
+//! Per ray and ball, `s(t) = A·(t − t_c)² + s_min` (closest approach `t_c`, `s_min` from the
+//! cross product, so no cancellation) gives the influence interval `|t − t_c| < √((1 − s_min)/A)`.
+//! The march starts at the near plane and steps `|g(t)| / L(t)`, where `g` is the summed field
+//! minus `T` and `L` the sum of `|q|·FIELD_LIPSCHITZ·|d|/R` over the balls active at `t`;
+//! steps stop at the next ball's entry, so `L` bounds `|g'|` over every step and a step never
+//! passes a root. The hit is where the step falls below [`EPSILON_T`]; a ray still marching after
+//! [`MAX_STEPS`] (a near-tangent graze) is counted as a miss and reported in [`CastStats::capped`].
+
+use super::{
+    field, field_slope, mul, wide_from_f32, Ball, MetaballError, Metaballs, Wide,
+    FIELD_LIPSCHITZ_WIDE,
+};
+use super::{MAX_COORD, MAX_FAR, MIN_NEAR};
+use crate::depth::{Depth, DepthRow};
+use crate::scene::Light;
+use crate::sink::{Row, RowPixel, RowSink};
+use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
+
+/// The march stops when a step is shorter than this (eye-depth units, 2^-14): the hit is then
+/// at most `EPSILON_T · L / |g'|` in front of the surface (see `docs/metaballs.md`).
+pub const EPSILON_T: Wide = Wide::from_bits(1 << (32 - 14));
+/// Most march steps per ray.
+pub const MAX_STEPS: u32 = 400;
+
+/// A perspective camera for the caster (`gluLookAt` + `gluPerspective`, pixel centres at
+/// `(c + ½, r + ½)`); the ray direction's component along the view axis is 1, so the ray
+/// parameter is the eye depth.
+#[derive(Clone, Copy, Debug)]
+pub struct MetaCamera {
+    eye: [Wide; 3],
+    /// Direction through the centre of pixel (0, 0).
+    corner: [Wide; 3],
+    /// Direction change per column and per row.
+    per_column: [Wide; 3],
+    per_row: [Wide; 3],
+    near: Wide,
+    far: Wide,
+    width: u16,
+    height: u16,
+}
+
+fn sub3(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn cross3(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn unit3(a: [f32; 3]) -> Option<[f32; 3]> {
+    let l = libm::sqrtf(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    (l > 1e-6 && l.is_finite()).then(|| a.map(|c| c / l))
+}
+fn wide3(a: [f32; 3]) -> [Wide; 3] {
+    a.map(wide_from_f32)
+}
+
+impl MetaCamera {
+    /// A camera looking from `eye` at `target` on a `width × height` target.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        eye: [f32; 3],
+        target: [f32; 3],
+        up: [f32; 3],
+        fovy_degrees: f32,
+        near: f32,
+        far: f32,
+        width: u16,
+        height: u16,
+    ) -> Result<Self, MetaballError> {
+        let bad = MetaballError::Camera;
+        let in_envelope = fovy_degrees > 0.0
+            && fovy_degrees <= 120.0
+            && near >= MIN_NEAR
+            && near < far
+            && far <= MAX_FAR
+            && (1..=2048).contains(&width)
+            && (1..=2048).contains(&height)
+            && u32::from(width) <= 4 * u32::from(height)
+            && eye.iter().all(|c| c.abs() <= MAX_COORD);
+        if !in_envelope {
+            return Err(bad);
+        }
+        let forward = unit3(sub3(target, eye)).ok_or(bad)?;
+        let side = unit3(cross3(forward, up)).ok_or(bad)?;
+        let up = cross3(side, forward);
+        let tan_half = libm::tanf(fovy_degrees.to_radians() / 2.0);
+        let (w, h) = (f32::from(width), f32::from(height));
+        let sx = 2.0 * tan_half * w / h / w;
+        let sy = 2.0 * tan_half / h;
+        let x0 = (0.5 / w * 2.0 - 1.0) * tan_half * w / h;
+        let y0 = (1.0 - 0.5 / h * 2.0) * tan_half;
+        let corner = [0, 1, 2].map(|i| forward[i] + side[i] * x0 + up[i] * y0);
+        Ok(MetaCamera {
+            eye: wide3(eye),
+            corner: wide3(corner),
+            per_column: wide3(side.map(|c| c * sx)),
+            per_row: wide3(up.map(|c| -c * sy)),
+            near: wide_from_f32(near),
+            far: wide_from_f32(far),
+            width,
+            height,
+        })
+    }
+
+    /// Target width in pixels.
+    pub fn width(&self) -> u16 {
+        self.width
+    }
+
+    /// Target height in pixels.
+    pub fn height(&self) -> u16 {
+        self.height
+    }
+
+    /// The ray direction through the centre of pixel `(column, row)`.
+    fn direction(&self, column: u16, row: u16) -> [Wide; 3] {
+        [0, 1, 2].map(|i| {
+            self.corner[i]
+                + self.per_column[i].saturating_mul_int(i64::from(column))
+                + self.per_row[i].saturating_mul_int(i64::from(row))
+        })
+    }
+}
+
+/// What a frame did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CastStats {
+    /// Rows sent to the sink.
+    pub rows: u32,
+    /// Pixels whose ray hit the surface.
+    pub hits: u32,
+    /// March steps over the frame.
+    pub steps: u64,
+    /// Most steps of one ray.
+    pub max_steps: u32,
+    /// Rays stopped after [`MAX_STEPS`] and drawn as background.
+    pub capped: u32,
+}
+
+/// Why a frame stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CastError<E> {
+    /// The scene holds more balls than the caster's `N`.
+    Capacity,
+    /// The camera is wider than the caster's `W`.
+    Width,
+    /// The sink failed; rows after the failing one were not sent.
+    Sink(E),
+}
+
+/// Per ball and frame: the values every ray reuses.
+#[derive(Clone, Copy, Debug)]
+struct FrameBall {
+    /// Centre minus eye.
+    offset: [Wide; 3],
+    r2: Wide,
+    inv_r2: Wide,
+    density: Wide,
+    /// `|q|·FIELD_LIPSCHITZ/R`: the slope bound per unit of ray length.
+    slope_bound: Wide,
+    color: Rgb888,
+}
+
+impl FrameBall {
+    const EMPTY: FrameBall = FrameBall {
+        offset: [Wide::ZERO; 3],
+        r2: Wide::ZERO,
+        inv_r2: Wide::ZERO,
+        density: Wide::ZERO,
+        slope_bound: Wide::ZERO,
+        color: Rgb888::BLACK,
+    };
+}
+
+/// Per ball and ray: the quadratic `s(t)` and its influence interval.
+#[derive(Clone, Copy, Debug)]
+struct RayBall {
+    ball: u8,
+    closest: Wide,
+    a: Wide,
+    s_min: Wide,
+    enter: Wide,
+    exit: Wide,
+    lipschitz: Wide,
+}
+
+impl RayBall {
+    const EMPTY: RayBall = RayBall {
+        ball: 0,
+        closest: Wide::ZERO,
+        a: Wide::ZERO,
+        s_min: Wide::ZERO,
+        enter: Wide::ZERO,
+        exit: Wide::ZERO,
+        lipschitz: Wide::ZERO,
+    };
+
+    /// `s(t)`, or `None` outside the influence sphere.
+    #[inline]
+    fn s(&self, t: Wide) -> Option<Wide> {
+        // Inside the (padded) interval A·u² ≤ 1 + 2^-12, so the products stay small.
+        if t < self.enter || t >= self.exit {
+            return None;
+        }
+        let u = t - self.closest;
+        let s = mul(self.a, mul(u, u)) + self.s_min;
+        (s < Wide::ONE).then_some(s)
+    }
+}
+
+/// Integer square root of `x` (floor).
+fn isqrt(x: u64) -> u64 {
+    let mut r = 0u64;
+    let mut bit = 1u64 << 62;
+    let mut x = x;
+    while bit > x {
+        bit >>= 2;
+    }
+    while bit != 0 {
+        if x >= r + bit {
+            x -= r + bit;
+            r = (r >> 1) + bit;
+        } else {
+            r >>= 1;
+        }
+        bit >>= 2;
+    }
+    r
+}
+
+/// `√x` for `x ≥ 0` in I32F32 (16 fractional bits exact).
+fn sqrt_wide(x: Wide) -> Wide {
+    Wide::from_bits((isqrt(x.to_bits().max(0) as u64) << 16) as i64)
+}
+
+fn dot(a: [Wide; 3], b: [Wide; 3]) -> Wide {
+    mul(a[0], b[0]) + mul(a[1], b[1]) + mul(a[2], b[2])
+}
+
+/// The ray caster's memory: one row of pixels and depth, per-frame ball data for up to `N`
+/// balls. `W·(size_of::<P>() + 4) + N·48` bytes plus `N·56` bytes of stack per ray.
+pub struct Caster<P, const W: usize, const N: usize> {
+    pixels: [P; W],
+    depth: [Depth; W],
+    balls: [FrameBall; N],
+    background: P,
+}
+
+impl<P: RowPixel, const W: usize, const N: usize> Caster<P, W, N> {
+    /// A caster drawing `background` where no ray hits.
+    pub const fn new(background: P) -> Self {
+        Caster {
+            pixels: [background; W],
+            depth: [Depth::ZERO; W],
+            balls: [FrameBall::EMPTY; N],
+            background,
+        }
+    }
+
+    /// Renders one frame: rows top to bottom to `sink`.
+    pub fn render<S: RowSink<P>>(
+        &mut self,
+        scene: &Metaballs<'_>,
+        camera: &MetaCamera,
+        light: &Light,
+        sink: &mut S,
+    ) -> Result<CastStats, CastError<S::Error>> {
+        let width = usize::from(camera.width);
+        if width > W {
+            return Err(CastError::Width);
+        }
+        let count = scene.balls().len();
+        if count > N {
+            return Err(CastError::Capacity);
+        }
+        for (slot, ball) in self.balls.iter_mut().zip(scene.balls()) {
+            *slot = frame_ball(ball, camera);
+        }
+        let frame = Frame {
+            balls: self.balls.get(..count).unwrap_or(&[]),
+            threshold: Wide::from(scene.threshold()),
+            camera,
+            light: Lighting::new(light),
+        };
+        let mut stats = CastStats::default();
+        for row in 0..camera.height {
+            for (column, (pixel, depth)) in self
+                .pixels
+                .iter_mut()
+                .zip(self.depth.iter_mut())
+                .enumerate()
+            {
+                let shade = frame.pixel::<N>(column as u16, row, &mut stats);
+                match shade {
+                    Some(hit) => {
+                        *pixel = P::from_shade(hit.color, u32::from(hit.ball));
+                        *depth = hit.depth;
+                        stats.hits += 1;
+                    }
+                    None => {
+                        *pixel = self.background;
+                        *depth = Depth::ZERO;
+                    }
+                }
+            }
+            sink.write_row(Row {
+                y: row,
+                pixels: self.pixels.get(..width).unwrap_or(&[]),
+                depth: DepthRow::Q30(self.depth.get(..width).unwrap_or(&[])),
+                complete: true,
+            })
+            .map_err(CastError::Sink)?;
+            stats.rows += 1;
+        }
+        Ok(stats)
+    }
+}
+
+fn frame_ball(ball: &Ball, camera: &MetaCamera) -> FrameBall {
+    let radius = Wide::from(ball.radius);
+    let density = Wide::from(ball.density);
+    let centre = ball.centre.map(Wide::from);
+    FrameBall {
+        offset: [0, 1, 2].map(|i| centre[i] - camera.eye[i]),
+        r2: radius * radius,
+        inv_r2: Wide::ONE.checked_div(radius * radius).unwrap_or(Wide::ZERO),
+        density,
+        slope_bound: (density.abs() * FIELD_LIPSCHITZ_WIDE)
+            .checked_div(radius)
+            .unwrap_or(Wide::MAX),
+        color: ball.color,
+    }
+}
+
+/// The light in I32F32.
+struct Lighting {
+    direction: [Wide; 3],
+    ambient: Wide,
+    diffuse: Wide,
+}
+
+impl Lighting {
+    fn new(light: &Light) -> Self {
+        Lighting {
+            direction: wide3(light.direction()),
+            ambient: wide_from_f32(light.ambient()),
+            diffuse: wide_from_f32(light.diffuse()),
+        }
+    }
+}
+
+/// A shaded hit.
+struct Hit {
+    color: Rgb888,
+    ball: u8,
+    depth: Depth,
+}
+
+struct Frame<'a> {
+    balls: &'a [FrameBall],
+    threshold: Wide,
+    camera: &'a MetaCamera,
+    light: Lighting,
+}
+
+/// The field sum minus `T` at `t`, the slope bound of the active balls, the next entry after
+/// `t`, and the positive density of the active balls.
+struct Sample {
+    g: Wide,
+    lipschitz: Wide,
+    next_entry: Option<Wide>,
+    positive: Wide,
+}
+
+impl Frame<'_> {
+    fn pixel<const N: usize>(&self, column: u16, row: u16, stats: &mut CastStats) -> Option<Hit> {
+        let d = self.camera.direction(column, row);
+        let dd = dot(d, d);
+        let length = sqrt_wide(dd);
+        let inv_dd = quotient(Wide::ONE, dd)?;
+        let mut rays = [RayBall::EMPTY; N];
+        let mut count = 0usize;
+        for (index, ball) in self.balls.iter().enumerate() {
+            if let Some(ray) = ray_ball(ball, index, d, dd, inv_dd, length) {
+                if let Some(slot) = rays.get_mut(count) {
+                    *slot = ray;
+                    count += 1;
+                }
+            }
+        }
+        let rays = rays.get(..count).unwrap_or(&[]);
+        let mut t = self.camera.near;
+        let first = self.sample(rays, t);
+        let inside = first.g > Wide::ZERO;
+        let mut steps = 0u32;
+        let mut found = false;
+        while steps < MAX_STEPS && t <= self.camera.far {
+            let s = self.sample(rays, t);
+            if (s.g > Wide::ZERO) != inside || s.g == Wide::ZERO {
+                found = true;
+                break;
+            }
+            steps += 1;
+            // Outside with too little positive density active: nothing until the next entry.
+            if !inside && s.positive <= self.threshold {
+                match s.next_entry {
+                    Some(next) => {
+                        t = next;
+                        continue;
+                    }
+                    None => break,
+                }
+            }
+            let safe = quotient(s.g.abs(), s.lipschitz).unwrap_or(Wide::MAX);
+            if safe < EPSILON_T {
+                found = true;
+                break;
+            }
+            // Stopping at the next entry keeps that ball's slope out of this step.
+            let step = s.next_entry.map_or(safe, |next| safe.min(next - t));
+            t = t.saturating_add(step);
+        }
+        stats.steps += u64::from(steps);
+        stats.max_steps = stats.max_steps.max(steps);
+        if !found {
+            if steps >= MAX_STEPS {
+                stats.capped += 1;
+            }
+            return None;
+        }
+        if t > self.camera.far {
+            return None;
+        }
+        self.shade(rays, d, t, inside)
+    }
+
+    fn sample(&self, rays: &[RayBall], t: Wide) -> Sample {
+        let mut sample = Sample {
+            g: -self.threshold,
+            lipschitz: Wide::ZERO,
+            next_entry: None,
+            positive: Wide::ZERO,
+        };
+        for ray in rays {
+            if ray.enter > t {
+                sample.next_entry = Some(sample.next_entry.map_or(ray.enter, |n| n.min(ray.enter)));
+                continue;
+            }
+            if ray.exit <= t {
+                continue;
+            }
+            let Some(ball) = self.balls.get(usize::from(ray.ball)) else {
+                continue;
+            };
+            sample.lipschitz += ray.lipschitz;
+            if ball.density > Wide::ZERO {
+                sample.positive += ball.density;
+            }
+            if let Some(s) = ray.s(t) {
+                sample.g += mul(ball.density, field(s));
+            }
+        }
+        sample
+    }
+
+    fn shade(&self, rays: &[RayBall], d: [Wide; 3], t: Wide, inside: bool) -> Option<Hit> {
+        let mut gradient = [Wide::ZERO; 3];
+        let mut best = (Wide::MIN, 0u8);
+        let mut weight = Wide::ZERO;
+        let mut rgb = [Wide::ZERO; 3];
+        for ray in rays {
+            let (Some(ball), Some(s)) = (self.balls.get(usize::from(ray.ball)), ray.s(t)) else {
+                continue;
+            };
+            let contribution = ball.density * field(s);
+            if contribution > best.0 {
+                best = (contribution, ray.ball);
+            }
+            if contribution > Wide::ZERO {
+                weight += contribution;
+                let c = ball.color;
+                for (acc, channel) in rgb.iter_mut().zip([c.r(), c.g(), c.b()]) {
+                    *acc += contribution.saturating_mul_int(i64::from(channel));
+                }
+            }
+            // ∇(q·f(s)) = q·f'(s)·2(p − c)/R², p − c = t·d − offset.
+            let k = ball.density * field_slope(s) * ball.inv_r2 * Wide::from_num(2);
+            for (g, (di, oi)) in gradient.iter_mut().zip(d.iter().zip(ball.offset)) {
+                *g += k * (t * *di - oi);
+            }
+        }
+        let largest = gradient.iter().map(|g| g.abs()).max().unwrap_or(Wide::ZERO);
+        let mut intensity = self.light.ambient;
+        if largest > Wide::ZERO {
+            // The outward normal is −∇g; seen from inside the surface, +∇g faces the eye.
+            let inv_largest = quotient(Wide::ONE, largest).unwrap_or(Wide::ZERO);
+            let n = gradient.map(|g| g * inv_largest);
+            let length = sqrt_wide(dot(n, n));
+            let mut n_dot_l = quotient(dot(n, self.light.direction), length).unwrap_or(Wide::ZERO);
+            if !inside {
+                n_dot_l = -n_dot_l;
+            }
+            if n_dot_l > Wide::ZERO {
+                intensity += self.light.diffuse * n_dot_l;
+            }
+        }
+        let intensity = intensity.min(Wide::ONE);
+        let fallback = self
+            .balls
+            .get(usize::from(best.1))
+            .map_or(Rgb888::BLACK, |b| b.color);
+        let inv_weight = quotient(Wide::ONE, weight);
+        let channel = |i: usize, fallback: u8| -> u8 {
+            let base = rgb
+                .get(i)
+                .zip(inv_weight)
+                .map(|(acc, inv)| *acc * inv)
+                .unwrap_or(Wide::from_num(fallback));
+            let v = (base * intensity).round().to_num::<i64>();
+            v.clamp(0, 255) as u8
+        };
+        let color = Rgb888::new(
+            channel(0, fallback.r()),
+            channel(1, fallback.g()),
+            channel(2, fallback.b()),
+        );
+        let depth = quotient(self.camera.near, t).map_or(Depth::ZERO, Depth::saturating_from_num);
+        Some(Hit {
+            color,
+            ball: best.1,
+            depth,
+        })
+    }
+}
+
+/// The ray's quadratic for one ball, or `None` if the ray misses its influence sphere.
+/// `inv_dd = 1/|d|²` is the ray's one division.
+fn ray_ball(
+    ball: &FrameBall,
+    index: usize,
+    d: [Wide; 3],
+    dd: Wide,
+    inv_dd: Wide,
+    length: Wide,
+) -> Option<RayBall> {
+    let w = ball.offset;
+    let closest = mul(dot(w, d), inv_dd);
+    let cross = [
+        mul(w[1], d[2]) - mul(w[2], d[1]),
+        mul(w[2], d[0]) - mul(w[0], d[2]),
+        mul(w[0], d[1]) - mul(w[1], d[0]),
+    ];
+    let s_min = mul(mul(dot(cross, cross), inv_dd), ball.inv_r2);
+    if s_min >= Wide::ONE {
+        return None;
+    }
+    let a = mul(dd, ball.inv_r2);
+    // (1 − s_min)/A = (1 − s_min)·R²/|d|²; padded by 2^-16 so the rounding of the square root
+    // never shortens the interval.
+    let half = sqrt_wide(mul(mul(Wide::ONE - s_min, ball.r2), inv_dd)) + Wide::from_bits(1 << 16);
+    Some(RayBall {
+        ball: u8::try_from(index).ok()?,
+        closest,
+        a,
+        s_min,
+        enter: closest - half,
+        exit: closest + half,
+        lipschitz: ball.slope_bound * length,
+    })
+}
+
+/// `numerator / denominator` for a positive denominator in one `i64` division (I32F32's own
+/// division widens to `i128`, a slow library call on the targets): the denominator keeps 16
+/// fractional bits and is rounded up, so the quotient's magnitude never exceeds the exact one
+/// (the march's step stays safe); relative error ≤ 2^-16 / denominator. `None` for a
+/// denominator below 2^-16 or `|numerator| ≥ 2^15` (the field sum is below 2^12, normals ≤ 1).
+fn quotient(numerator: Wide, denominator: Wide) -> Option<Wide> {
+    let den = (denominator.to_bits() >> 16) + 1;
+    if den <= 1 {
+        return None;
+    }
+    numerator
+        .to_bits()
+        .checked_mul(1 << 16)?
+        .checked_div(den)
+        .map(Wide::from_bits)
+}

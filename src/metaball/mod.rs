@@ -1,0 +1,343 @@
+//! Metaballs: an implicit surface `Σ qᵢ·f(rᵢ/Rᵢ) = T`, ray cast per pixel in fixed point.
+//!
+//! Each ball has a centre, a radius of influence `R`, a density `q` (negative subtracts) and a
+//! colour. Its field is the degree-six polynomial in `s = r²/R²`
+//!
+//! ```text
+//! f(s) = 1 − 22/9·s + 17/9·s² − 4/9·s³   for s < 1, 0 beyond,
+//! ```
+//!
+//! the one polynomial in `r²` of degree six in `r` with `f(0) = 1, f'(0) = 0, f(R) = 0,
+//! f'(R) = 0, f(R/2) = 1/2` (derivation in the repository's `docs/metaballs.md`). Along a ray
+//! `s` is quadratic in the ray parameter, so the summed field is piecewise a polynomial of
+//! degree six.
+//!
+//! [`Caster`] renders a [`Metaballs`] scene row by row into the crate's [`RowSink`](crate::sink::RowSink)s with
+//! no frame buffer and no allocation: per pixel, a sphere-tracing march whose step is the
+//! field's value over its Lipschitz bound (it never steps over a root), restricted to where the
+//! ray crosses influence spheres.
+//!
+//! ## Bit budget
+//!
+//! Scene data is [`Coord`] (I16F16); everything per ray is [`Wide`] (I32F32, an `i64`).
+//! [`Metaballs::new`] enforces the envelope that keeps every product inside I32F32:
+//!
+//! | quantity | limit | why |
+//! |---|---|---|
+//! | centre coordinates, eye | ±[`MAX_COORD`] = 64 | eye–centre vector ≤ 2^8 per axis |
+//! | radius `R` | [`MIN_RADIUS`] = 1/16 to [`MAX_RADIUS`] = 32 | `1/R²` ≤ 2^8 keeps 16 bits of `s` |
+//! | density `|q|`, threshold `T` | ≤ [`MAX_DENSITY`] = 64, `T > 0` | field sum ≤ 64·`N` ≤ 2^12 |
+//! | balls | ≤ `N` of the caster, ≤ 64 | field sum and its Lipschitz bound ≤ 2^20 |
+//! | ray direction | `1 + tan(fovy/2)·(aspect + 1)` ≤ 16 per axis | `fovy` ≤ 120°, aspect ≤ 4 |
+//!
+//! With those, `|w × d|` ≤ 2^12 per axis and `|w × d|²` ≤ 3·2^24, below I32F32's 2^31; near ≥ 1/256 and far ≤ [`MAX_FAR`] = 1024 bound the ray parameter.
+
+mod cast;
+
+pub use cast::{CastError, CastStats, Caster, MetaCamera, EPSILON_T, MAX_STEPS};
+
+use embedded_graphics::pixelcolor::Rgb888;
+use fixed::types::{I16F16, I32F32};
+
+/// Scene coordinates, radii, densities and the threshold: I16F16.
+pub type Coord = I16F16;
+/// Per-ray arithmetic: I32F32 (an `i64`; 31 integer bits for the products in the bit budget).
+pub type Wide = I32F32;
+
+/// Largest centre or eye coordinate (absolute value).
+pub const MAX_COORD: f32 = 64.0;
+/// Smallest radius of influence.
+pub const MIN_RADIUS: f32 = 1.0 / 16.0;
+/// Largest radius of influence.
+pub const MAX_RADIUS: f32 = 32.0;
+/// Largest density magnitude and threshold.
+pub const MAX_DENSITY: f32 = 64.0;
+/// Farthest far plane (eye depth).
+pub const MAX_FAR: f32 = 1024.0;
+/// Nearest near plane (eye depth).
+pub const MIN_NEAR: f32 = 1.0 / 256.0;
+/// Most balls in a scene.
+pub const MAX_BALLS: usize = 64;
+
+/// The field polynomial's coefficients in `s = r²/R²`, lowest power first: `f(s) = Σ cₖ sᵏ`.
+pub const FIELD_COEFFICIENTS: [f64; 4] = [1.0, -22.0 / 9.0, 17.0 / 9.0, -4.0 / 9.0];
+
+/// `max |df/dr|·R` over `0 ≤ r ≤ R` (1.58343 at `r ≈ 0.5035 R`), rounded up to 51/32: the field's Lipschitz
+/// constant in units of `1/R`.
+pub const FIELD_LIPSCHITZ: f64 = 1.59375;
+
+/// [`FIELD_LIPSCHITZ`] in I32F32 (exact: 51/32).
+const FIELD_LIPSCHITZ_WIDE: Wide = Wide::lit("1.59375");
+
+/// One ball.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ball {
+    /// Centre (world).
+    pub centre: [Coord; 3],
+    /// Radius of influence `R`: the field is 0 from here on.
+    pub radius: Coord,
+    /// Density `q`; negative subtracts.
+    pub density: Coord,
+    /// Base colour.
+    pub color: Rgb888,
+}
+
+impl Ball {
+    /// A ball from `f32` values (converted to I16F16, rounding to nearest; out-of-range values
+    /// saturate and NaN becomes 0, so [`Metaballs::new`] rejects them or sees a valid number).
+    pub fn new(centre: [f32; 3], radius: f32, density: f32, color: Rgb888) -> Self {
+        Ball {
+            centre: centre.map(coord_from_f32),
+            radius: coord_from_f32(radius),
+            density: coord_from_f32(density),
+            color,
+        }
+    }
+}
+
+/// `f32` to I16F16 without a panic path (`saturating_from_num` panics on NaN).
+fn coord_from_f32(v: f32) -> Coord {
+    Coord::checked_from_num(v).unwrap_or(if v > 0.0 {
+        Coord::MAX
+    } else if v < 0.0 {
+        Coord::MIN
+    } else {
+        Coord::ZERO
+    })
+}
+
+/// `f32` to I32F32 without a panic path (`saturating_from_num` panics on NaN).
+pub(crate) fn wide_from_f32(v: f32) -> Wide {
+    Wide::checked_from_num(v).unwrap_or(if v > 0.0 {
+        Wide::MAX
+    } else if v < 0.0 {
+        Wide::MIN
+    } else {
+        Wide::ZERO
+    })
+}
+
+/// Why a metaball scene was rejected.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MetaballError {
+    /// No balls, or more than [`MAX_BALLS`].
+    BallCount,
+    /// Ball `index` is outside the envelope (centre, radius or density).
+    Ball {
+        /// Index of the ball in the slice.
+        index: usize,
+    },
+    /// The threshold is not in `(0, MAX_DENSITY]`.
+    Threshold,
+    /// A degenerate camera (eye = target, up along the view), a field of view outside
+    /// (0°, 120°], near/far outside [`MIN_NEAR`]..[`MAX_FAR`], a target wider than 4:1 or
+    /// larger than 2048 per side, or an eye outside ±[`MAX_COORD`].
+    Camera,
+}
+
+impl core::fmt::Display for MetaballError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            MetaballError::BallCount => write!(f, "a metaball scene holds 1 to {MAX_BALLS} balls"),
+            MetaballError::Ball { index } => write!(
+                f,
+                "ball {index}: centre within ±{MAX_COORD}, radius {MIN_RADIUS}..{MAX_RADIUS}, |density| ≤ {MAX_DENSITY}"
+            ),
+            MetaballError::Threshold => write!(f, "threshold must be in (0, {MAX_DENSITY}]"),
+            MetaballError::Camera => write!(f, "camera outside the metaball caster's envelope"),
+        }
+    }
+}
+
+impl core::error::Error for MetaballError {}
+
+/// A checked metaball scene: balls borrowed (from flash or a frame's stack) and the threshold.
+#[derive(Clone, Copy, Debug)]
+pub struct Metaballs<'a> {
+    balls: &'a [Ball],
+    threshold: Coord,
+}
+
+impl<'a> Metaballs<'a> {
+    /// Checks the envelope of the module's bit budget.
+    pub fn new(balls: &'a [Ball], threshold: Coord) -> Result<Self, MetaballError> {
+        if balls.is_empty() || balls.len() > MAX_BALLS {
+            return Err(MetaballError::BallCount);
+        }
+        let max_coord = Coord::from_num(MAX_COORD);
+        let max_q = Coord::from_num(MAX_DENSITY);
+        for (index, b) in balls.iter().enumerate() {
+            let centre_ok = b
+                .centre
+                .iter()
+                .all(|c| c.unsigned_abs() <= max_coord.unsigned_abs());
+            let radius_ok =
+                b.radius >= Coord::from_num(MIN_RADIUS) && b.radius <= Coord::from_num(MAX_RADIUS);
+            let density_ok = b.density.unsigned_abs() <= max_q.unsigned_abs();
+            if !(centre_ok && radius_ok && density_ok) {
+                return Err(MetaballError::Ball { index });
+            }
+        }
+        if threshold <= Coord::ZERO || threshold > max_q {
+            return Err(MetaballError::Threshold);
+        }
+        Ok(Metaballs { balls, threshold })
+    }
+
+    /// The balls.
+    pub fn balls(&self) -> &'a [Ball] {
+        self.balls
+    }
+
+    /// The threshold `T`.
+    pub fn threshold(&self) -> Coord {
+        self.threshold
+    }
+}
+
+/// The I32F32 product, rounded down as `fixed`'s `*` rounds it, from 32×32-bit partial
+/// products: `fixed` widens I32F32 products to `i128`, a slow library call on 32-bit targets.
+/// Wraps where `*` would overflow; the module's bit budget keeps every product in range.
+#[inline(always)]
+pub(crate) fn mul(a: Wide, b: Wide) -> Wide {
+    let (a, b) = (a.to_bits(), b.to_bits());
+    let (a_high, a_low) = (a >> 32, i64::from(a as u32));
+    let (b_high, b_low) = (b >> 32, i64::from(b as u32));
+    // a·b = a_high·b_high·2^64 + (a_high·b_low + a_low·b_high)·2^32 + a_low·b_low.
+    let low = ((a_low as u64).wrapping_mul(b_low as u64) >> 32) as i64;
+    Wide::from_bits(
+        (a_high.wrapping_mul(b_high) << 32)
+            .wrapping_add(a_high.wrapping_mul(b_low))
+            .wrapping_add(a_low.wrapping_mul(b_high))
+            .wrapping_add(low),
+    )
+}
+
+/// `f(s)` in I32F32 for `0 ≤ s < 1` (Horner; every partial sum within ±3).
+#[inline]
+fn field(s: Wide) -> Wide {
+    let c = field_coefficients();
+    mul(mul(mul(c[3], s) + c[2], s) + c[1], s) + c[0]
+}
+
+/// `df/ds` in I32F32 for `0 ≤ s < 1`.
+#[inline]
+fn field_slope(s: Wide) -> Wide {
+    let c = field_coefficients();
+    mul(
+        mul(c[3], Wide::from_num(3) * s) + c[2] * Wide::from_num(2),
+        s,
+    ) + c[1]
+}
+
+/// [`FIELD_COEFFICIENTS`] in I32F32. A `const`, so the literals are parsed at compile time
+/// (`lit` in a plain function body would parse them on every call).
+const FIELD_WIDE: [Wide; 4] = [
+    Wide::ONE,
+    Wide::lit("-2.444444444444444444"),
+    Wide::lit("1.888888888888888889"),
+    Wide::lit("-0.444444444444444444"),
+];
+
+/// [`FIELD_COEFFICIENTS`] in I32F32.
+#[inline(always)]
+fn field_coefficients() -> [Wide; 4] {
+    FIELD_WIDE
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn f64_field(s: f64) -> f64 {
+        FIELD_COEFFICIENTS
+            .iter()
+            .rev()
+            .fold(0.0, |acc, c| acc * s + c)
+    }
+
+    #[test]
+    fn five_conditions() {
+        // f(0) = 1, f(R) = 0, f(R/2) = 1/2 (s = 1/4); f'(0) = 0 holds for any polynomial in r²;
+        // f'(R) = df/ds · 2r/R² = 0 needs df/ds(1) = 0.
+        assert!((f64_field(0.0) - 1.0).abs() < 1e-15);
+        assert!(f64_field(1.0).abs() < 1e-15);
+        assert!((f64_field(0.25) - 0.5).abs() < 1e-15);
+        let slope1 =
+            FIELD_COEFFICIENTS[1] + 2.0 * FIELD_COEFFICIENTS[2] + 3.0 * FIELD_COEFFICIENTS[3];
+        assert!(slope1.abs() < 1e-15);
+    }
+
+    #[test]
+    fn lipschitz_constant_bounds_the_slope() {
+        assert_eq!(FIELD_LIPSCHITZ_WIDE.to_num::<f64>(), FIELD_LIPSCHITZ);
+        let mut max = 0.0f64;
+        for i in 0..=100_000 {
+            let x = i as f64 / 100_000.0;
+            let s = x * x;
+            let dfds = FIELD_COEFFICIENTS[1]
+                + 2.0 * FIELD_COEFFICIENTS[2] * s
+                + 3.0 * FIELD_COEFFICIENTS[3] * s * s;
+            max = max.max((dfds * 2.0 * x).abs());
+        }
+        assert!(
+            max <= FIELD_LIPSCHITZ && max > FIELD_LIPSCHITZ - 0.02,
+            "{max}"
+        );
+    }
+
+    #[test]
+    fn fixed_field_matches_f64() {
+        for i in 0..=64 {
+            let s = i as f64 / 64.0;
+            let fx = field(Wide::from_num(s)).to_num::<f64>();
+            assert!((fx - f64_field(s)).abs() < 1e-8, "{s}");
+            let dfds = FIELD_COEFFICIENTS[1]
+                + 2.0 * FIELD_COEFFICIENTS[2] * s
+                + 3.0 * FIELD_COEFFICIENTS[3] * s * s;
+            assert!((field_slope(Wide::from_num(s)).to_num::<f64>() - dfds).abs() < 1e-8);
+        }
+    }
+
+    #[test]
+    fn mul_is_fixeds_product() {
+        let mut x = 0x1234_5678_9abc_def1u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            // Magnitudes from 2^-32 to 2^15, both signs.
+            (x as i64) >> (x % 48)
+        };
+        for _ in 0..100_000 {
+            let (a, b) = (Wide::from_bits(next()), Wide::from_bits(next()));
+            if let Some(exact) = a.checked_mul(b) {
+                assert_eq!(mul(a, b), exact, "{a} × {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn envelope_is_checked() {
+        let ok = Ball::new([0.0; 3], 1.0, 1.0, Rgb888::new(1, 2, 3));
+        assert!(Metaballs::new(&[ok], Coord::from_num(0.5)).is_ok());
+        assert_eq!(
+            Metaballs::new(&[], Coord::ONE).err(),
+            Some(MetaballError::BallCount)
+        );
+        let far = Ball::new([65.0, 0.0, 0.0], 1.0, 1.0, Rgb888::new(1, 2, 3));
+        assert_eq!(
+            Metaballs::new(&[ok, far], Coord::ONE).err(),
+            Some(MetaballError::Ball { index: 1 })
+        );
+        let tiny = Ball::new([0.0; 3], 0.01, 1.0, Rgb888::new(1, 2, 3));
+        assert_eq!(
+            Metaballs::new(&[tiny], Coord::ONE).err(),
+            Some(MetaballError::Ball { index: 0 })
+        );
+        assert_eq!(
+            Metaballs::new(&[ok], Coord::ZERO).err(),
+            Some(MetaballError::Threshold)
+        );
+    }
+}

@@ -1,0 +1,44 @@
+//! The firmware's metaball frames: the host casts them through the same code
+//! (`scanline3d_demo::metaballs`) and must reproduce the hashes the firmware prints on QEMU
+//! (`cargo xtask metaball` compares them run by run), and the firmware's balls are the
+//! `six.meta` scene's.
+
+use scanline3d::sink::HashSink;
+use scanline3d_demo::metaballs::{self, PanelCaster};
+use scanline3d_sim::metaball::{MetaScene, SIX_BALLS};
+
+/// Printed by `cargo run --profile firmware --example metaball --target thumbv7em-none-eabihf`
+/// for frames 0, 2 and 4; a change here means the cast pixels changed.
+const FIRMWARE_HASHES: [u32; 3] = [0x044f5679, 0x2e3f1b50, 0x32912b1c];
+
+#[test]
+fn host_reproduces_firmware_metaball_hashes() {
+    let mut caster = Box::new(PanelCaster::new(
+        embedded_graphics::pixelcolor::Rgb565::new(0, 0, 0),
+    ));
+    let hashes: Vec<u32> = [0, 2, 4]
+        .iter()
+        .map(|&frame| {
+            let mut sink = HashSink::new();
+            let stats = metaballs::render_frame(&mut caster, frame, &mut sink).unwrap();
+            assert!(stats.hits > 1000, "frame {frame}: {stats:?}");
+            sink.hash()
+        })
+        .collect();
+    assert_eq!(hashes, FIRMWARE_HASHES, "{hashes:08x?}");
+}
+
+#[test]
+fn firmware_balls_are_the_six_meta_scene() {
+    let scene = MetaScene::parse(SIX_BALLS, "six.meta").unwrap();
+    assert_eq!(scene.threshold as f32, metaballs::THRESHOLD);
+    for frame in 0..=metaballs::FRAMES {
+        let host = scene.library_balls(frame);
+        let firmware = metaballs::balls(frame);
+        assert_eq!(host.len(), firmware.len());
+        for (h, f) in host.iter().zip(&firmware) {
+            // Both round the same f64 centre through f32 to I16F16.
+            assert_eq!(h, f, "frame {frame}");
+        }
+    }
+}
