@@ -16,61 +16,102 @@ use scanline3d_sim::scene::{Algorithm, LightSpec, SceneSpec};
 const W: usize = 240;
 const H: usize = 240;
 
+/// What one corpus scene gives: report lines, failures of the exact methods, and depth sort's
+/// real mismatches and covered pixels at 4 sub-pixel bits.
+struct SceneResult {
+    name: &'static str,
+    lines: Vec<String>,
+    failures: Vec<String>,
+    depth_sort_real: usize,
+    covered: usize,
+}
+
+fn check_scene(scene: &corpus::CorpusScene) -> SceneResult {
+    let mut r = SceneResult {
+        name: scene.name,
+        lines: Vec::new(),
+        failures: Vec::new(),
+        depth_sort_real: 0,
+        covered: 0,
+    };
+    for (k, camera) in scene.cameras.iter().enumerate() {
+        let spec = SceneSpec::single(
+            scene.mesh.clone(),
+            *camera,
+            LightSpec::default(),
+            scene.cull_back_faces,
+        );
+        let reference = spec.reference().unwrap();
+        let ref_image = reference.render(W, H);
+        for sub_bits in [4, 8] {
+            let bound = ErrorBound {
+                sub_bits,
+                max_model_coord: spec.max_model_coord(),
+                focal_px: reference.camera.focal_px(H),
+                arithmetic: Default::default(),
+            };
+            for algorithm in Algorithm::ALL {
+                let fixed = spec.render_fixed_with(W, H, sub_bits, algorithm).unwrap();
+                let m = metrics::compare(&fixed.image, &ref_image, &reference, &bound);
+                let what = format!("{} cam {k} S={sub_bits} {algorithm}", scene.name);
+                r.lines.push(format!(
+                    "{what:40} {:5} id mismatches ({:.3} %), real {}",
+                    m.id_mismatches,
+                    m.id_mismatch_percent(),
+                    m.real
+                ));
+                if !algorithm.is_exact() {
+                    if sub_bits == 4 {
+                        r.depth_sort_real += m.real;
+                        r.covered += ref_image.ids.iter().filter(|&&i| i >= 0).count();
+                    }
+                    continue;
+                }
+                if m.real > 0 {
+                    r.failures
+                        .push(format!("{what}: {} real mismatches", m.real));
+                }
+                if sub_bits == 8 && m.id_mismatch_percent() > 0.1 {
+                    let pc = m.id_mismatch_percent();
+                    r.failures.push(format!("{what}: {pc:.3} % id mismatches"));
+                }
+                if m.depth_beyond_bound > 0 {
+                    let n = m.depth_beyond_bound;
+                    r.failures
+                        .push(format!("{what}: {n} pixels beyond the depth bound"));
+                }
+            }
+        }
+    }
+    r
+}
+
 #[test]
 fn every_method_against_the_reference() {
+    // One thread per scene: the scenes are independent, and this is the longest test.
+    let scenes = corpus::all();
+    let results: Vec<SceneResult> = std::thread::scope(|s| {
+        let handles: Vec<_> = scenes
+            .iter()
+            .map(|scene| s.spawn(move || check_scene(scene)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a scene's thread panicked"))
+            .collect()
+    });
     let mut failures = Vec::new();
     // Real mismatches of depth sort per scene, summed over cameras, at 4 sub-pixel bits.
     let mut depth_sort_real = std::collections::BTreeMap::new();
     let (mut ds_real, mut ds_pixels) = (0usize, 0usize);
-    for scene in corpus::all() {
-        for (k, camera) in scene.cameras.iter().enumerate() {
-            let spec = SceneSpec::single(
-                scene.mesh.clone(),
-                *camera,
-                LightSpec::default(),
-                scene.cull_back_faces,
-            );
-            let reference = spec.reference().unwrap();
-            let ref_image = reference.render(W, H);
-            for sub_bits in [4, 8] {
-                let bound = ErrorBound {
-                    sub_bits,
-                    max_model_coord: spec.max_model_coord(),
-                    focal_px: reference.camera.focal_px(H),
-                    arithmetic: Default::default(),
-                };
-                for algorithm in Algorithm::ALL {
-                    let fixed = spec.render_fixed_with(W, H, sub_bits, algorithm).unwrap();
-                    let m = metrics::compare(&fixed.image, &ref_image, &reference, &bound);
-                    let what = format!("{} cam {k} S={sub_bits} {algorithm}", scene.name);
-                    println!(
-                        "{what:40} {:5} id mismatches ({:.3} %), real {}",
-                        m.id_mismatches,
-                        m.id_mismatch_percent(),
-                        m.real
-                    );
-                    if !algorithm.is_exact() {
-                        if sub_bits == 4 {
-                            *depth_sort_real.entry(scene.name).or_insert(0) += m.real;
-                            ds_real += m.real;
-                            ds_pixels += ref_image.ids.iter().filter(|&&i| i >= 0).count();
-                        }
-                        continue;
-                    }
-                    if m.real > 0 {
-                        failures.push(format!("{what}: {} real mismatches", m.real));
-                    }
-                    if sub_bits == 8 && m.id_mismatch_percent() > 0.1 {
-                        let pc = m.id_mismatch_percent();
-                        failures.push(format!("{what}: {pc:.3} % id mismatches"));
-                    }
-                    if m.depth_beyond_bound > 0 {
-                        let n = m.depth_beyond_bound;
-                        failures.push(format!("{what}: {n} pixels beyond the depth bound"));
-                    }
-                }
-            }
+    for r in results {
+        for line in &r.lines {
+            println!("{line}");
         }
+        failures.extend(r.failures);
+        depth_sort_real.insert(r.name, r.depth_sort_real);
+        ds_real += r.depth_sort_real;
+        ds_pixels += r.covered;
     }
     println!("depth sort, real mismatches per scene (all cameras, 4 sub-pixel bits): {depth_sort_real:?}");
     println!(

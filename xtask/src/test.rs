@@ -44,6 +44,11 @@ pub(crate) fn cargo_test(extra: &[&str], totals: &mut (u64, u64)) -> Result<(), 
 
 pub(crate) fn test() -> Result<(), String> {
     install()?;
+    // The instrumented fuzz build (its own workspace and target directory) runs in the
+    // background from the start: test runs, single-threaded link steps and QEMU leave a core
+    // free for it.
+    step("fuzz target: AFL-instrumented build started in the background");
+    let fuzz_build = start_fuzz_build()?;
     step("format");
     run(cargo().args(["fmt", "--all", "--", "--check"]))?;
     step("rustdoc (warnings denied: broken links, missing docs)");
@@ -84,10 +89,6 @@ pub(crate) fn test() -> Result<(), String> {
         "firmware",
         &["panic_never", "firmware", "trace", "metaball"],
     )?;
-    // The instrumented fuzz build runs beside the package checks and the firmware, whose QEMU
-    // runs leave a core free.
-    step("fuzz target: AFL-instrumented build started in the background");
-    let fuzz_build = start_fuzz_build()?;
     package()?;
     firmware()?;
     crate::trace::trace()?;
