@@ -718,27 +718,14 @@ fn render(a: RenderArgs) -> Result<(), String> {
     };
     report_empty(&image.ids, &spec.camera);
     loaded.file_ids(&mut image.ids);
-    scene::write_png(&a.out, w, h, &image.color)?;
-    say!("wrote {}", a.out.display());
-    if let Some(p) = &a.ids {
-        scene::write_ids(p, &image.ids)?;
-        say!("wrote {}", p.display());
-    }
-    if let Some(p) = &a.depth {
-        scene::write_depth(p, &image.depth)?;
-        say!("wrote {}", p.display());
-    }
-    match &a.stats {
-        Some(p) if p.as_os_str() == "-" => {
-            let _ = std::io::stdout().write_all(stats_json.as_bytes());
-        }
-        Some(p) => {
-            std::fs::write(p, &stats_json).map_err(|e| format!("{}: {e}", p.display()))?;
-            say!("wrote {}", p.display());
-        }
-        None => {}
-    }
-    Ok(())
+    write_outputs(
+        &a.out,
+        &image,
+        a.ids.as_deref(),
+        a.depth.as_deref(),
+        a.stats.as_deref(),
+        &stats_json,
+    )
 }
 
 /// `sim trace --compare-accel`: traces with every acceleration structure, checks the images
@@ -926,22 +913,42 @@ fn metaball_command(a: MetaballArgs) -> Result<(), String> {
             scanline3d_sim::metaball::compare::compare(&caster, &expected, &reference)
         );
     }
-    scene::write_png(&a.out, w, h, &image.color)?;
-    say!("wrote {}", a.out.display());
-    if let Some(p) = &a.ids {
+    write_outputs(
+        &a.out,
+        &image,
+        a.ids.as_deref(),
+        a.depth.as_deref(),
+        a.stats.as_deref(),
+        &json,
+    )
+}
+
+/// Writes a rendered image as PNG, and optionally its id and depth images and its statistics
+/// (`-` for standard output), saying what it wrote.
+fn write_outputs(
+    out: &Path,
+    image: &Image,
+    ids: Option<&Path>,
+    depth: Option<&Path>,
+    stats: Option<&Path>,
+    stats_json: &str,
+) -> Result<(), String> {
+    scene::write_png(out, image.width, image.height, &image.color)?;
+    say!("wrote {}", out.display());
+    if let Some(p) = ids {
         scene::write_ids(p, &image.ids)?;
         say!("wrote {}", p.display());
     }
-    if let Some(p) = &a.depth {
+    if let Some(p) = depth {
         scene::write_depth(p, &image.depth)?;
         say!("wrote {}", p.display());
     }
-    match &a.stats {
+    match stats {
         Some(p) if p.as_os_str() == "-" => {
-            let _ = std::io::stdout().write_all(json.as_bytes());
+            let _ = std::io::stdout().write_all(stats_json.as_bytes());
         }
         Some(p) => {
-            std::fs::write(p, &json).map_err(|e| format!("{}: {e}", p.display()))?;
+            std::fs::write(p, stats_json).map_err(|e| format!("{}: {e}", p.display()))?;
             say!("wrote {}", p.display());
         }
         None => {}
