@@ -92,7 +92,7 @@
 //! 8 half-screens; triangles smaller than a pixel cover exactly the centres they contain (often
 //! none). Exactly coplanar overlapping surfaces resolve deterministically: the triangle that
 //! becomes active first (earlier first row, then lower id) keeps the pixel. Each limit has a test
-//! at the limit and just past it (`tests/envelope.rs`).
+//! at the limit and just past it (`tests/suite/envelope.rs`).
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]

@@ -31,7 +31,7 @@
 //! bit-identical to the span z-buffer's for flat shading (ids and colours). With Gouraud
 //! shading the kept pieces carry vertex colours rounded to 8 bits a channel and spans are
 //! painted from the window's edge, so colours could differ from the span z-buffer's by
-//! rounding (ids cannot); on the demo orbit they are identical (`tests/warnock.rs`).
+//! rounding (ids cannot); on the demo orbit they are identical (`tests/suite/warnock.rs`).
 //!
 //! # Memory
 //!

@@ -2,7 +2,7 @@
 //! lecture's cyclic-overlap case) renders on the host exactly as `sim`'s BSP method renders the
 //! OBJ it came from: the same frames the lean BSP firmware must print under QEMU.
 
-#[path = "../firmware/examples/lean/cyclic_bsp.rs"]
+#[path = "../../firmware/examples/lean/cyclic_bsp.rs"]
 mod scene;
 
 use embedded_graphics::pixelcolor::Rgb565;

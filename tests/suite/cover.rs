@@ -1,7 +1,7 @@
 //! Cover tests: planar tilings cover every pixel centre inside exactly once and outside never,
 //! and single-triangle coverage equals the exact edge-function test with the top-left rule.
 
-mod common;
+use crate::common;
 
 use common::*;
 use proptest::prelude::*;

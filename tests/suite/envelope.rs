@@ -2,7 +2,7 @@
 //! specific error just past it. The reasons (bit budgets) are in the README's envelope table and
 //! the module docs of `vertex`, `project` and `raster`.
 
-mod common;
+use crate::common;
 
 use common::*;
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888};

@@ -1,6 +1,6 @@
 //! Hostile input: every bad input gets a specific error, and the sink never sees a garbage row.
 
-mod common;
+use crate::common;
 
 use common::*;
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888};

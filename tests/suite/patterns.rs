@@ -1,6 +1,6 @@
 //! Exact pixel patterns, checked with embedded-graphics' MockDisplay (which fails on overdraw).
 
-mod common;
+use crate::common;
 
 use common::*;
 use embedded_graphics::mock_display::MockDisplay;

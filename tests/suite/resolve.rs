@@ -1,7 +1,7 @@
 //! The hidden-surface methods of `scanline3d::resolve` against the span z-buffer: the exact
 //! ones (band and full-frame z-buffers, span sorting) must render bit-identical frames, with
 //! flat and Gouraud shading, at full and reduced target sizes. Depth sort must paint every
-//! covered pixel; its errors are measured against the reference in `sim/tests/hsr.rs`.
+//! covered pixel; its errors are measured against the reference in `sim/tests/suite/hsr.rs`.
 
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use scanline3d::resolve::{BandWorkspace, DepthSortWorkspace, SpanSortWorkspace, ZBufferWorkspace};

@@ -7,7 +7,7 @@
 //! * Simple depth sort is the lecture's fast, wrong-in-cases baseline. It must fail on the
 //!   lecture's failure cases (interpenetration, cyclic overlap), where every exact method is
 //!   right; its failure rate on the whole corpus is printed
-//!   (`cargo test --release -p scanline3d-sim --test hsr -- --nocapture`).
+//!   (`cargo test --release -p scanline3d-sim --test suite hsr:: -- --nocapture`).
 
 use scanline3d_sim::corpus;
 use scanline3d_sim::metrics::{self, ErrorBound};

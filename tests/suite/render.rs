@@ -1,7 +1,7 @@
 //! End-to-end renders compared with the independent f64 ray caster in `common`, plus memory,
 //! error and degradation behaviour.
 
-mod common;
+use crate::common;
 
 use common::*;
 use embedded_graphics::pixelcolor::{BinaryColor, Gray8, Rgb565, Rgb888, RgbColor};

@@ -1,0 +1,17 @@
+//! Integration tests of the host tool (`sim`), one binary: each module was once its own test
+//! target. `peers.rs` stays apart: it needs the `peers` feature.
+
+mod accuracy;
+mod cli;
+mod export;
+mod extremes;
+mod hsr;
+mod interpolation;
+mod metaball;
+mod metaball_cli;
+mod presets;
+mod realworld;
+mod realworld_cli;
+mod trace;
+mod trace_fixed;
+mod vertex_cache;

@@ -1,0 +1,17 @@
+//! Integration tests of the library, one binary: each module was once its own test target.
+//! Linking one binary instead of one per file keeps `cargo xtask test` inside its budget.
+
+mod bsp_export;
+mod common;
+mod cover;
+mod envelope;
+mod firmware_hashes;
+mod hostile;
+mod hsr_scenes;
+mod metaball_firmware;
+mod module_graph;
+mod newell;
+mod patterns;
+mod render;
+mod resolve;
+mod warnock;
