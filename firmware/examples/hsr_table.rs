@@ -55,7 +55,35 @@ fn main() -> Result<(), String> {
             Ok(())
         }
     }
-    hsr::for_each(&mut Timing)
+    hsr::for_each(&mut Timing)?;
+
+    // The fixed-point tracer at the levels it runs at, the same way (`hsr::traced`).
+    use scanline3d_sim::hsr::traced;
+    for level in 0..traced::TRACED_LEVELS {
+        let mut buffers = Box::new(traced::Buffers::new()?);
+        SceneSpec::hsr(level)?.with_scene(|scene| buffers.fill(scene))??;
+        for (variant, shadows) in [("primary", false), ("shadows", true)] {
+            let start = Instant::now();
+            let mut frames = 0u32;
+            let elapsed = loop {
+                let mut sink = HashSink::new();
+                buffers
+                    .with_tracer(shadows, |t| traced::frame(t, Rgb565::BLACK, &mut sink))?
+                    .map_err(|e| format!("{e:?}"))?;
+                frames += 1;
+                let elapsed = start.elapsed();
+                if frames >= 3 && elapsed > Duration::from_millis(300) {
+                    break elapsed;
+                }
+            };
+            println!(
+                "host variant {variant} polygons {} frames {frames} ns_per_frame {}",
+                hsr::LEVELS[level].polygons,
+                elapsed.as_nanos() / frames as u128
+            );
+        }
+    }
+    Ok(())
 }
 
 #[cfg(target_os = "none")]
@@ -218,13 +246,57 @@ mod firmware {
         Ok(())
     }
 
+    /// The fixed-point tracer on the first levels, primary rays only and with shadow rays:
+    /// instructions of the frame, and apart from them those of filling the objects and
+    /// building the hierarchy (which `sim export` could do on the host instead).
+    fn trace_levels() -> Result<(), &'static str> {
+        for level in 0..hsr::traced::TRACED_LEVELS {
+            let mut buffers = hsr::traced::Buffers::new()?;
+            let instances = hsr::instances(&HSR_MESHES[level]);
+            let scene = hsr::scene(&instances).map_err(|_| "scene")?;
+            let mark = counter::start();
+            buffers.fill(&scene)?;
+            let build = counter::instructions(&mark);
+            for shadows in [false, true] {
+                let mut sink = HashSink::new();
+                let top = arch::sp();
+                measure::paint_stack();
+                let (stats, instructions) = buffers.with_tracer(shadows, |tracer| {
+                    let mark = counter::start();
+                    let stats = hsr::traced::frame(tracer, Rgb565::BLACK, &mut sink);
+                    (stats, counter::instructions(&mark))
+                })?;
+                let stack = top - measure::stack_low_water();
+                let stats = stats.map_err(|_| "trace")?;
+                if stats.dropped_rays != 0 {
+                    return Err("ray stack overflowed");
+                }
+                println!(
+                    "trace variant {} polygons {} instructions {} hash {:08x} build_instructions {} scene_bytes {} render_stack {} rays {} tests {} box_tests {}",
+                    if shadows { "shadows" } else { "primary" },
+                    hsr::LEVELS[level].polygons,
+                    instructions,
+                    sink.hash(),
+                    build,
+                    buffers.bytes_used(),
+                    stack,
+                    stats.rays(),
+                    stats.intersection_tests,
+                    stats.box_tests
+                );
+            }
+        }
+        Ok(())
+    }
+
     fn run() -> Result<(), &'static str> {
         arch::start_counter()?;
         counter::enable();
         measure::calibrate()?;
         calibrate_long()?;
         println!("summary static_ram {}", measure::static_ram());
-        hsr::for_each(&mut Table)
+        hsr::for_each(&mut Table)?;
+        trace_levels()
     }
 
     pub fn main() -> ! {

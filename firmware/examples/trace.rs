@@ -37,13 +37,17 @@ mod arch;
 mod measure;
 
 #[cfg(target_os = "none")]
+#[path = "common/row_count.rs"]
+mod row_count;
+
+#[cfg(target_os = "none")]
 #[allow(dead_code)]
 #[path = "trace/classic.rs"]
 mod classic;
 
 #[cfg(target_os = "none")]
 mod firmware {
-    use super::{arch, classic, view};
+    use super::{arch, classic, row_count::RowCounted, view};
     use embedded_graphics::pixelcolor::Rgb565;
     use scanline3d::sink::HashSink;
     use scanline3d::trace::{Scene, TraceCamera, TraceOptions, Tracer};
@@ -83,12 +87,12 @@ mod firmware {
         let stack_top = &raw const _stack_start as usize;
         measure::paint_stack();
         let mut row = [Rgb565::new(0, 0, 0); view::CLASSIC.width as usize];
-        let mut sink = HashSink::new();
-        let mark = arch::start();
+        let mut sink = RowCounted::new(HashSink::new());
         let stats = Tracer::<STACK>::new(&scene, &camera, options)
             .render(&mut row, &mut sink)
             .map_err(|_| "render")?;
-        let instructions = arch::instructions(&mark);
+        let instructions = sink.instructions;
+        let sink = sink.sink;
         let peak_stack = stack_top - measure::stack_low_water();
         if stats.dropped_rays != 0 {
             return Err("ray stack overflowed");

@@ -200,3 +200,207 @@ fn levels<M: Method, V: Visit>(v: &mut V) -> Result<(), V::Error> {
     v.visit::<M, { LEVELS[1].tris }, { LEVELS[1].active }, { LEVELS[1].pieces }>(1)?;
     v.visit::<M, { LEVELS[2].tris }, { LEVELS[2].active }, { LEVELS[2].pieces }>(2)
 }
+
+/// Ray tracing on the table's scenes, the lecture's fourth method: the library's fixed-point
+/// tracer ([`scanline3d::trace`]) over every triangle of a level, with a bounding-volume
+/// hierarchy built at run time into [`traced::Buffers`] (its cost is reported apart from the
+/// frame's), the scenes' camera and, with shadows, their light.
+pub mod traced {
+    use super::{Scene, CAMERA, HEIGHT, WIDTH};
+    use fixed::types::I16F16;
+    use scanline3d::scene::MeshColors;
+    use scanline3d::sink::{RowPixel, RowSink};
+    use scanline3d::trace::bvh::{self, BvhNode};
+    use scanline3d::trace::{
+        Colour, Light, Material, Object, Scene as TracedScene, Shape, TraceCamera, TraceError,
+        TraceOptions, TraceStats, Tracer, Triangle, Vec3,
+    };
+
+    /// Levels the tracer runs at: the first two. At 60,000 triangles the traced objects (60
+    /// bytes each, vertices inline) and their hierarchy need about 7 MB, more than the QEMU
+    /// board's 4 MiB of RAM or flash.
+    pub const TRACED_LEVELS: usize = 2;
+    /// Most triangles a traced level may have.
+    pub const CAPACITY: usize = 2_500;
+    /// Ray stack entries: the default depth limit (4) plus one.
+    pub const STACK: usize = 5;
+
+    /// Objects (one per triangle, in the rasterizers' id order), one material per triangle
+    /// (its colour; KA = KD = 1, the light's diffuse level as its intensity) and the
+    /// hierarchy's nodes and items.
+    pub struct Buffers {
+        objects: [Object<'static>; CAPACITY],
+        materials: [Material; CAPACITY],
+        nodes: [BvhNode; 2 * CAPACITY],
+        items: [u32; CAPACITY],
+        len: usize,
+        bounded: usize,
+        nodes_used: usize,
+        items_used: usize,
+    }
+
+    fn vec3(v: [I16F16; 3]) -> Vec3 {
+        Vec3 {
+            x: v[0],
+            y: v[1],
+            z: v[2],
+        }
+    }
+
+    fn material(c: embedded_graphics::pixelcolor::Rgb888) -> Result<Material, &'static str> {
+        use embedded_graphics::pixelcolor::RgbColor;
+        let channel = |v: u8| I16F16::from_num(v) / 255;
+        let colour =
+            Colour::new([channel(c.r()), channel(c.g()), channel(c.b())]).map_err(|_| "colour")?;
+        Material::new(
+            colour,
+            [I16F16::ONE, I16F16::ONE, I16F16::ZERO, I16F16::ZERO],
+            I16F16::ONE,
+        )
+        .map_err(|_| "material")
+    }
+
+    impl Buffers {
+        /// Empty buffers (their slots hold a placeholder until [`Buffers::fill`]).
+        pub fn new() -> Result<Buffers, &'static str> {
+            let one = I16F16::ONE.to_bits();
+            let placeholder = Triangle::new([
+                Vec3::ZERO,
+                Vec3::from_bits(one, 0, 0),
+                Vec3::from_bits(0, one, 0),
+            ])
+            .map_err(|_| "placeholder triangle")?;
+            let object = Object {
+                shape: Shape::Triangle(placeholder),
+                material: 0,
+            };
+            let node = BvhNode {
+                min: Vec3::ZERO,
+                max: Vec3::ZERO,
+                index: 0,
+                count: 0,
+                axis: 0,
+            };
+            Ok(Buffers {
+                objects: [object; CAPACITY],
+                materials: [material(embedded_graphics::pixelcolor::Rgb888::new(0, 0, 0))?;
+                    CAPACITY],
+                nodes: [node; 2 * CAPACITY],
+                items: [0; CAPACITY],
+                len: 0,
+                bounded: 0,
+                nodes_used: 0,
+                items_used: 0,
+            })
+        }
+
+        /// Every triangle of `scene` (whose instances must be untransformed, as the table's
+        /// are) as a traced object with its flat colour, and the hierarchy over them.
+        pub fn fill(&mut self, scene: &Scene<'_>) -> Result<(), &'static str> {
+            let mut n = 0;
+            for instance in scene.instances {
+                if instance.transform != scanline3d::scene::Transform::IDENTITY {
+                    return Err("traced scenes take untransformed instances");
+                }
+                let mesh = instance.mesh;
+                let vertices = mesh.vertices();
+                for (k, t) in mesh.triangles().iter().enumerate() {
+                    let corner = |i: usize| -> Result<Vec3, &'static str> {
+                        let v = t.get(i).and_then(|&v| vertices.get(usize::from(v)));
+                        v.map(|v| vec3(*v)).ok_or("vertex index")
+                    };
+                    let colour = match mesh.colors() {
+                        MeshColors::Uniform(c) => Some(c),
+                        MeshColors::PerFace(c) => c.get(k).copied(),
+                        MeshColors::PerVertex(c) => {
+                            t.first().and_then(|&v| c.get(usize::from(v))).copied()
+                        }
+                    }
+                    .ok_or("colour index")?;
+                    let triangle = Triangle::new([corner(0)?, corner(1)?, corner(2)?])
+                        .map_err(|_| "a triangle the tracer rejects")?;
+                    let index = u16::try_from(n).map_err(|_| "too many triangles")?;
+                    *self.objects.get_mut(n).ok_or("traced CAPACITY exceeded")? = Object {
+                        shape: Shape::Triangle(triangle),
+                        material: index,
+                    };
+                    *self
+                        .materials
+                        .get_mut(n)
+                        .ok_or("traced CAPACITY exceeded")? = material(colour)?;
+                    n += 1;
+                }
+            }
+            self.len = n;
+            let objects = self.objects.get(..n).ok_or("length")?;
+            let (nodes, items, bounded) =
+                bvh::build(objects, &mut self.nodes, &mut self.items).map_err(|_| "hierarchy")?;
+            (self.nodes_used, self.items_used, self.bounded) = (nodes, items, bounded);
+            Ok(())
+        }
+
+        /// Bytes the filled buffers use: objects, materials, nodes and items.
+        pub fn bytes_used(&self) -> usize {
+            self.len * (core::mem::size_of::<Object<'static>>() + core::mem::size_of::<Material>())
+                + self.nodes_used * core::mem::size_of::<BvhNode>()
+                + self.items_used * core::mem::size_of::<u32>()
+        }
+
+        /// Calls `f` with a tracer over the filled buffers: the table's camera, ambient level
+        /// and, if `shadows`, its light (else no light: primary rays only).
+        pub fn with_tracer<R>(
+            &self,
+            shadows: bool,
+            f: impl FnOnce(&Tracer<'_, '_, STACK>) -> R,
+        ) -> Result<R, &'static str> {
+            let (eye, target, up, fovy, near, far) = CAMERA;
+            let f64s = |v: [f32; 3]| v.map(f64::from);
+            let camera = TraceCamera::new(
+                f64s(eye),
+                f64s(target),
+                f64s(up),
+                f64::from(fovy),
+                f64::from(near),
+                f64::from(far),
+                WIDTH as u16,
+                HEIGHT as u16,
+            )
+            .map_err(|_| "camera")?;
+            let (towards, ambient, diffuse) = scanline3d_demo::LIGHT;
+            let towards = towards.map(I16F16::from_num);
+            let light = Light::directional(vec3(towards), I16F16::from_num(diffuse))
+                .map_err(|_| "light")?;
+            let lights = [light];
+            let lights = if shadows { &lights[..] } else { &[] };
+            let objects = self.objects.get(..self.len).ok_or("length")?;
+            let materials = self.materials.get(..self.len).ok_or("length")?;
+            let scene = TracedScene::new(
+                objects,
+                materials,
+                lights,
+                Colour::new([I16F16::ZERO; 3]).map_err(|_| "background")?,
+                I16F16::from_num(ambient),
+            )
+            .map_err(|_| "traced scene")?
+            .with_bvh(
+                self.nodes.get(..self.nodes_used).ok_or("nodes")?,
+                self.items.get(..self.items_used).ok_or("items")?,
+                self.bounded,
+            )
+            .map_err(|_| "hierarchy rejected")?;
+            let tracer = Tracer::<STACK>::new(&scene, &camera, TraceOptions::default());
+            Ok(f(&tracer))
+        }
+    }
+
+    /// One traced frame into `sink` through a row of `P` (`background` only fills the row
+    /// buffer before the first row is traced).
+    pub fn frame<P: RowPixel, K: RowSink<P>>(
+        tracer: &Tracer<'_, '_, STACK>,
+        background: P,
+        sink: &mut K,
+    ) -> Result<TraceStats, TraceError<K::Error>> {
+        let mut row = [background; WIDTH];
+        tracer.render(&mut row, sink)
+    }
+}

@@ -92,6 +92,69 @@ impl scanline3d_sim::hsr::Visit for HsrHostRun {
     }
 }
 
+/// One traced (variant, level) as the host computes it: the frame hash and the id image against
+/// the f64 reference (time per frame comes from the host run of the `hsr_table` example).
+pub(crate) struct TracedHost {
+    variant: &'static str,
+    polygons: usize,
+    hash: u32,
+    accuracy: scanline3d_sim::metrics::Metrics,
+}
+
+/// The fixed-point tracer on the host at every traced level, primary rays only and with
+/// shadows, through the same code as the firmware (`scanline3d_sim::hsr::traced`).
+fn traced_on_host(run: &HsrHostRun) -> Result<Vec<TracedHost>, String> {
+    use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
+    use scanline3d::sink::{FnSink, HashSink, Row, TriangleId};
+    use scanline3d_sim::hsr::{self, traced, HEIGHT, WIDTH};
+    use scanline3d_sim::{metrics, reference::Image};
+    let mut out = Vec::new();
+    for level in 0..traced::TRACED_LEVELS {
+        let spec = &run.specs[level];
+        let mut buffers = Box::new(traced::Buffers::new()?);
+        spec.with_scene(|scene| buffers.fill(scene))??;
+        for (variant, shadows) in [("primary", false), ("shadows", true)] {
+            let mut sink = HashSink::new();
+            buffers
+                .with_tracer(shadows, |t| traced::frame(t, Rgb565::BLACK, &mut sink))?
+                .map_err(|e| format!("traced frame: {e:?}"))?;
+            let mut image = Image {
+                width: WIDTH,
+                height: HEIGHT,
+                ids: vec![-1; WIDTH * HEIGHT],
+                depth: vec![f32::INFINITY; WIDTH * HEIGHT],
+                color: vec![[0; 3]; WIDTH * HEIGHT],
+            };
+            let mut ids = FnSink(|row: Row<'_, TriangleId>| {
+                let start = row.y as usize * WIDTH;
+                // The tracer sends no depth row: NaN over surfaces (not compared).
+                for (x, id) in row.pixels.iter().enumerate() {
+                    image.ids[start + x] = id.0;
+                    image.depth[start + x] = if id.0 >= 0 { f32::NAN } else { f32::INFINITY };
+                }
+                Ok::<(), std::convert::Infallible>(())
+            });
+            buffers
+                .with_tracer(shadows, |t| traced::frame(t, TriangleId::NONE, &mut ids))?
+                .map_err(|e| format!("traced id frame: {e:?}"))?;
+            let (reference, ref_image) = &run.references[level];
+            let bound = metrics::ErrorBound {
+                sub_bits: 4,
+                max_model_coord: spec.max_model_coord(),
+                focal_px: reference.camera.focal_px(HEIGHT),
+                arithmetic: Default::default(),
+            };
+            out.push(TracedHost {
+                variant,
+                polygons: hsr::LEVELS[level].polygons,
+                hash: sink.hash(),
+                accuracy: metrics::compare(&image, ref_image, reference, &bound),
+            });
+        }
+    }
+    Ok(out)
+}
+
 /// Mean time per frame (ns) from a criterion run of `cargo bench --bench hsr`, if there is one.
 pub(crate) fn criterion_mean_ns(method: &str, polygons: usize) -> Option<f64> {
     criterion_mean_ns_of("hsr", method, &polygons.to_string())
@@ -134,6 +197,9 @@ pub(crate) fn hsr_table() -> Result<(), String> {
         })
         .collect::<Result<_, String>>()?;
 
+    step("hidden-surface table: the fixed-point tracer on the host");
+    let traced = traced_on_host(&host)?;
+
     step(&format!(
         "hidden-surface table: firmware on QEMU mps2-an386, {TARGET}"
     ));
@@ -158,7 +224,36 @@ pub(crate) fn hsr_table() -> Result<(), String> {
             .ok_or_else(|| format!("firmware line lacks {k}"))
     };
 
-    // Host time: criterion if `cargo bench --bench hsr` has run, else the example's own loop.
+    // Host time: criterion if `cargo bench --bench hsr` has run, else the example's own loop;
+    // the tracer's always from that loop (it has no criterion bench).
+    step("hidden-surface table: timing loop on the host");
+    let out = cargo()
+        .args([
+            "run",
+            "--package",
+            FIRMWARE_PACKAGE,
+            "--profile",
+            "firmware",
+        ])
+        .args(["--example", "hsr_table"])
+        .current_dir(root())
+        .stderr(Stdio::inherit())
+        .output()
+        .map_err(|e| format!("hsr_table on the host: {e}"))?;
+    let host_text = String::from_utf8_lossy(&out.stdout).into_owned();
+    print!("{host_text}");
+    let host_lines: Vec<_> = host_text
+        .lines()
+        .filter(|l| l.starts_with("host "))
+        .map(fields)
+        .collect();
+    let loop_ns = |key: &str, name: &str, polygons: usize| -> Option<f64> {
+        let polygons = polygons.to_string();
+        host_lines
+            .iter()
+            .find(|f| f.get(key) == Some(&name) && f.get("polygons") == Some(&polygons.as_str()))
+            .and_then(|f| f.get("ns_per_frame")?.parse().ok())
+    };
     let mut times: Vec<Option<f64>> = host
         .entries
         .iter()
@@ -167,39 +262,12 @@ pub(crate) fn hsr_table() -> Result<(), String> {
     let timing = if times.iter().all(Option::is_some) {
         "criterion (`cargo bench --bench hsr`, mean)".to_string()
     } else {
-        step("hidden-surface table: no criterion results, timing loop on the host");
-        let out = cargo()
-            .args([
-                "run",
-                "--package",
-                FIRMWARE_PACKAGE,
-                "--profile",
-                "firmware",
-            ])
-            .args(["--example", "hsr_table"])
-            .current_dir(root())
-            .stderr(Stdio::inherit())
-            .output()
-            .map_err(|e| format!("hsr_table on the host: {e}"))?;
-        let text = String::from_utf8_lossy(&out.stdout).into_owned();
-        print!("{text}");
-        let lines: Vec<_> = text
-            .lines()
-            .filter(|l| l.starts_with("host "))
-            .map(fields)
-            .collect();
         for (t, e) in times.iter_mut().zip(&host.entries) {
-            let polygons = e.polygons.to_string();
-            *t = lines
-                .iter()
-                .find(|f| {
-                    f.get("method") == Some(&e.method)
-                        && f.get("polygons") == Some(&polygons.as_str())
-                })
-                .and_then(|f| f.get("ns_per_frame")?.parse().ok());
+            *t = loop_ns("method", e.method, e.polygons);
         }
         "in-process timing loop (`cargo run --profile firmware -p scanline3d-firmware --example hsr_table` on the host, about 0.3 s per entry; less reliable than criterion)".to_string()
     };
+    let traced_ns = |t: &TracedHost| loop_ns("variant", t.variant, t.polygons);
 
     let mut instructions = Vec::new();
     for e in &host.entries {
@@ -217,6 +285,36 @@ pub(crate) fn hsr_table() -> Result<(), String> {
             ));
         }
         instructions.push(number(f, "instructions")?);
+    }
+    // The tracer's lines: (host entry, firmware fields), hashes checked.
+    let traced_lines: Vec<_> = first
+        .lines()
+        .filter(|l| l.starts_with("trace "))
+        .map(fields)
+        .collect();
+    let mut traced_rows = Vec::new();
+    for t in &traced {
+        let polygons = t.polygons.to_string();
+        let f = traced_lines
+            .iter()
+            .find(|f| {
+                f.get("variant") == Some(&t.variant)
+                    && f.get("polygons") == Some(&polygons.as_str())
+            })
+            .ok_or_else(|| {
+                format!(
+                    "firmware printed no trace line for {} at {}",
+                    t.variant, t.polygons
+                )
+            })?;
+        let hash = f.get("hash").and_then(|h| u32::from_str_radix(h, 16).ok());
+        if hash != Some(t.hash) {
+            return Err(format!(
+                "traced {} at {} polygons: firmware hash {hash:08x?} differs from the host's {:08x}",
+                t.variant, t.polygons, t.hash
+            ));
+        }
+        traced_rows.push((t, f));
     }
     println!("firmware frame hashes equal the host's");
     let smallest = instructions.iter().copied().min().unwrap_or(1).max(1) as f64;
@@ -287,6 +385,23 @@ pub(crate) fn hsr_table() -> Result<(), String> {
             row.join(" | ")
         ));
     }
+    for variant in ["primary", "shadows"] {
+        let mut cells = Vec::new();
+        for level in hsr::LEVELS.iter() {
+            let found = traced_rows
+                .iter()
+                .find(|(t, _)| t.variant == variant && t.polygons == level.polygons);
+            cells.push(match found {
+                Some((_, f)) => format!("{:.1}", number(f, "instructions")? as f64 / smallest),
+                None => "does not fit".to_string(),
+            });
+        }
+        line(format!(
+            "| **scanline3d: {}** | {} |",
+            traced_name(variant),
+            cells.join(" | ")
+        ));
+    }
     line(String::new());
     line(
         "The lecture's figures are 1974 estimates for its own scenes and machines; ours are".into(),
@@ -315,9 +430,25 @@ pub(crate) fn hsr_table() -> Result<(), String> {
             e.accuracy.real
         ));
     }
+    for (t, f) in &traced_rows {
+        let (bytes, stack) = (number(f, "scene_bytes")?, number(f, "render_stack")?);
+        line(format!(
+            "| {} | {} | {} | {} | n/a: rays, not triangles | n/a | {} B | {} B | {} B | {:.3} % | {} |",
+            traced_name(t.variant),
+            thousands(t.polygons as u64),
+            thousands(number(f, "instructions")?),
+            micros(traced_ns(t)),
+            thousands(bytes),
+            thousands(stack),
+            thousands(bytes + stack),
+            t.accuracy.id_mismatch_percent(),
+            t.accuracy.real
+        ));
+    }
     line(String::new());
     line("* **Instructions per frame:** the render call alone, counted on the firmware (`firmware/examples/hsr_table.rs`). **Triangles drawn:** set up for the row walk after culling and clipping. **Depth complexity:** fragments (pixel centres covered before the depth test) per pixel showing a triangle.".into());
     line("* **Workspace** is the method's `BYTES`, sized for the scene (`hsr::LEVELS`: triangles after culling, triangles per row); **render call stack** is the peak stack of the render call, measured by painting; **RAM** is their sum (the scene itself is in flash).".into());
+    line(format!("* **Ray tracing** is the library's fixed-point tracer (`scanline3d::trace`, [tracing.md](tracing.md)) over every triangle of the scene, no back faces culled, with a bounding-volume hierarchy: *ray casting* traces primary rays only (no light, so ambient colour), *with shadows* adds the light as a shadow ray per lit pixel and Lambert shading. Its **workspace** column holds the traced objects (60 B per triangle, vertices inline), a material per triangle and the hierarchy, built at run time in {} instructions at 2,500 polygons (not in the frame's count; `sim export` can build it on the host instead). At 60,000 polygons those would need about 7 MB, more than the QEMU board's 4 MiB of RAM or flash, so that level is not traced.", traced_rows.iter().find(|(t, _)| t.polygons == 2500).map_or(Ok("n/a".to_string()), |(_, f)| number(f, "build_instructions").map(thousands))?));
     line("* **Id mismatches** are pixels whose triangle differs from the f64 ray-cast reference (`scanline3d_sim::metrics::compare`, host render through the same method); **real** ones are those not explained by the documented position error bound or a depth tie.".into());
     qualitative(
         &mut line,
@@ -327,6 +458,8 @@ pub(crate) fn hsr_table() -> Result<(), String> {
         &firmware_of,
         &number,
         &ray_ns,
+        &traced_rows,
+        &traced_ns,
     )?;
     let path = root().join("docs/hsr-table.md");
     std::fs::write(&path, stamp("cargo xtask hsr-table") + &md)
@@ -340,36 +473,19 @@ pub(crate) fn hsr_table() -> Result<(), String> {
 /// end or the tests).
 pub(crate) type CodeRange = (&'static str, &'static str, &'static str);
 
-pub(crate) const METHOD_CODE: [(&str, &[CodeRange]); 9] = [
+pub(crate) const METHOD_CODE: [(&str, &[CodeRange]); 10] = [
     (
         "span-zbuffer",
         &[(
-            "src/render.rs",
+            "src/workspace.rs",
             "/// The span z-buffer: one row of depth",
-            "/// Checks a `width",
+            "pub struct Workspace<",
         )],
     ),
-    (
-        "zbuffer",
-        &[(
-            "src/resolve/mod.rs",
-            "// Band and full-frame z-buffer",
-            "// Span sorting",
-        )],
-    ),
-    (
-        "band:16",
-        &[(
-            "src/resolve/mod.rs",
-            "// Band and full-frame z-buffer",
-            "// Span sorting",
-        )],
-    ),
-    (
-        "span-sort",
-        &[("src/resolve/mod.rs", "// Span sorting", "// Depth sort")],
-    ),
-    ("depth-sort", &[("src/resolve/mod.rs", "// Depth sort", "")]),
+    ("zbuffer", &[("src/resolve/band.rs", "", "")]),
+    ("band:16", &[("src/resolve/band.rs", "", "")]),
+    ("span-sort", &[("src/resolve/span_sort.rs", "", "")]),
+    ("depth-sort", &[("src/resolve/depth_sort.rs", "", "")]),
     (
         "bsp",
         &[("src/resolve/bsp.rs", "", ""), ("sim/src/bsp.rs", "", "")],
@@ -377,7 +493,36 @@ pub(crate) const METHOD_CODE: [(&str, &[CodeRange]); 9] = [
     ("newell", &[("src/resolve/newell.rs", "", "")]),
     ("warnock", &[("src/resolve/warnock.rs", "", "")]),
     ("ray casting", &[("sim/src/reference.rs", "", "")]),
+    (
+        "ray tracing",
+        &[
+            ("src/trace/tracer.rs", "", ""),
+            ("src/trace/intersect.rs", "", ""),
+            ("src/trace/bvh.rs", "", ""),
+        ],
+    ),
 ];
+
+/// A host time in µs, or n/a.
+fn micros(ns: Option<f64>) -> String {
+    ns.map_or("n/a".into(), |ns| format!("{:.1} µs", ns / 1000.0))
+}
+
+/// The table's name of a traced variant.
+fn traced_name(variant: &str) -> &'static str {
+    if variant == "shadows" {
+        "ray tracing with shadows"
+    } else {
+        "ray casting"
+    }
+}
+
+/// [`code_lines`], or an error naming the method whose code [`METHOD_CODE`] no longer finds.
+fn code_lines_or_err(method: &str) -> Result<usize, String> {
+    code_lines(method).ok_or_else(|| {
+        format!("xtask METHOD_CODE: the code of {method} is not where it says (moved or renamed?)")
+    })
+}
 
 /// Lines of code (not blank, not comments) of a method, as [`METHOD_CODE`] locates it.
 pub(crate) fn code_lines(method: &str) -> Option<usize> {
@@ -415,6 +560,8 @@ pub(crate) fn qualitative<'f>(
     firmware_of: &impl Fn(&HsrHost) -> Option<&'f std::collections::HashMap<&'f str, &'f str>>,
     number: &impl Fn(&std::collections::HashMap<&str, &str>, &str) -> Result<u64, String>,
     ray_ns: &[f64],
+    traced: &[(&TracedHost, &std::collections::HashMap<&str, &str>)],
+    traced_ns: &impl Fn(&TracedHost) -> Option<f64>,
 ) -> Result<(), String> {
     use scanline3d_sim::hsr;
     let level = 1; // 2,500 polygons
@@ -450,13 +597,26 @@ pub(crate) fn qualitative<'f>(
             instructions[k] as f64 / fastest,
             times[k].map_or("n/a".into(), |ns| format!("{:.1} µs", ns / 1000.0)),
             thousands(ram),
-            code_lines(e.method).map_or("n/a".into(), |n| n.to_string()),
+            code_lines_or_err(e.method)?,
+        ));
+    }
+    for (t, f) in traced.iter().filter(|(t, _)| t.polygons == polygons) {
+        let i = number(f, "instructions")?;
+        line(format!(
+            "| {} | {} ({:.1}×) | {} | {} B | {} | {} | triangles, spheres, planes, boxes, cylinders, cones, ellipsoids, polygons |",
+            traced_name(t.variant),
+            thousands(i),
+            i as f64 / fastest,
+            micros(traced_ns(t)),
+            thousands(number(f, "scene_bytes")? + number(f, "render_stack")?),
+            code_lines_or_err("ray tracing")?,
+            if t.variant == "shadows" { "yes: shadows here; reflection and refraction on the same code path (classic scene: [tracing.md](tracing.md))" } else { "yes, with secondary rays (not traced here)" },
         ));
     }
     line(format!(
-        "| ray casting (f64 reference, host only) | n/a (f64, not on the targets) | {:.1} µs (one frame, `std::time::Instant`) | host heap (BVH over all triangles) | {} | not yet: primary rays only; secondary rays are the ray tracer's job | triangles, spheres, planes |",
+        "| ray casting (f64 reference, host only) | n/a (f64, not on the targets) | {:.1} µs (one frame, `std::time::Instant`, in xtask's unoptimised build) | host heap (BVH over all triangles) | {} | primary rays only (the f64 Whitted tracer is `sim trace`) | triangles, spheres, planes |",
         ray_ns.get(level).copied().unwrap_or(0.0) / 1000.0,
-        code_lines("ray casting").map_or("n/a".into(), |n| n.to_string()),
+        code_lines_or_err("ray casting")?,
     ));
     line(String::new());
     line("* **Procedure** counts non-blank, non-comment lines of the method's own code, without the shared pipeline (transform, clipping, projection, edge walk) and without tests: `xtask` `METHOD_CODE` says which lines. The BSP count includes its host-side tree builder.".into());
