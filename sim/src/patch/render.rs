@@ -142,7 +142,8 @@ impl Reference {
         BASE_COLOR.map(|c| (c * i).round().clamp(0.0, 255.0) as u8)
     }
 
-    /// Renders every pixel centre of a `w × h` image.
+    /// Renders every pixel centre of a `w × h` image (rows shared among the machine's cores;
+    /// the result does not depend on how).
     pub fn render(&self, w: usize, h: usize) -> (Image, RenderStats) {
         let mut img = Image {
             width: w,
@@ -151,25 +152,62 @@ impl Reference {
             depth: vec![f32::INFINITY; w * h],
             color: vec![[0; 3]; w * h],
         };
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let rows_per = h.div_ceil(threads).max(1);
+        let parts: Vec<RenderStats> = std::thread::scope(|scope| {
+            let workers: Vec<_> = img
+                .ids
+                .chunks_mut(rows_per * w)
+                .zip(img.depth.chunks_mut(rows_per * w))
+                .zip(img.color.chunks_mut(rows_per * w))
+                .enumerate()
+                .map(|(k, ((ids, depth), color))| {
+                    scope.spawn(move || self.render_rows(k * rows_per, w, h, ids, depth, color))
+                })
+                .collect();
+            workers
+                .into_iter()
+                .map(|t| t.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                .collect()
+        });
         let mut stats = RenderStats::default();
-        for r in 0..h {
-            for c in 0..w {
-                let (x, y) = (c as f64 + 0.5, r as f64 + 0.5);
-                let (hit, s) = self.cast(x, y, w, h);
-                stats.rays += 1;
-                stats.rounds += u64::from(s.rounds);
-                stats.max_rounds = stats.max_rounds.max(s.rounds);
-                stats.rays_split += u64::from(s.splits > 0);
-                stats.capped += u64::from(s.capped);
-                if let Some(hit) = hit {
-                    let i = r * w + c;
-                    stats.hits += 1;
-                    img.ids[i] = hit.patch as i32;
-                    img.depth[i] = hit.t as f32;
-                    img.color[i] = self.shade(&hit, self.camera.ray(x, y, w, h));
-                }
-            }
+        for p in parts {
+            stats.rays += p.rays;
+            stats.hits += p.hits;
+            stats.rounds += p.rounds;
+            stats.max_rounds = stats.max_rounds.max(p.max_rounds);
+            stats.rays_split += p.rays_split;
+            stats.capped += p.capped;
         }
         (img, stats)
+    }
+
+    /// Renders the rows from `first` on into the given slices of the image.
+    fn render_rows(
+        &self,
+        first: usize,
+        w: usize,
+        h: usize,
+        ids: &mut [i32],
+        depth: &mut [f32],
+        color: &mut [[u8; 3]],
+    ) -> RenderStats {
+        let mut stats = RenderStats::default();
+        for (i, ((id, z), rgb)) in ids.iter_mut().zip(depth).zip(color).enumerate() {
+            let (x, y) = ((i % w) as f64 + 0.5, (first + i / w) as f64 + 0.5);
+            let (hit, s) = self.cast(x, y, w, h);
+            stats.rays += 1;
+            stats.rounds += u64::from(s.rounds);
+            stats.max_rounds = stats.max_rounds.max(s.rounds);
+            stats.rays_split += u64::from(s.splits > 0);
+            stats.capped += u64::from(s.capped);
+            if let Some(hit) = hit {
+                stats.hits += 1;
+                *id = hit.patch as i32;
+                *z = hit.t as f32;
+                *rgb = self.shade(&hit, self.camera.ray(x, y, w, h));
+            }
+        }
+        stats
     }
 }
