@@ -40,7 +40,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Render an OBJ scene to PNG (and optionally id, depth and statistics files).
+    /// Render an OBJ scene, or a Bezier patch model (.bpt), to PNG (and optionally id, depth
+    /// and statistics files).
     Render(RenderArgs),
     /// Compare two id/depth image pairs, or re-render a scene with both renderers and compare.
     Compare(CompareArgs),
@@ -281,7 +282,8 @@ fn method(s: &str) -> Result<Method, String> {
 
 #[derive(Args, Debug)]
 struct RenderArgs {
-    /// The OBJ scene (polygons fan-triangulated in file order).
+    /// The OBJ scene (polygons fan-triangulated in file order), or a .bpt patch model (one id
+    /// per patch in file order; the camera and size options apply).
     scene: PathBuf,
     #[command(flatten)]
     view: View,
@@ -676,6 +678,12 @@ fn report_empty(ids: &[i32], camera: &CameraSpec) {
 }
 
 fn render(a: RenderArgs) -> Result<(), String> {
+    if a.scene
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("bpt"))
+    {
+        return render_patches(a);
+    }
     let (spec, loaded) = spec_from(&a.scene, &a.view)?;
     let (w, h) = a.view.size;
     let renderer = match (a.renderer, a.view.algorithm) {
@@ -725,6 +733,59 @@ fn render(a: RenderArgs) -> Result<(), String> {
         a.depth.as_deref(),
         a.stats.as_deref(),
         &stats_json,
+    )
+}
+
+/// `sim render MODEL.bpt`: a Bezier patch model (docs/patches.md); ids are patch indices in
+/// file order. Only the camera and size options of `View` apply.
+fn render_patches(a: RenderArgs) -> Result<(), String> {
+    use scanline3d_sim::patch::{parse, render::Reference};
+    let model = parse::load(&a.scene)?;
+    let camera = CameraSpec {
+        eye: a.view.eye,
+        target: a.view.target,
+        up: a.view.up,
+        fovy: a.view.fov,
+        near: a.view.near,
+        far: a.view.far,
+    };
+    let (w, h) = a.view.size;
+    let (image, json) = match a.renderer {
+        Renderer::Reference => {
+            let start = std::time::Instant::now();
+            let patches = model.patches.len();
+            let reference = Reference::new(
+                model,
+                camera.reference()?,
+                LightSpec::default().reference()?,
+            );
+            let (image, s) = reference.render(w, h);
+            let json = format!(
+                "{{\"renderer\": \"reference\", \"patches\": {patches}, \"width\": {w}, \"height\": {h}, \"hits\": {}, \"clip_rounds_mean\": {:.3}, \"clip_rounds_max\": {}, \"rays_split\": {}, \"capped\": {}, \"seconds\": {:.3}}}\n",
+                s.hits,
+                s.mean_rounds(),
+                s.max_rounds,
+                s.rays_split,
+                s.capped,
+                start.elapsed().as_secs_f64()
+            );
+            (image, json)
+        }
+        Renderer::Fixed => {
+            return Err(format!(
+                "{}: the fixed-point patch renderer is not in this build; use --renderer reference",
+                a.scene.display()
+            ))
+        }
+    };
+    report_empty(&image.ids, &camera);
+    write_outputs(
+        &a.out,
+        &image,
+        a.ids.as_deref(),
+        a.depth.as_deref(),
+        a.stats.as_deref(),
+        &json,
     )
 }
 
