@@ -49,6 +49,11 @@ struct Frame {
     #[cfg_attr(not(target_os = "none"), allow(dead_code))]
     instructions: u64,
     complete: bool,
+    /// Triangles (or clipped pieces) set up for the walk, and pixel centres covered.
+    #[cfg_attr(not(target_os = "none"), allow(dead_code))]
+    activated: u32,
+    #[cfg_attr(not(target_os = "none"), allow(dead_code))]
+    fragments: u32,
 }
 
 /// Renders one frame of `scene` into the panel model, counting its instructions.
@@ -74,6 +79,8 @@ fn frame<
         hash: sink.hash(),
         instructions,
         complete: stats.is_complete(),
+        activated: stats.activated,
+        fragments: stats.fragments,
     })
 }
 
@@ -364,8 +371,8 @@ mod firmware {
                 report: |name: &str, frame, f: Frame| {
                     complete &= f.complete;
                     println!(
-                        "variant {} frame {} hash {:08x} complete {} instructions {}",
-                        name, frame, f.hash, f.complete, f.instructions
+                        "variant {} frame {} hash {:08x} complete {} instructions {} activated {} fragments {}",
+                        name, frame, f.hash, f.complete, f.instructions, f.activated, f.fragments
                     )
                 },
             })?;
@@ -377,8 +384,8 @@ mod firmware {
                 report: |name: &str, scene: &str, view, f: Frame| {
                     complete &= f.complete;
                     println!(
-                        "corpus {} scene {} view {} hash {:08x} complete {} instructions {}",
-                        name, scene, view, f.hash, f.complete, f.instructions
+                        "corpus {} scene {} view {} hash {:08x} complete {} instructions {} activated {} fragments {}",
+                        name, scene, view, f.hash, f.complete, f.instructions, f.activated, f.fragments
                     )
                 },
             })?;

@@ -15,6 +15,7 @@ mod metaball;
 mod package;
 mod peers;
 mod profile;
+mod speed;
 mod test;
 mod trace;
 mod tradeoff;
@@ -169,6 +170,10 @@ fn main() -> ExitCode {
         "tradeoff" => install()
             .and_then(|_| tradeoff::tradeoff())
             .and_then(|_| peers()),
+        "speed" => {
+            let label = std::env::args().nth(2).unwrap_or_else(|| "after".into());
+            install().and_then(|_| speed::speed(&label))
+        }
         "profile" => {
             let variant = std::env::args().nth(2).unwrap_or_else(|| "balanced".into());
             install().and_then(|_| profile::profile(&variant))
@@ -192,7 +197,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | trace | metaball | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | trace | metaball | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | speed [before|after] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }
