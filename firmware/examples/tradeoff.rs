@@ -29,7 +29,15 @@ use scanline3d_demo as demo;
 
 /// The demo's panel workspace with room to spare: the approximate set-up of some variants moves
 /// the camera slightly, so the exact capacities `sim analyze --demo` measured may not cover it.
-type Ws<Sh, Z> = Workspace<Rgb565, Sh, 240, 240, 640, 80, 3, Z>;
+/// Built with `--cfg scanline3d_vertex_cache` (`cargo xtask speed` does both), with a vertex
+/// cache holding every demo vertex (the same pixels).
+type Ws<Sh, Z> = Workspace<Rgb565, Sh, 240, 240, 640, 80, 3, Z, CACHE>;
+
+/// Vertex cache entries of the demo workspace.
+#[cfg(not(scanline3d_vertex_cache))]
+const CACHE: usize = 0;
+#[cfg(scanline3d_vertex_cache)]
+const CACHE: usize = demo::PANEL_VERTICES;
 
 /// A new workspace: boxed on the host (a debug build would need a large main stack), on the
 /// stack on targets (no allocator; the variant's frame holds it while it renders).
@@ -263,9 +271,24 @@ mod corpus_views {
         include!(env!("SCANLINE3D_CORPUS"));
     }
 
-    /// A workspace for the largest corpus scene.
-    type CorpusWs<Sh, Z> =
-        Workspace<Rgb565, Sh, 240, 240, { corpus::MAX_TRIANGLES }, { corpus::MAX_ACTIVE }, 1, Z>;
+    /// A workspace for the largest corpus scene (with `--cfg scanline3d_vertex_cache`, a vertex
+    /// cache for the largest mesh).
+    type CorpusWs<Sh, Z> = Workspace<
+        Rgb565,
+        Sh,
+        240,
+        240,
+        { corpus::MAX_TRIANGLES },
+        { corpus::MAX_ACTIVE },
+        1,
+        Z,
+        CORPUS_CACHE,
+    >;
+
+    #[cfg(not(scanline3d_vertex_cache))]
+    const CORPUS_CACHE: usize = 0;
+    #[cfg(scanline3d_vertex_cache)]
+    const CORPUS_CACHE: usize = corpus::MAX_VERTICES;
 
     pub struct Views<'a, C, R> {
         pub count: &'a C,

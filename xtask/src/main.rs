@@ -176,7 +176,8 @@ fn main() -> ExitCode {
         }
         "profile" => {
             let variant = std::env::args().nth(2).unwrap_or_else(|| "balanced".into());
-            install().and_then(|_| profile::profile(&variant))
+            let cache = std::env::args().nth(3).as_deref() == Some("cache");
+            install().and_then(|_| profile::profile(&variant, cache))
         }
         // The host renders build whole-frame workspaces (megabytes at 60,000 polygons) by value:
         // give them a thread with room for that.
@@ -197,7 +198,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | trace | metaball | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | speed [before|after] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | trace | metaball | lean | package | hsr-table | peers | tradeoff | profile [VARIANT [cache]] | speed [before|after] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }
