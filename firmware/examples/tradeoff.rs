@@ -73,8 +73,9 @@ fn frame<
     const ACT: usize,
     const I: usize,
     Z: DepthFormat,
+    const V: usize,
 >(
-    ws: &mut Workspace<Rgb565, Sh, 240, 240, T, ACT, I, Z>,
+    ws: &mut Workspace<Rgb565, Sh, 240, 240, T, ACT, I, Z, V>,
     scene: &Scene<'_>,
     options: &RenderOptions<S, FrustumClip, A>,
     count: &impl Fn() -> Counter,
@@ -266,7 +267,8 @@ mod corpus_views {
     use super::*;
     use scanline3d::scene::{Instance, Light, Transform};
 
-    #[allow(clippy::all, missing_docs)]
+    // MAX_VERTICES is used only with a vertex cache.
+    #[allow(clippy::all, missing_docs, dead_code)]
     pub mod corpus {
         include!(env!("SCANLINE3D_CORPUS"));
     }

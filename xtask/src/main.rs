@@ -198,7 +198,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | trace | metaball | lean | package | hsr-table | peers | tradeoff | profile [VARIANT [cache]] | speed [before|after] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | trace | metaball | lean | package | hsr-table | peers | tradeoff | profile [VARIANT [cache]] | speed [before|after|doc] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }
