@@ -146,7 +146,10 @@ fn hashes(label: &str) -> BTreeMap<(String, String, usize), String> {
             let [t, s, v, h, ..] = w[..] else {
                 return None;
             };
-            Some(((t.to_string(), s.to_string(), v.parse().ok()?), h.to_string()))
+            Some((
+                (t.to_string(), s.to_string(), v.parse().ok()?),
+                h.to_string(),
+            ))
         })
         .collect()
 }
@@ -228,7 +231,10 @@ fn write_doc() -> Result<(), String> {
         if other.is_empty() {
             continue;
         }
-        let same = other.iter().filter(|(k, h)| base.get(*k) == Some(*h)).count();
+        let same = other
+            .iter()
+            .filter(|(k, h)| base.get(*k) == Some(*h))
+            .count();
         md += &format!(
             "Frame hashes of \"{title}\" equal to \"before\": {same} of {} frames (demo orbit and every corpus view, three targets).\n\n",
             other.len()
