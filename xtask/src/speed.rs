@@ -70,6 +70,9 @@ pub fn speed(label: &str) -> Result<(), String> {
         // Only rewrite docs/speed.md from the saved figures.
         return write_doc();
     }
+    if label == "before" && data_dir().join("before.tsv").exists() {
+        return Err("docs/speed/before.tsv records the code before issue 19's set-up rework; delete it to measure a new baseline".into());
+    }
     step("every corpus scene as firmware data (scanline3d_sim::export::corpus_source)");
     let dir = root().join("target/speed-corpus");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
