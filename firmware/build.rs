@@ -18,8 +18,8 @@ fn main() {
         "cargo::rustc-check-cfg=cfg(scanline3d_variant, values(\"fast\", \"balanced\", \"exact\", \"default\", \"bits0\", \"micromath\", \"narrowtransform\", \"reciprocal\", \"narrownormals\", \"depth16\", \"gouraudaffine\", \"gouraudsegments16\", \"gouraudsegments8\", \"gouraudperpixel\"))"
     );
     println!("cargo::rustc-check-cfg=cfg(scanline3d_corpus)");
-    // `examples/firmware.rs` with `--cfg scanline3d_vertex_cache` renders the demo with a
-    // vertex cache (`cargo xtask firmware` measures both).
+    // `examples/firmware.rs` and `examples/tradeoff.rs` with `--cfg scanline3d_vertex_cache`
+    // render with a vertex cache (`cargo xtask firmware` and `cargo xtask speed` measure both).
     println!("cargo::rustc-check-cfg=cfg(scanline3d_vertex_cache)");
     if std::env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
         return;

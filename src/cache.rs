@@ -12,30 +12,39 @@
 //! with more vertices than `VERTS` is rendered uncached, also bit-identically, and says so in
 //! [`FrameStats::cached_vertices`](crate::FrameStats::cached_vertices) (0).
 //!
-//! Each entry is [`CachedVertex::BYTES`] bytes: on a microcontroller a 642-vertex mesh costs
-//! about 18 KiB, on a host it is nothing.
+//! An entry is compact, [`CachedVertex::BYTES`] = 8 bytes, so that the cache fits beside the
+//! rest of the workspace on a microcontroller (a 642-vertex mesh: 5,136 bytes): the snapped
+//! screen position as two `i16` (sub-pixel units) and the depth, which is positive for every
+//! projected vertex (`near / w` with `w >= near`), in two halves. A set top bit of the depth
+//! marks a vertex without a cached position; its `x` then holds the clip outcodes. A vertex
+//! whose position does not fit `i16` (or whose depth is not positive) is stored that way, so
+//! its triangles take the clipping path, which computes the same position. The eye-space point
+//! is not kept: the rare triangles that need clipping transform their vertices again, with the
+//! same result.
 
 use crate::project::{ProjectionPrecision, ScreenVertex, SubPx, Viewport};
 use crate::vertex::EyePoint;
 use crate::Depth;
 use fixed::types::I16F16;
 
-/// One vertex as the frame sees it: eye-space position, which clip planes it is outside, and
-/// (when inside all of them) its snapped screen position and depth.
+/// One vertex as the frame sees it: its snapped screen position and depth when it is inside
+/// every clip plane (and the position fits `i16`), else which clip planes it is outside.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct CachedVertex {
-    pub(crate) eye: EyePoint,
-    /// Bit `k` set: outside clip plane `k` of [`Viewport::clip_distances`]. [`NOT_PROJECTED`]
-    /// marks a vertex without a screen position.
-    pub(crate) outside: u8,
-    x: i32,
-    y: i32,
-    q: Depth,
+    /// Screen position in sub-pixel units ([`SubPx`] bits); `x` holds the clip outcodes of a
+    /// vertex without a cached position (bit `k`: outside plane `k` of
+    /// [`Viewport::clip_distances`]).
+    x: i16,
+    y: i16,
+    /// [`Depth`] bits, high and low half (two `u16` keep the entry 2-byte aligned: 8 bytes);
+    /// [`NOT_PROJECTED`] set in the high half: no cached position.
+    q: [u16; 2],
 }
 
-/// Set in [`CachedVertex::outside`] when the vertex has no screen position (it is outside a
-/// plane, or its projection failed): triangles using it take the clipping path.
-const NOT_PROJECTED: u8 = 0x80;
+/// Set in the high half of [`CachedVertex::q`] when the vertex has no cached screen position
+/// (it is outside a plane, its projection failed or its position does not fit `i16`):
+/// triangles using it take the clipping path.
+const NOT_PROJECTED: u16 = 0x8000;
 
 impl CachedVertex {
     /// Size of one cache entry in bytes.
@@ -43,15 +52,9 @@ impl CachedVertex {
 
     /// An unused entry (its value is never read before the frame fills it).
     pub const EMPTY: Self = CachedVertex {
-        eye: EyePoint {
-            x: I16F16::ZERO,
-            y: I16F16::ZERO,
-            w: I16F16::ZERO,
-        },
-        outside: NOT_PROJECTED,
         x: 0,
         y: 0,
-        q: Depth::ZERO,
+        q: [NOT_PROJECTED, 0],
     };
 
     /// Clip-tests and (when inside) projects eye-space point `eye` at precision `P`.
@@ -64,35 +67,51 @@ impl CachedVertex {
             .clip_distances(&eye)
             .iter()
             .enumerate()
-            .fold(0u8, |bits, (k, d)| bits | (((*d < 0) as u8) << k));
+            .fold(0i16, |bits, (k, d)| bits | (((*d < 0) as i16) << k));
         let screen = if outside == 0 {
             vp.project_as::<P>(&eye, [I16F16::ZERO; 3], true)
         } else {
             None
         };
-        match screen {
-            Some(s) => CachedVertex {
-                eye,
-                outside,
-                x: s.x.0,
-                y: s.y.0,
-                q: s.q,
-            },
-            None => CachedVertex {
-                eye,
-                outside: outside | NOT_PROJECTED,
-                ..Self::EMPTY
-            },
+        let cached = screen.and_then(|s| {
+            let q = s.q.to_bits();
+            (q > 0).then_some(())?;
+            Some(CachedVertex {
+                x: i16::try_from(s.x.0).ok()?,
+                y: i16::try_from(s.y.0).ok()?,
+                q: [(q >> 16) as u16, q as u16],
+            })
+        });
+        cached.unwrap_or(CachedVertex {
+            x: outside,
+            ..Self::EMPTY
+        })
+    }
+
+    /// Whether this entry has a cached screen position.
+    #[inline]
+    fn projected(&self) -> bool {
+        self.q[0] & NOT_PROJECTED == 0
+    }
+
+    /// The clip outcodes (0 for a vertex with a cached position, which is inside every plane).
+    #[inline]
+    fn outside(&self) -> i16 {
+        if self.projected() {
+            0
+        } else {
+            self.x
         }
     }
 
     /// The screen vertex with colour `color`, if this vertex has one.
     #[inline]
     pub(crate) fn screen<const S: u32>(&self, color: [I16F16; 3]) -> Option<ScreenVertex<S>> {
-        (self.outside == 0).then_some(ScreenVertex {
-            x: SubPx(self.x),
-            y: SubPx(self.y),
-            q: self.q,
+        let q = (self.q[0] as i32) << 16 | self.q[1] as i32;
+        self.projected().then_some(ScreenVertex {
+            x: SubPx(self.x as i32),
+            y: SubPx(self.y as i32),
+            q: Depth::from_bits(q),
             color,
         })
     }
@@ -100,7 +119,7 @@ impl CachedVertex {
     /// Whether all of `v` lie outside one clip plane (the triangle is invisible).
     #[inline]
     pub(crate) fn all_outside_one_plane(v: [&Self; 3]) -> bool {
-        v[0].outside & v[1].outside & v[2].outside & !NOT_PROJECTED != 0
+        v[0].outside() & v[1].outside() & v[2].outside() != 0
     }
 }
 
@@ -144,10 +163,23 @@ mod tests {
     }
 
     #[test]
-    fn an_entry_is_28_bytes() {
-        // Eye point (3 × 4), outcodes (1), screen x, y and depth (3 × 4), padded to 4.
-        assert_eq!(CachedVertex::BYTES, 28);
-        assert_eq!(vertex_cache_bytes(731), 20_468);
+    fn an_entry_is_8_bytes() {
+        // Screen x, y (2 × 2), depth (2 × 2).
+        assert_eq!(CachedVertex::BYTES, 8);
+        assert_eq!(vertex_cache_bytes(731), 5_848);
+    }
+
+    #[test]
+    fn positions_beyond_i16_are_not_cached() {
+        // 2048 pixels wide with 8 sub-pixel bits: the screen's right half is beyond i16.
+        let vp = Viewport::<8>::new(2048, 2048, 1.7, 0.5, 50.0).unwrap();
+        let right = CachedVertex::new::<8, ExactDivision>(&vp, eye(2.0, 0.0, 5.0));
+        assert!(vp
+            .project_as::<ExactDivision>(&eye(2.0, 0.0, 5.0), [I16F16::ZERO; 3], true)
+            .is_some());
+        assert_eq!(right.outside(), 0);
+        assert!(right.screen::<8>([I16F16::ZERO; 3]).is_none());
+        assert!(!CachedVertex::all_outside_one_plane([&right; 3]));
     }
 
     #[test]
@@ -156,9 +188,10 @@ mod tests {
         let behind = CachedVertex::new::<4, ExactDivision>(&vp, eye(0.0, 0.0, -1.0));
         let far = CachedVertex::new::<4, ExactDivision>(&vp, eye(0.0, 0.0, 80.0));
         let inside = CachedVertex::new::<4, ExactDivision>(&vp, eye(0.0, 0.0, 5.0));
-        assert_eq!(behind.outside & 1, 1);
-        assert_eq!(far.outside & 2, 2);
-        assert_eq!(inside.outside, 0);
+        assert_eq!(behind.outside() & 1, 1);
+        assert_eq!(far.outside() & 2, 2);
+        assert_eq!(inside.outside(), 0);
+        assert!(inside.screen::<4>([I16F16::ZERO; 3]).is_some());
         assert!(behind.screen::<4>([I16F16::ZERO; 3]).is_none());
         assert!(CachedVertex::all_outside_one_plane([&behind; 3]));
         assert!(!CachedVertex::all_outside_one_plane([

@@ -176,8 +176,8 @@ impl<const S: u32> Viewport<S> {
         let nx = self.ax.apply(p.x.to_bits());
         let ny = self.ay.apply(p.y.to_bits());
         // round(c/2 + n/w) = floor((c·w + 2n + w) / 2w)
-        let x = (cx * w + 2 * nx + w).div_euclid(2 * w);
-        let y = (cy * w - 2 * ny + w).div_euclid(2 * w);
+        let x = floor_div(cx * w + 2 * nx + w, 2 * w);
+        let y = floor_div(cy * w - 2 * ny + w, 2 * w);
         let q = if depth {
             ((self.near.to_bits() as i64) << 30) / w
         } else {
@@ -227,6 +227,20 @@ impl<const S: u32> Viewport<S> {
         };
         Some(screen_vertex(x, y, q, color))
     }
+}
+
+/// `floor(n / d)` for `d > 0`: a 32-bit division when both fit `u32` (an on-screen vertex at a
+/// moderate `w`: `n ≈ X · 2w`), else the 64-bit one. The same quotient either way; on 32-bit
+/// cores the first is one `UDIV` (Cortex-M4) or a 32-bit library call (Cortex-M0) instead of a
+/// 64-bit library division.
+#[inline]
+fn floor_div(n: i64, d: i64) -> i64 {
+    if let (Ok(n32), Ok(d32)) = (u32::try_from(n), u32::try_from(d)) {
+        if let Some(q) = n32.checked_div(d32) {
+            return q as i64;
+        }
+    }
+    n.div_euclid(d.max(1))
 }
 
 /// A projected vertex from its position and depth bits (within range after clipping; the
@@ -296,6 +310,35 @@ impl<const S: u32> Viewport<S> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+
+    /// The 32-bit path of `floor_div` gives the 64-bit quotient, on both sides of its limits.
+    #[test]
+    fn floor_div_equals_euclidean_division() {
+        let edges = [
+            0i64,
+            1,
+            2,
+            3,
+            u32::MAX as i64 - 1,
+            u32::MAX as i64,
+            1 << 32,
+            (1 << 32) + 1,
+        ];
+        for n in edges.iter().flat_map(|&e| [e, -e, e + 7, -e - 7, e << 20]) {
+            for d in [1i64, 2, 3, 65_536, u32::MAX as i64, 1 << 32, (1 << 40) + 3] {
+                assert_eq!(floor_div(n, d), n.div_euclid(d), "{n} / {d}");
+            }
+        }
+        let mut x = 0x1F83_D9AB_FB41_BD6Bu64;
+        for _ in 0..100_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let n = (x as i64) >> (x % 40 + 1);
+            let d = ((x >> 20) % (1 << (x % 36 + 1))) as i64 + 1;
+            assert_eq!(floor_div(n, d), n.div_euclid(d), "{n} / {d}");
+        }
+    }
 
     /// An eye-space point from floats (tests of the stages around projection use it too).
     pub(crate) fn eye(x: f32, y: f32, w: f32) -> EyePoint {

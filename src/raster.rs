@@ -346,6 +346,9 @@ impl PlaneSolver {
     /// 2^32 in magnitude), returning it with `extra` more fractional bits.
     pub fn plane(&self, f: [i64; 3], extra: u32) -> Plane {
         let (d1, d2) = (f[1] - f[0], f[2] - f[0]);
+        if let Some(p) = self.plane_i64(f[0], d1, d2, extra) {
+            return p;
+        }
         // Gradient per doubled unit = num / area.
         let mut num_x = cross_diff(d1, self.e2.1, d2, self.e1.1);
         let mut num_y = cross_diff(d2, self.e1.0, d1, self.e2.0);
@@ -369,19 +372,61 @@ impl PlaneSolver {
     }
 }
 
+impl PlaneSolver {
+    /// [`PlaneSolver::plane`] in 64-bit arithmetic, `None` where an intermediate would not fit
+    /// (then the 128-bit path decides). Every step is the 128-bit path's own operation on the
+    /// same values, checked instead of widened, so a result is the same plane bit for bit; on
+    /// 32-bit cores this skips 128-bit multiplies (`__multi3`) for the ordinary triangle, whose
+    /// numerators stay below 2^63.
+    #[inline]
+    fn plane_i64(&self, f0: i64, d1: i64, d2: i64, extra: u32) -> Option<Plane> {
+        let mut num_x = cross_diff_i64(d1, self.e2.1, d2, self.e1.1)?;
+        let mut num_y = cross_diff_i64(d2, self.e1.0, d1, self.e2.0)?;
+        if self.flip {
+            num_x = -num_x;
+            num_y = -num_y;
+        }
+        let area = self.area.max(1);
+        let px = 1i64.checked_shl(self.sub_bits + 1 + extra)?;
+        let to_ref = num_x
+            .checked_mul(self.to_ref.0)?
+            .checked_add(num_y.checked_mul(self.to_ref.1)?)?;
+        let scale = 1i64.checked_shl(extra)?;
+        let value = f0
+            .checked_mul(scale)?
+            .checked_add(round_div_i64(to_ref.checked_mul(scale)?, area)?)?;
+        Some(Plane {
+            value,
+            dx: round_div_i64(num_x.checked_mul(px)?, area)?,
+            dy: round_div_i64(num_y.checked_mul(px)?, area)?,
+        })
+    }
+}
+
+/// [`cross_diff`] where every factor fits 31 bits (`None` otherwise): exact in 64 bits.
+#[inline]
+fn cross_diff_i64(a: i64, b: i64, c: i64, d: i64) -> Option<i64> {
+    const LIMIT: u64 = 1 << 30;
+    let small = |v: i64| v.unsigned_abs() < LIMIT;
+    (small(a) && small(b) && small(c) && small(d)).then(|| a * b - c * d)
+}
+
+/// [`round_div`] in 64 bits, `None` if `2·n + d` does not fit (`d >= 1`).
+#[inline]
+fn round_div_i64(n: i64, d: i64) -> Option<i64> {
+    let d = d.max(1);
+    n.checked_mul(2)?
+        .checked_add(d)?
+        .checked_div_euclid(d.checked_mul(2)?)
+}
+
 /// `a·b − c·d`, exactly. When every factor fits 31 bits the products and their difference fit
 /// 63, and 64-bit multiplies give the same result as 128-bit ones, much cheaper on 32-bit cores.
 #[inline]
 fn cross_diff(a: i64, b: i64, c: i64, d: i64) -> i128 {
-    const LIMIT: u64 = 1 << 30;
-    if a.unsigned_abs() < LIMIT
-        && b.unsigned_abs() < LIMIT
-        && c.unsigned_abs() < LIMIT
-        && d.unsigned_abs() < LIMIT
-    {
-        (a * b - c * d) as i128
-    } else {
-        a as i128 * b as i128 - c as i128 * d as i128
+    match cross_diff_i64(a, b, c, d) {
+        Some(v) => v as i128,
+        None => a as i128 * b as i128 - c as i128 * d as i128,
     }
 }
 
@@ -676,6 +721,65 @@ mod tests {
             let (a, b, c, d) = (f(next()), f(next()), f(next()), f(next()));
             assert_eq!(cross_diff(a, b, c, d), wide(a, b, c, d), "{a} {b} {c} {d}");
         }
+    }
+
+    /// `plane` (64-bit where every step fits, else 128-bit) equals the plane computed wholly in
+    /// 128 bits, for small, large and extreme triangles and values, with and without extra bits.
+    #[test]
+    fn plane_equals_the_128_bit_plane() {
+        fn wide(s: &PlaneSolver, f: [i64; 3], extra: u32) -> Plane {
+            let (d1, d2) = (f[1] as i128 - f[0] as i128, f[2] as i128 - f[0] as i128);
+            let (e1, e2) = (
+                (s.e1.0 as i128, s.e1.1 as i128),
+                (s.e2.0 as i128, s.e2.1 as i128),
+            );
+            let sign = if s.flip { -1 } else { 1 };
+            let nx = sign * (d1 * e2.1 - d2 * e1.1);
+            let ny = sign * (d2 * e1.0 - d1 * e2.0);
+            let area = s.area as i128;
+            let div = |n: i128| (2 * n + area).div_euclid(2 * area);
+            let px = 1i128 << (s.sub_bits + 1 + extra);
+            let value = ((f[0] as i128) << extra)
+                + div((nx * s.to_ref.0 as i128 + ny * s.to_ref.1 as i128) << extra);
+            let sat = |v: i128| v.clamp(i64::MIN as i128, i64::MAX as i128) as i64;
+            Plane {
+                value: value as i64,
+                dx: sat(div(nx * px)),
+                dy: sat(div(ny * px)),
+            }
+        }
+        let mut x = 0x5851_F42D_4C95_7F2Du64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut fast = 0;
+        for i in 0..20_000 {
+            // Coordinates from a pixel's worth to the guard band's ±2^22 sub-pixels.
+            let span = 1i64 << (4 + next() % 19);
+            let mut coord = || (next() % (2 * span as u64)) as i64 - span;
+            let v: [ScreenVertex<4>; 3] = core::array::from_fn(|_| ScreenVertex {
+                x: crate::project::SubPx(coord() as i32),
+                y: crate::project::SubPx(coord() as i32),
+                q: Depth::ZERO,
+                color: [I16F16::ZERO; 3],
+            });
+            let Some(s) = PlaneSolver::new(&v) else {
+                continue;
+            };
+            // Values up to 2^32 in magnitude (the documented limit), most of them depths.
+            let bits = if i % 2 == 0 { 31 } else { 1 + next() % 32 };
+            let mut value = || (next() >> (64 - bits)) as i64 - (1i64 << (bits - 1));
+            let f = [value(), value(), value()];
+            for extra in [0, DEPTH_PLANE_EXTRA_BITS] {
+                fast += s.plane_i64(f[0], f[1] - f[0], f[2] - f[0], extra).is_some() as u32;
+                assert_eq!(s.plane(f, extra), wide(&s, f, extra), "{v:?} {f:?} {extra}");
+            }
+        }
+        // Both paths were taken.
+        assert!(fast > 1000 && fast < 39_000, "{fast}");
     }
 
     /// The edge set-up (one 32-bit division, comparisons for the first row) places and steps

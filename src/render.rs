@@ -374,10 +374,8 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                         emit([a, b, d]);
                         break 'pieces false;
                     }
-                    [0, 1, 2].map(|k| ClipVertex {
-                        p: c[k].eye,
-                        color: colors[k],
-                    })
+                    // The cache keeps no eye-space points: transform again (same result).
+                    self.clip_vertices::<A>(idx, colors)
                 }
                 None => self.clip_vertices::<A>(idx, colors),
             };

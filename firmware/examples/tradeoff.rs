@@ -29,7 +29,15 @@ use scanline3d_demo as demo;
 
 /// The demo's panel workspace with room to spare: the approximate set-up of some variants moves
 /// the camera slightly, so the exact capacities `sim analyze --demo` measured may not cover it.
-type Ws<Sh, Z> = Workspace<Rgb565, Sh, 240, 240, 640, 80, 3, Z>;
+/// Built with `--cfg scanline3d_vertex_cache` (`cargo xtask speed` does both), with a vertex
+/// cache holding every demo vertex (the same pixels).
+type Ws<Sh, Z> = Workspace<Rgb565, Sh, 240, 240, 640, 80, 3, Z, CACHE>;
+
+/// Vertex cache entries of the demo workspace.
+#[cfg(not(scanline3d_vertex_cache))]
+const CACHE: usize = 0;
+#[cfg(scanline3d_vertex_cache)]
+const CACHE: usize = demo::PANEL_VERTICES;
 
 /// A new workspace: boxed on the host (a debug build would need a large main stack), on the
 /// stack on targets (no allocator; the variant's frame holds it while it renders).
@@ -49,6 +57,11 @@ struct Frame {
     #[cfg_attr(not(target_os = "none"), allow(dead_code))]
     instructions: u64,
     complete: bool,
+    /// Triangles (or clipped pieces) set up for the walk, and pixel centres covered.
+    #[cfg_attr(not(target_os = "none"), allow(dead_code))]
+    activated: u32,
+    #[cfg_attr(not(target_os = "none"), allow(dead_code))]
+    fragments: u32,
 }
 
 /// Renders one frame of `scene` into the panel model, counting its instructions.
@@ -60,8 +73,9 @@ fn frame<
     const ACT: usize,
     const I: usize,
     Z: DepthFormat,
+    const V: usize,
 >(
-    ws: &mut Workspace<Rgb565, Sh, 240, 240, T, ACT, I, Z>,
+    ws: &mut Workspace<Rgb565, Sh, 240, 240, T, ACT, I, Z, V>,
     scene: &Scene<'_>,
     options: &RenderOptions<S, FrustumClip, A>,
     count: &impl Fn() -> Counter,
@@ -74,6 +88,8 @@ fn frame<
         hash: sink.hash(),
         instructions,
         complete: stats.is_complete(),
+        activated: stats.activated,
+        fragments: stats.fragments,
     })
 }
 
@@ -251,14 +267,30 @@ mod corpus_views {
     use super::*;
     use scanline3d::scene::{Instance, Light, Transform};
 
-    #[allow(clippy::all, missing_docs)]
+    // MAX_VERTICES is used only with a vertex cache.
+    #[allow(clippy::all, missing_docs, dead_code)]
     pub mod corpus {
         include!(env!("SCANLINE3D_CORPUS"));
     }
 
-    /// A workspace for the largest corpus scene.
-    type CorpusWs<Sh, Z> =
-        Workspace<Rgb565, Sh, 240, 240, { corpus::MAX_TRIANGLES }, { corpus::MAX_ACTIVE }, 1, Z>;
+    /// A workspace for the largest corpus scene (with `--cfg scanline3d_vertex_cache`, a vertex
+    /// cache for the largest mesh).
+    type CorpusWs<Sh, Z> = Workspace<
+        Rgb565,
+        Sh,
+        240,
+        240,
+        { corpus::MAX_TRIANGLES },
+        { corpus::MAX_ACTIVE },
+        1,
+        Z,
+        CORPUS_CACHE,
+    >;
+
+    #[cfg(not(scanline3d_vertex_cache))]
+    const CORPUS_CACHE: usize = 0;
+    #[cfg(scanline3d_vertex_cache)]
+    const CORPUS_CACHE: usize = corpus::MAX_VERTICES;
 
     pub struct Views<'a, C, R> {
         pub count: &'a C,
@@ -364,8 +396,8 @@ mod firmware {
                 report: |name: &str, frame, f: Frame| {
                     complete &= f.complete;
                     println!(
-                        "variant {} frame {} hash {:08x} complete {} instructions {}",
-                        name, frame, f.hash, f.complete, f.instructions
+                        "variant {} frame {} hash {:08x} complete {} instructions {} activated {} fragments {}",
+                        name, frame, f.hash, f.complete, f.instructions, f.activated, f.fragments
                     )
                 },
             })?;
@@ -377,8 +409,8 @@ mod firmware {
                 report: |name: &str, scene: &str, view, f: Frame| {
                     complete &= f.complete;
                     println!(
-                        "corpus {} scene {} view {} hash {:08x} complete {} instructions {}",
-                        name, scene, view, f.hash, f.complete, f.instructions
+                        "corpus {} scene {} view {} hash {:08x} complete {} instructions {} activated {} fragments {}",
+                        name, scene, view, f.hash, f.complete, f.instructions, f.activated, f.fragments
                     )
                 },
             })?;

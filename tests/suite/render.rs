@@ -226,14 +226,14 @@ fn workspace_bytes_follow_the_documented_formula() {
     check_bytes! { Rgb888, Gouraud, Depth16, 2, 136, [(31, 17, 100, 3)] }
     check_bytes! { Rgb565, Gouraud<PerPixel>, Depth, 4, 200, [(240, 240, 1280, 64), (9, 3, 1, 7)] }
 
-    // The vertex cache adds 28 bytes a vertex (README), `vertex_cache_bytes` of them: exactly
+    // The vertex cache adds 8 bytes a vertex (README), `vertex_cache_bytes` of them: exactly
     // when that is a multiple of 8, else the total pads once where the sum pads twice.
-    assert_eq!(CachedVertex::BYTES, 28);
+    assert_eq!(CachedVertex::BYTES, 8);
     let plain = workspace_bytes::<Rgb565, Flat, Depth>(240, 240, 1280, 64);
     type Cached = Workspace<Rgb565, Flat, 240, 240, 1280, 64, 8, Depth, 700>;
     assert_eq!(Cached::BYTES, plain + vertex_cache_bytes(700));
     type Odd = Workspace<Rgb565, Flat, 240, 240, 1280, 64, 8, Depth, 701>;
-    let parts = documented_bytes::<Rgb565>(4, 240, 240, 1280, 64, 104) + 701 * 28;
+    let parts = documented_bytes::<Rgb565>(4, 240, 240, 1280, 64, 104) + 701 * 8;
     assert!((parts..parts + 8).contains(&Odd::BYTES), "{}", Odd::BYTES);
     assert!(Odd::BYTES <= plain + vertex_cache_bytes(701));
 }

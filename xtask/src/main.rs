@@ -15,6 +15,7 @@ mod metaball;
 mod package;
 mod peers;
 mod profile;
+mod speed;
 mod test;
 mod trace;
 mod tradeoff;
@@ -169,9 +170,14 @@ fn main() -> ExitCode {
         "tradeoff" => install()
             .and_then(|_| tradeoff::tradeoff())
             .and_then(|_| peers()),
+        "speed" => {
+            let label = std::env::args().nth(2).unwrap_or_else(|| "after".into());
+            install().and_then(|_| speed::speed(&label))
+        }
         "profile" => {
             let variant = std::env::args().nth(2).unwrap_or_else(|| "balanced".into());
-            install().and_then(|_| profile::profile(&variant))
+            let cache = std::env::args().nth(3).as_deref() == Some("cache");
+            install().and_then(|_| profile::profile(&variant, cache))
         }
         // The host renders build whole-frame workspaces (megabytes at 60,000 polygons) by value:
         // give them a thread with room for that.
@@ -192,7 +198,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | trace | metaball | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | trace | metaball | lean | package | hsr-table | peers | tradeoff | profile [VARIANT [cache]] | speed [before|after|doc] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }

@@ -55,7 +55,7 @@ pub(crate) fn peers() -> Result<(), String> {
     line(String::new());
     line("## Time per frame".into());
     line(String::new());
-    line("Ratios = the peer's time / ours, then / ours with the vertex cache, then / ours with the `Exact` preset (above 1: ours is faster). The vertex cache (`scanline3d::cache`) costs 28 bytes per vertex and changes no pixel (`sim/tests/suite/vertex_cache.rs`), so ours-cached has the accuracy of ours below. `embedded-3dgfx` draws one mesh per triangle, the only way it has to give each face its own colour as ours does; `embedded-3dgfx-1mesh` draws the whole scene as one mesh in one colour, its cheapest frame, for scale (not the same picture).".into());
+    line(format!("Ratios = the peer's time / ours, then / ours with the vertex cache, then / ours with the `Exact` preset (above 1: ours is faster). The vertex cache (`scanline3d::cache`) costs {} bytes per vertex and changes no pixel (`sim/tests/suite/vertex_cache.rs`), so ours-cached has the accuracy of ours below. `embedded-3dgfx` draws one mesh per triangle, the only way it has to give each face its own colour as ours does; `embedded-3dgfx-1mesh` draws the whole scene as one mesh in one colour, its cheapest frame, for scale (not the same picture).", scanline3d::cache::CachedVertex::BYTES));
     line(String::new());
     line(
         "| scene | ours | ours, vertex cache | ours, Exact | euc | embedded-3dgfx | embedded-3dgfx-1mesh |"

@@ -1,5 +1,5 @@
-//! `cargo xtask profile [VARIANT]`: where a trade-off variant's demo frames spend their
-//! instructions on thumbv6m. QEMU logs every translated block and every block it executes
+//! `cargo xtask profile [VARIANT [cache]]`: where a trade-off variant's demo frames spend their
+//! instructions on thumbv6m (with `cache`, rendered with a vertex cache). QEMU logs every translated block and every block it executes
 //! (`-d in_asm,exec,nochain`); the count of each block times its length gives exact
 //! instructions per block. Prints the share of compiler built-ins (64-bit multiply and divide,
 //! memcpy), the top functions, and the top source lines of this repository, with the
@@ -83,12 +83,19 @@ fn percent(n: u64, total: u64) -> f64 {
     100.0 * n as f64 / total.max(1) as f64
 }
 
-pub fn profile(variant: &str) -> Result<(), String> {
+pub fn profile(variant: &str, cache: bool) -> Result<(), String> {
     step(&format!(
-        "trade-off firmware, {variant} alone, for {TARGET}"
+        "trade-off firmware, {variant} alone{}, for {TARGET}",
+        if cache { ", vertex cache" } else { "" }
     ));
-    let cfg = format!("scanline3d_variant=\"{}\"", variant.replace([':', '-'], ""));
-    let elf = build_tradeoff(Some(TARGET), &[cfg], None)?;
+    let mut cfgs = vec![format!(
+        "scanline3d_variant=\"{}\"",
+        variant.replace([':', '-'], "")
+    )];
+    if cache {
+        cfgs.push("scanline3d_vertex_cache".into());
+    }
+    let elf = build_tradeoff(Some(TARGET), &cfgs, None)?;
     let log = root().join("target/profile-trace.log");
     step("run on QEMU, logging every executed block (a few GB, removed afterwards)");
     let out = run_on_qemu_with(
