@@ -109,6 +109,7 @@ pub mod math;
 pub mod metaball;
 pub mod method;
 pub mod options;
+pub mod patch;
 pub mod preset;
 // A pipeline stage: public only with the feature `internals` (measurement firmware, tests).
 #[cfg(feature = "internals")]
