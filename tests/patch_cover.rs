@@ -223,7 +223,7 @@ fn closed_patch_models_have_no_holes_over_random_views_and_tolerances() {
 #[test]
 fn a_full_subdivision_buffer_is_reported_and_changes_nothing_else() {
     let (points, weights) = puffy_cube(1, false);
-    let model = PatchModel::new(&points, None, PatchColors::Uniform(Rgb888::WHITE)).unwrap();
+    let model = PatchModel::new(&points, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
     let _ = weights;
     let cam = CameraSpec {
         eye: [2.5, 1.8, 3.0],

@@ -249,7 +249,7 @@ mod tests {
     #[test]
     fn points_match_the_polynomial() {
         let pts = saddle();
-        let model = PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::WHITE)).unwrap();
+        let model = PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
         let net = Net::of(&model, 0);
         for (u, v) in [(0.0, 0.0), (0.25, 0.5), (1.0, 0.75), (0.5, 1.0), (0.1, 0.9)] {
             let p = dehomogenize(net.point((u * 65536.0) as u32, (v * 65536.0) as u32));
@@ -279,7 +279,7 @@ mod tests {
     #[test]
     fn a_piece_has_the_same_surface() {
         let pts = saddle();
-        let model = PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::WHITE)).unwrap();
+        let model = PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
         let net = Net::of(&model, 0);
         let piece = net.piece([16384, 49152], [0, 32768]);
         // The piece's corner (1, 1) is the patch's (0.75, 0.5).
@@ -302,7 +302,7 @@ mod tests {
             }
         }
         let pts = [p];
-        let model = PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::WHITE)).unwrap();
+        let model = PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
         let net = Net::of(&model, 0);
         let n = net.normal(0, 0).expect("a normal at the apex");
         // Roughly along the cone's side: positive z component.
