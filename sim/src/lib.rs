@@ -25,6 +25,8 @@ pub use scanline3d_meshgen as meshgen;
 pub mod metaball;
 #[cfg(not(target_os = "none"))]
 pub mod metrics;
+#[cfg(not(target_os = "none"))]
+pub mod patch;
 #[cfg(all(not(target_os = "none"), feature = "peers"))]
 pub mod peers;
 #[cfg(not(target_os = "none"))]
