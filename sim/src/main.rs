@@ -300,6 +300,14 @@ struct RenderArgs {
     /// Which renderer.
     #[arg(long, value_enum, default_value = "fixed")]
     renderer: Renderer,
+    /// Patch scenes (.bpt), fixed renderer: flatness tolerance in pixels (screen-space
+    /// distance between the surface and its triangles, estimated from the control points).
+    #[arg(long, default_value_t = 0.5)]
+    tolerance: f64,
+    /// Patch scenes (.bpt), fixed renderer: Gouraud shading (normals from the patch
+    /// derivatives at each vertex) instead of flat.
+    #[arg(long)]
+    gouraud: bool,
 }
 
 /// How `sim metaball` renders.
@@ -676,6 +684,9 @@ fn report_empty(ids: &[i32], camera: &CameraSpec) {
 }
 
 fn render(a: RenderArgs) -> Result<(), String> {
+    if a.scene.extension().is_some_and(|e| e == "bpt") {
+        return render_patches(a);
+    }
     let (spec, loaded) = spec_from(&a.scene, &a.view)?;
     let (w, h) = a.view.size;
     let renderer = match (a.renderer, a.view.algorithm) {
@@ -718,6 +729,71 @@ fn render(a: RenderArgs) -> Result<(), String> {
     };
     report_empty(&image.ids, &spec.camera);
     loaded.file_ids(&mut image.ids);
+    write_outputs(
+        &a.out,
+        &image,
+        a.ids.as_deref(),
+        a.depth.as_deref(),
+        a.stats.as_deref(),
+        &stats_json,
+    )
+}
+
+/// `sim render MODEL.bpt`: a Bezier patch model (ids are patch indices in file order). Drawn
+/// two-sided unless `--cull`.
+fn render_patches(a: RenderArgs) -> Result<(), String> {
+    use scanline3d_sim::patch::{fixed, parse};
+    let model = parse::load(&a.scene)?;
+    let v = &a.view;
+    let camera = CameraSpec {
+        eye: v.eye,
+        target: v.target,
+        up: v.up,
+        fovy: v.fov,
+        near: v.near,
+        far: v.far,
+    };
+    camera.fixed()?;
+    let (w, h) = v.size;
+    let (image, stats_json) = match a.renderer {
+        Renderer::Fixed => {
+            let shading = if a.gouraud {
+                fixed::PatchShading::Gouraud
+            } else {
+                fixed::PatchShading::Flat
+            };
+            let light = LightSpec::default();
+            let r = fixed::render_fixed(
+                &model,
+                &camera,
+                &light,
+                (w, h),
+                a.tolerance,
+                v.faces.cull,
+                shading,
+            )?;
+            let trimmed = fixed::FixedPatches::new(&model)?.trimmed;
+            if trimmed > 0 {
+                let _ = writeln!(
+                    std::io::stderr(),
+                    "sim: {trimmed} trimmed patches drawn untrimmed: the scanline patch renderer does not trim"
+                );
+            }
+            let s = r.stats;
+            let f = s.frame;
+            let json = format!(
+                "{{\"renderer\": \"fixed\", \"patches\": {}, \"tolerance\": {}, \"width\": {w}, \"height\": {h}, \"triangles\": {}, \"patches_culled\": {}, \"pieces\": {}, \"pieces_culled\": {}, \"overflows\": {}, \"capped\": {}, \"late\": {}, \"culled\": {}, \"clipped\": {}, \"drawn\": {}, \"fragments\": {}, \"peak_active\": {}, \"dropped\": {}}}\n",
+                model.patches.len(), a.tolerance, f.triangles_in, s.patches_culled, s.pieces, s.pieces_culled, s.overflows, s.capped, s.late, f.culled, f.clipped, f.activated, f.fragments, f.peak_active, f.dropped
+            );
+            (r.image, json)
+        }
+        Renderer::Reference => {
+            return Err(
+                "the Bezier-clipping reference for .bpt scenes comes with branch patch-ref".into(),
+            )
+        }
+    };
+    report_empty(&image.ids, &camera);
     write_outputs(
         &a.out,
         &image,

@@ -154,8 +154,29 @@ impl<P: RowPixel, S: Shading, const W: usize, const H: usize, const SUBS: usize,
         tolerance: Tolerance,
         sink: &mut K,
     ) -> Result<PatchStats, RenderError<K::Error>> {
+        self.render_sized(W, H, scene, options, tolerance, sink)
+    }
+
+    /// Renders a `width × height` target (at most `W × H`; else
+    /// [`RenderError::InvalidTarget`]), as [`Self::render`] does the whole one.
+    pub fn render_sized<const SUB: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
+        &mut self,
+        width: usize,
+        height: usize,
+        scene: &PatchScene<'_>,
+        options: &RenderOptions<SUB, C, A>,
+        tolerance: Tolerance,
+        sink: &mut K,
+    ) -> Result<PatchStats, RenderError<K::Error>> {
         let camera = &scene.camera;
-        let vp = Viewport::<SUB>::new(W, H, camera.focal(), camera.near(), camera.far())
+        let (Some(depth), Some(pixels), Some(heads)) = (
+            self.depth.get_mut(..width),
+            self.pixels.get_mut(..width),
+            self.heads.get_mut(..height),
+        ) else {
+            return Err(RenderError::InvalidTarget);
+        };
+        let vp = Viewport::<SUB>::new(width, height, camera.focal(), camera.near(), camera.far())
             .ok_or(RenderError::InvalidTarget)?;
         let model = scene.model;
         let bits = model.max_abs_bits();
@@ -166,7 +187,7 @@ impl<P: RowPixel, S: Shading, const W: usize, const H: usize, const SUBS: usize,
             mv: A::Transform::prepare(mv, bits),
             lighting: Lighting::new(&scene.light, &scene.transform),
             vp,
-            heads: &mut self.heads,
+            heads,
             next: &mut self.next,
             entries: &mut self.entries,
             free: 0,
@@ -177,13 +198,13 @@ impl<P: RowPixel, S: Shading, const W: usize, const H: usize, const SUBS: usize,
             clipping: core::marker::PhantomData,
         };
         rows.file_patches()?;
-        let mut resolve = SpanZBuffer::new(&mut self.depth, &mut self.pixels, self.background);
+        let mut resolve = SpanZBuffer::new(depth, pixels, self.background);
         let frame = walk_rows::<P, S, SUB, K, _>(
-            H,
+            height,
             self.active.as_mut_view(),
             &mut rows,
             &mut resolve,
-            W as i32,
+            width as i32,
             sink,
             FrameStats::default(),
         )?;

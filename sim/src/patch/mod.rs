@@ -3,6 +3,7 @@
 //! ([`parse`]), and the reference renderer: ray tracing by Bezier clipping ([`clip`],
 //! [`render`]). `docs/patches.md` describes the format and the algorithm.
 
+pub mod fixed;
 pub mod model;
 pub mod parse;
 
