@@ -12,13 +12,16 @@
 //!
 //! A cubic's distance from its chords over `n` equal parameter steps is at most
 //! `¾·max|Δ²P|/n²` (the second differences of its control points; Filip, Magedson and Markot
-//! 1986). Edges take the smallest power of two that brings this under the tolerance; the
-//! interior splits it three ways, between the `u` and `v` terms and the twist term
-//! `3·max|Δ_uv P|/(n_u·n_v)`. The bound is exact for polynomial patches under an affine map;
+//! 1986). Edges take the smallest power of two that brings this under the tolerance. Inside,
+//! bilinear interpolation of a cell errs by at most `⅛·(h_u²·|S_uu| + h_v²·|S_vv|)` and
+//! cutting the cell along a diagonal adds `¼·h_u·h_v·|S_uv|`; with `|S_uu| ≤ 6·max|Δ_uu P|`
+//! and `|S_uv| ≤ 9·max|Δ_uv P|` the three terms are `¾·max|Δ_uu P|/n_u²`, the same in `v`,
+//! and `9/4·max|Δ_uv P|/(n_u·n_v)`, each given a third of the tolerance. The bound holds for
+//! polynomial patches under an affine map;
 //! it is applied to the projected control points, so under perspective and for rational
 //! patches it is an estimate (the measured error against the exact reference is in the
-//! repository's `docs/patches.md`). Distances are `|dx| + |dy|` in sub-pixels, which is at
-//! least the Euclidean distance.
+//! repository's `docs/patches.md`). Lengths are in sub-pixels, bounded above by
+//! `max + min/2` of `|dx|, |dy|`.
 
 use super::{MAX_LEVEL, PARAM_ONE};
 
@@ -44,11 +47,16 @@ pub(crate) struct Levels {
 /// Control point indices of the edges, in the order of [`Levels::edges`].
 const EDGES: [[usize; 4]; 4] = [[0, 4, 8, 12], [12, 13, 14, 15], [3, 7, 11, 15], [0, 1, 2, 3]];
 
-/// `|a − 2b + c|` in the `|dx| + |dy|` norm; `None` if a point is not projected.
+/// An upper bound of the length of `d`: `max + min/2` of `|dx|, |dy|` (at most 12 % over).
+fn length(d: [i64; 2]) -> i64 {
+    let (x, y) = (d[0].saturating_abs(), d[1].saturating_abs());
+    x.max(y).saturating_add(x.min(y) / 2 + 1)
+}
+
+/// `|a − 2b + c|` (bounded above by [`length`]); `None` if a point is not projected.
 fn second_difference(a: Option<[i64; 2]>, b: Option<[i64; 2]>, c: Option<[i64; 2]>) -> Option<i64> {
     let (a, b, c) = (a?, b?, c?);
-    let d = |k: usize| (a[k] - 2 * b[k] + c[k]).saturating_abs();
-    Some(d(0).saturating_add(d(1)))
+    Some(length([0, 1].map(|k| a[k] - 2 * b[k] + c[k])))
 }
 
 /// The smallest level `k` with `scale·m ≤ 4·tol·4^k`, and whether it had to stop at
@@ -102,8 +110,7 @@ pub(crate) fn levels(s: &ScreenNet, tol: i64) -> Levels {
             at(4 * (i + 1) + j)?,
             at(4 * (i + 1) + j + 1)?,
         );
-        let t = |k: usize| (d[k] - b[k] - c[k] + a[k]).saturating_abs();
-        Some(t(0).saturating_add(t(1)))
+        Some(length([0, 1].map(|k| d[k] - b[k] - c[k] + a[k])))
     }));
     // Each of the three interior terms gets a third of the tolerance: ¾·m/n² ≤ tol/3.
     let (mut u, cu) = level(along_u, 9, tol);
@@ -111,9 +118,9 @@ pub(crate) fn levels(s: &ScreenNet, tol: i64) -> Levels {
     capped |= cu || cv;
     (u, v) = (u.max(1), v.max(1));
     match twist {
-        // 3·m/(n_u·n_v) ≤ tol/3.
+        // 9/4·m/(n_u·n_v) ≤ tol/3.
         Some(m) => {
-            while m.saturating_mul(9) > tol << (u + v) {
+            while m.saturating_mul(27) > (4 * tol) << (u + v) {
                 if u.min(v) as u32 >= MAX_LEVEL {
                     capped = true;
                     break;
@@ -280,7 +287,8 @@ mod tests {
         }
         let l = levels(&s, 8);
         assert_eq!((l.u, l.v, l.edges, l.capped), (1, 1, [0; 4], false));
-        // Bend edge v = 0: P_10 moved by 64 sub-pixels: Δ² = 128, ¾·128/n² ≤ 8 needs n = 4.
+        // Bend edge v = 0: P_10 moved by 64 sub-pixels: |Δ²| = 128 (bounded by 129),
+        // ¾·129/n² ≤ 8 needs n = 4.
         s[4] = Some([100, -64]);
         let l = levels(&s, 8);
         assert_eq!(l.edges, [2, 0, 0, 0]);
