@@ -584,7 +584,29 @@ fn export_traced(scene: &std::path::Path, out: &std::path::Path) -> Result<(), S
     Ok(())
 }
 
+/// `sim export MODEL.bpt --out f.rs`: a patch model as static fixed-point data.
+fn export_patches(scene: &std::path::Path, out: &std::path::Path) -> Result<(), String> {
+    use scanline3d_sim::patch::{fixed, parse};
+    let fixed = fixed::FixedPatches::new(&parse::load(scene)?)?;
+    let source = fixed::export_source(&fixed, fixed::PATCH_COLOR, &export_command_line());
+    let source = scanline3d_sim::export::rustfmt(&source).unwrap_or(source);
+    std::fs::write(out, source).map_err(|e| format!("{}: {e}", out.display()))?;
+    say!(
+        "wrote {} ({} patches{}{})",
+        out.display(),
+        fixed.points.len(),
+        if fixed.weights.is_some() { ", rational" } else { "" },
+        if fixed.trimmed > 0 { ", trims dropped: the scanline renderer does not trim" } else { "" }
+    );
+    Ok(())
+}
+
 fn export_command(a: ExportArgs) -> Result<(), String> {
+    if let Some(scene) =
+        (a.views.scene.as_ref()).filter(|p| p.extension().is_some_and(|e| e == "bpt"))
+    {
+        return export_patches(scene, &a.out);
+    }
     if let Some(scene) =
         (a.views.scene.as_ref()).filter(|p| p.extension().is_some_and(|e| e == "scene"))
     {

@@ -12,6 +12,7 @@ mod hsr_table;
 mod install;
 mod lean;
 mod metaball;
+mod patch;
 mod package;
 mod peers;
 mod profile;
@@ -163,6 +164,7 @@ fn main() -> ExitCode {
         "trace" => install().and_then(|_| trace::trace()),
         "lean" => install().and_then(|_| lean()),
         "metaball" => install().and_then(|_| metaball::metaball()),
+        "patch" => install().and_then(|_| patch::patch()),
         "package" => install().and_then(|_| package()),
         "peers" => peers(),
         // The trade table and, in the same command, the peers (`docs/peers.md`).
@@ -192,7 +194,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | trace | metaball | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | trace | metaball | patch | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }
