@@ -383,8 +383,30 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
             .cross_product::<<A as Arithmetic>::Normals>(n.unwrap_or([0; 3]))
     }
 
-    /// Tessellates triangle `uv` of `patch` (control net `net`), clips and projects it and
-    /// hands each screen piece to `f` (pieces starting on or below `row`).
+    /// The lit flat colour of `patch` with its normal at `(u, v)` (black for Gouraud, which
+    /// colours vertices instead).
+    fn face<S: Shading>(&self, patch: u16, net: &Net, [u, v]: Uv) -> Rgb888 {
+        if S::PER_VERTEX {
+            return Rgb888::new(0, 0, 0);
+        }
+        shade(self.model.color(patch as usize), self.intensity(net.normal(u, v)))
+    }
+
+    /// The surface point at `(u, v)` in eye space, lit there for Gouraud shading.
+    fn vertex<S: Shading>(&self, patch: u16, net: &Net, [u, v]: Uv) -> ClipVertex {
+        ClipVertex {
+            p: self.eye(net.point(u, v)),
+            color: if S::PER_VERTEX {
+                let base = self.model.color(patch as usize);
+                color_channels(shade(base, self.intensity(net.normal(u, v))))
+            } else {
+                [I16F16::ZERO; 3]
+            },
+        }
+    }
+
+    /// Tessellates triangle `uv` of `patch` (control net `net`) and draws it ([`Self::draw`]),
+    /// flat-shaded with the normal at its parameter centroid.
     fn triangle<S: Shading>(
         &mut self,
         patch: u16,
@@ -393,22 +415,71 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
         row: usize,
         f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
-        self.stats.frame.triangles_in += 1;
-        let base = self.model.color(patch as usize);
-        let face = if S::PER_VERTEX {
-            Rgb888::new(0, 0, 0)
-        } else {
-            let mid = |k: usize| uv.iter().map(|p| p[k]).sum::<u32>() / 3;
-            shade(base, self.intensity(net.normal(mid(0), mid(1))))
-        };
-        let cv = uv.map(|[u, v]| ClipVertex {
-            p: self.eye(net.point(u, v)),
-            color: if S::PER_VERTEX {
-                color_channels(shade(base, self.intensity(net.normal(u, v))))
-            } else {
-                [I16F16::ZERO; 3]
+        let mid = |k: usize| uv.iter().map(|p| p[k]).sum::<u32>() / 3;
+        let face = self.face::<S>(patch, net, [mid(0), mid(1)]);
+        let cv = uv.map(|p| self.vertex::<S>(patch, net, p));
+        self.draw(patch, cv, face, row, f);
+    }
+
+    /// Draws interior cells `is × js`, each grid point evaluated once (two rows of points at a
+    /// time), each cell flat-shaded with the normal at its centre.
+    fn cells<S: Shading>(
+        &mut self,
+        patch: u16,
+        net: &Net,
+        piece: Piece,
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        const SIDE: usize = (1 << super::MAX_LEVEL) + 1;
+        let Piece { levels, is, js } = piece;
+        let at = |i: u8, j: u8| [tessellate::grid(i as u32, levels.u), tessellate::grid(j as u32, levels.v)];
+        let empty = ClipVertex {
+            p: EyePoint {
+                x: I16F16::ZERO,
+                y: I16F16::ZERO,
+                w: I16F16::ZERO,
             },
-        });
+            color: [I16F16::ZERO; 3],
+        };
+        let points = |this: &Self, j: u8, out: &mut [ClipVertex; SIDE]| {
+            for (slot, i) in out.iter_mut().zip(is[0]..=is[1]) {
+                *slot = this.vertex::<S>(patch, net, at(i, j));
+            }
+        };
+        let (mut below, mut above) = ([empty; SIDE], [empty; SIDE]);
+        points(self, js[0], &mut below);
+        for j in js[0]..js[1] {
+            points(self, j + 1, &mut above);
+            for (k, i) in (is[0]..is[1]).enumerate() {
+                let (Some(&a), Some(&b), Some(&c), Some(&d)) =
+                    (below.get(k), below.get(k + 1), above.get(k + 1), above.get(k))
+                else {
+                    break;
+                };
+                let corners = [a, b, c, d];
+                let centre = |p: [u32; 2], q: [u32; 2]| [(p[0] + q[0]) / 2, (p[1] + q[1]) / 2];
+                let face = self.face::<S>(patch, net, centre(at(i, j), at(i + 1, j + 1)));
+                for t in tessellate::CELL_TRIANGLES {
+                    let cv = t.map(|k| corners.get(k).copied().unwrap_or(a));
+                    self.draw(patch, cv, face, row, f);
+                }
+            }
+            below = above;
+        }
+    }
+
+    /// Clips and projects triangle `cv` of `patch` and hands each screen piece to `f` (pieces
+    /// starting on or below `row`).
+    fn draw(
+        &mut self,
+        patch: u16,
+        cv: [ClipVertex; 3],
+        face: Rgb888,
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        self.stats.frame.triangles_in += 1;
         let vp = self.vp;
         let project = |c: &ClipVertex| vp.project_as::<A::Projection>(&c.p, c.color, true);
         let mut emit = |s: [ScreenVertex<SUB>; 3], stats: &mut PatchStats| {
@@ -492,7 +563,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
         let Piece { levels, is, js } = piece;
         let (ni, nj) = ((is[1] - is[0]) as u32, (js[1] - js[0]) as u32);
         if ni * nj <= LEAF_CELLS {
-            tessellate::cells(&levels, is, js, |t| self.triangle::<S>(patch, net, t, row, f));
+            self.cells::<S>(patch, net, piece, row, f);
             return;
         }
         let halves = if ni >= nj {
@@ -519,7 +590,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
             };
             if !self.file(entry, first) {
                 self.stats.overflows += 1;
-                tessellate::cells(&levels, is, js, |t| self.triangle::<S>(patch, net, t, row, f));
+                self.cells::<S>(patch, net, half, row, f);
             }
         }
     }

@@ -207,15 +207,22 @@ pub(crate) fn border(l: &Levels, side: usize, mut f: impl FnMut([Uv; 3])) {
     }
 }
 
+/// The two triangles of a cell with corners `(i, j), (i+1, j), (i+1, j+1), (i, j+1)`, as
+/// indices into that list: counter-clockwise in `(u, v)`.
+pub(crate) const CELL_TRIANGLES: [[usize; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
+
 /// Calls `f` with the two triangles of each interior cell `(i, j)`, `i` in `is`, `j` in `js`
-/// (cell `(i, j)` spans grid points `i ..= i + 1` and `j ..= j + 1`).
-pub(crate) fn cells(l: &Levels, is: [u8; 2], js: [u8; 2], mut f: impl FnMut([Uv; 3])) {
+/// (cell `(i, j)` spans grid points `i ..= i + 1` and `j ..= j + 1`). The renderer walks the
+/// cells itself, sharing grid points; this is their definition in parameter space.
+#[cfg(test)]
+fn cells(l: &Levels, is: [u8; 2], js: [u8; 2], mut f: impl FnMut([Uv; 3])) {
     for i in is[0]..is[1] {
         for j in js[0]..js[1] {
             let p = |di: u8, dj: u8| [grid((i + di) as u32, l.u), grid((j + dj) as u32, l.v)];
-            let (a, b, c, d) = (p(0, 0), p(1, 0), p(1, 1), p(0, 1));
-            f([a, b, c]);
-            f([a, c, d]);
+            let corners = [p(0, 0), p(1, 0), p(1, 1), p(0, 1)];
+            for t in CELL_TRIANGLES {
+                f(t.map(|k| corners[k]));
+            }
         }
     }
 }
