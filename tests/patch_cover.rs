@@ -49,7 +49,9 @@ fn puffy_cube(n: usize, rational: bool) -> (Vec<ControlPoints>, Vec<[Weight; 16]
                     let mut w = [Weight::ONE; 16];
                     for i in 0..4 {
                         for j in 0..4 {
-                            let s = |p: usize, k: usize| -1.0 + 2.0 * (p as f64 + k as f64 / 3.0) / n as f64;
+                            let s = |p: usize, k: usize| {
+                                -1.0 + 2.0 * (p as f64 + k as f64 / 3.0) / n as f64
+                            };
                             let mut p = [0.0; 3];
                             p[axis] = sign;
                             p[ua] = s(pi, i);
@@ -69,7 +71,14 @@ fn puffy_cube(n: usize, rational: bool) -> (Vec<ControlPoints>, Vec<[Weight; 16]
 
 /// The exact (f64) surface point of a patch at `(u, v)`.
 fn surface(points: &ControlPoints, weights: &[Weight; 16], u: f64, v: f64) -> [f64; 3] {
-    let b = |t: f64| [(1.0 - t).powi(3), 3.0 * t * (1.0 - t).powi(2), 3.0 * t * t * (1.0 - t), t.powi(3)];
+    let b = |t: f64| {
+        [
+            (1.0 - t).powi(3),
+            3.0 * t * (1.0 - t).powi(2),
+            3.0 * t * t * (1.0 - t),
+            t.powi(3),
+        ]
+    };
     let (bu, bv) = (b(u), b(v));
     let mut h = [0.0; 4];
     for i in 0..4 {
@@ -85,20 +94,35 @@ fn surface(points: &ControlPoints, weights: &[Weight; 16], u: f64, v: f64) -> [f
 }
 
 /// Pixels whose centre lies in a dense f64 tessellation of the exact surface.
-fn reference_cover(cam: &CameraSpec, points: &[ControlPoints], weights: &[[Weight; 16]]) -> Vec<bool> {
+fn reference_cover(
+    cam: &CameraSpec,
+    points: &[ControlPoints],
+    weights: &[[Weight; 16]],
+) -> Vec<bool> {
     const N: usize = 24;
     let camera = cam.reference().unwrap();
     let mut cover = vec![false; W * H];
     for (p, w) in points.iter().zip(weights) {
         let grid: Vec<Option<[f64; 2]>> = (0..=N)
             .flat_map(|i| (0..=N).map(move |j| (i, j)))
-            .map(|(i, j)| camera.project(surface(p, w, i as f64 / N as f64, j as f64 / N as f64), W, H))
+            .map(|(i, j)| {
+                camera.project(
+                    surface(p, w, i as f64 / N as f64, j as f64 / N as f64),
+                    W,
+                    H,
+                )
+            })
             .collect();
         let at = |i: usize, j: usize| grid[i * (N + 1) + j];
         for i in 0..N {
             for j in 0..N {
-                for t in [[at(i, j), at(i + 1, j), at(i + 1, j + 1)], [at(i, j), at(i + 1, j + 1), at(i, j + 1)]] {
-                    let [Some(a), Some(b), Some(c)] = t else { continue };
+                for t in [
+                    [at(i, j), at(i + 1, j), at(i + 1, j + 1)],
+                    [at(i, j), at(i + 1, j + 1), at(i, j + 1)],
+                ] {
+                    let [Some(a), Some(b), Some(c)] = t else {
+                        continue;
+                    };
                     fill(&mut cover, a, b, c);
                 }
             }
@@ -109,7 +133,9 @@ fn reference_cover(cam: &CameraSpec, points: &[ControlPoints], weights: &[[Weigh
 
 /// Marks the pixel centres inside triangle `a b c` (either winding, edges included).
 fn fill(cover: &mut [bool], a: [f64; 2], b: [f64; 2], c: [f64; 2]) {
-    let e = |p: [f64; 2], q: [f64; 2], x: f64, y: f64| (q[0] - p[0]) * (y - p[1]) - (q[1] - p[1]) * (x - p[0]);
+    let e = |p: [f64; 2], q: [f64; 2], x: f64, y: f64| {
+        (q[0] - p[0]) * (y - p[1]) - (q[1] - p[1]) * (x - p[0])
+    };
     let lo = |k: usize| a[k].min(b[k]).min(c[k]).floor().max(0.0) as usize;
     let hi = |k: usize, n: usize| (a[k].max(b[k]).max(c[k]).ceil().max(0.0) as usize).min(n);
     for r in lo(1)..hi(1, H) {
@@ -173,7 +199,11 @@ fn random_view(rng: &mut Rng) -> CameraSpec {
     CameraSpec {
         eye: [d * r * a.cos(), d * z, d * r * a.sin()],
         target,
-        up: if z.abs() > 0.95 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] },
+        up: if z.abs() > 0.95 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        },
         fovy: 45.0 + 20.0 * rng.unit(),
         near: 0.1,
         far: 100.0,
@@ -193,7 +223,10 @@ fn check_cover(ids: &[i32], cover: &[bool], radius: usize, what: &str) {
             }
         }
     }
-    assert!(inside > 200, "{what}: the model should fill part of the view ({inside})");
+    assert!(
+        inside > 200,
+        "{what}: the model should fill part of the view ({inside})"
+    );
 }
 
 #[test]
@@ -202,12 +235,15 @@ fn closed_patch_models_have_no_holes_over_random_views_and_tolerances() {
     for (n, rational) in [(1, false), (2, false), (2, true)] {
         let (points, weights) = puffy_cube(n, rational);
         let w = rational.then_some(&weights[..]);
-        let model = PatchModel::new(&points, w, PatchColors::Uniform(Rgb888::new(200, 180, 90))).unwrap();
+        let model =
+            PatchModel::new(&points, w, PatchColors::Uniform(Rgb888::new(200, 180, 90))).unwrap();
         for view in 0..10 {
             let cam = random_view(&mut rng);
             let tolerance = [0.25, 0.5, 1.0, 2.0, 4.0][view % 5];
             let (ids, stats) = render::<512>(&model, &cam, tolerance);
-            let what = format!("{n}×{n} per face, rational {rational}, view {view}, tolerance {tolerance}");
+            let what = format!(
+                "{n}×{n} per face, rational {rational}, view {view}, tolerance {tolerance}"
+            );
             assert_eq!(stats.late, 0, "{what}");
             assert_eq!(stats.overflows, 0, "{what}");
             assert_eq!(stats.frame.dropped, 0, "{what}");
@@ -223,7 +259,12 @@ fn closed_patch_models_have_no_holes_over_random_views_and_tolerances() {
 #[test]
 fn a_full_subdivision_buffer_is_reported_and_changes_nothing_else() {
     let (points, weights) = puffy_cube(1, false);
-    let model = PatchModel::new(&points, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
+    let model = PatchModel::new(
+        &points,
+        None,
+        PatchColors::Uniform(Rgb888::new(255, 255, 255)),
+    )
+    .unwrap();
     let _ = weights;
     let cam = CameraSpec {
         eye: [2.5, 1.8, 3.0],
@@ -240,7 +281,10 @@ fn a_full_subdivision_buffer_is_reported_and_changes_nothing_else() {
     assert!(tight_stats.overflows > 0);
     // The same triangles are made, only earlier, so the image is the same.
     assert_eq!(tight, roomy);
-    assert_eq!(tight_stats.frame.triangles_in, roomy_stats.frame.triangles_in);
+    assert_eq!(
+        tight_stats.frame.triangles_in,
+        roomy_stats.frame.triangles_in
+    );
     assert!(tight_stats.frame.peak_active > roomy_stats.frame.peak_active);
     // Deterministic: the same frame again gives the same statistics.
     assert_eq!(render::<6>(&model, &cam, 0.25).1, tight_stats);
@@ -261,7 +305,11 @@ fn a_full_subdivision_buffer_is_reported_and_changes_nothing_else() {
     let err = ws.render(&scene, &RenderOptions::default(), Tolerance::ONE, &mut sink);
     assert!(matches!(
         err,
-        Err(scanline3d::RenderError::Capacity { needed: 6, capacity: 4, .. })
+        Err(scanline3d::RenderError::Capacity {
+            needed: 6,
+            capacity: 4,
+            ..
+        })
     ));
     assert_eq!(rows, 0);
 }

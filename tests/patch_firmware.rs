@@ -12,14 +12,19 @@ const FIRMWARE_HASHES: [u32; 3] = [0x2cffb783, 0x9ab219ae, 0xadc347f5];
 
 #[test]
 fn host_reproduces_firmware_patch_hashes() {
-    let mut ws = Box::new(PanelPatches::new(embedded_graphics::pixelcolor::Rgb565::new(0, 0, 0)));
+    let mut ws = Box::new(PanelPatches::new(
+        embedded_graphics::pixelcolor::Rgb565::new(0, 0, 0),
+    ));
     let hashes: Vec<u32> = [0, 8, 16]
         .iter()
         .map(|&frame| {
             let mut sink = HashSink::new();
             let stats = patches::render_frame(&mut ws, frame, &mut sink).unwrap();
             eprintln!("frame {frame}: {stats:?}");
-            assert!(stats.frame.pixels_written > 5000, "frame {frame}: {stats:?}");
+            assert!(
+                stats.frame.pixels_written > 5000,
+                "frame {frame}: {stats:?}"
+            );
             assert_eq!(
                 (stats.overflows, stats.late, stats.frame.dropped),
                 (0, 0, 0),

@@ -221,14 +221,10 @@ mod firmware {
             Workspace::<Rgb565, Flat, 240, 240, 640, 80, 3, Depth, 1024>::new(Rgb565::new(0, 0, 0));
         let mut metaballs = demo::metaballs::PanelCaster::new(Rgb565::new(0, 0, 0));
         let mut patches = demo::patches::PanelPatches::new(Rgb565::new(0, 0, 0));
-        let mut small_patches = scanline3d::patch::PatchWorkspace::<
-            Rgb565,
-            Gouraud<PerPixel>,
-            64,
-            48,
-            40,
-            64,
-        >::new(Rgb565::new(0, 0, 0));
+        let mut small_patches =
+            scanline3d::patch::PatchWorkspace::<Rgb565, Gouraud<PerPixel>, 64, 48, 40, 64>::new(
+                Rgb565::new(0, 0, 0),
+            );
         let instances = demo::instances();
         let mut frame = 0;
         loop {

@@ -69,7 +69,12 @@ mod firmware {
             };
             let stats = patches::render_frame(ws, frame, &mut sink)?;
             let (hash, instructions) = (sink.hash.hash(), sink.instructions);
-            *line = (hash, instructions, stats.frame.triangles_in, stats.frame.peak_active);
+            *line = (
+                hash,
+                instructions,
+                stats.frame.triangles_in,
+                stats.frame.peak_active,
+            );
         }
         let peak_stack = stack_top - measure::stack_low_water();
         for (frame, (hash, instructions, triangles, active)) in FRAMES.iter().zip(lines) {

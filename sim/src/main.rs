@@ -595,8 +595,16 @@ fn export_patches(scene: &std::path::Path, out: &std::path::Path) -> Result<(), 
         "wrote {} ({} patches{}{})",
         out.display(),
         fixed.points.len(),
-        if fixed.weights.is_some() { ", rational" } else { "" },
-        if fixed.trimmed > 0 { ", trims dropped: the scanline renderer does not trim" } else { "" }
+        if fixed.weights.is_some() {
+            ", rational"
+        } else {
+            ""
+        },
+        if fixed.trimmed > 0 {
+            ", trims dropped: the scanline renderer does not trim"
+        } else {
+            ""
+        }
     );
     Ok(())
 }

@@ -56,11 +56,23 @@ fn the_rational_sphere_matches_its_analytic_silhouette_and_depth() {
         camera([-1.5, -0.8, 2.2], [0.0, 0.2, 0.0], [0.0, 1.0, 0.0]),
     ];
     for tolerance in [2.0, 0.5] {
-        let (mut mismatches, mut worst, mut depth_err, mut triangles) = (0usize, 0.0f64, 0.0f64, 0u32);
+        let (mut mismatches, mut worst, mut depth_err, mut triangles) =
+            (0usize, 0.0f64, 0.0f64, 0u32);
         for cam in &views {
-            let r = render_fixed(&model, cam, &light, (w, h), tolerance, false, PatchShading::Flat)
-                .unwrap();
-            assert_eq!((r.stats.late, r.stats.frame.dropped, r.stats.capped), (0, 0, 0));
+            let r = render_fixed(
+                &model,
+                cam,
+                &light,
+                (w, h),
+                tolerance,
+                false,
+                PatchShading::Flat,
+            )
+            .unwrap();
+            assert_eq!(
+                (r.stats.late, r.stats.frame.dropped, r.stats.capped),
+                (0, 0, 0)
+            );
             triangles += r.stats.frame.triangles_in;
             for y in 0..h {
                 for x in 0..w {
@@ -88,7 +100,10 @@ fn the_rational_sphere_matches_its_analytic_silhouette_and_depth() {
         );
         // Mismatches only where the chords cut inside the silhouette (the tolerance) or a
         // centre is within rounding of it (one pixel covers the snap and the measure's slack).
-        assert!(worst <= tolerance + 1.0, "tolerance {tolerance}: {worst} px");
+        assert!(
+            worst <= tolerance + 1.0,
+            "tolerance {tolerance}: {worst} px"
+        );
         if tolerance <= 0.5 {
             assert!(share <= 0.005, "tolerance {tolerance}: {share}");
         }
@@ -106,7 +121,16 @@ fn gouraud_shading_follows_the_analytic_normals() {
     let (w, h) = (160, 160);
     let light = LightSpec::default();
     let cam = camera([2.0, 1.5, 2.5], [0.0; 3], [0.0, 1.0, 0.0]);
-    let r = render_fixed(&model, &cam, &light, (w, h), 0.5, false, PatchShading::Gouraud).unwrap();
+    let r = render_fixed(
+        &model,
+        &cam,
+        &light,
+        (w, h),
+        0.5,
+        false,
+        PatchShading::Gouraud,
+    )
+    .unwrap();
     let dir = {
         let d = light.direction;
         let n = dot(d, d).sqrt();
@@ -116,8 +140,13 @@ fn gouraud_shading_follows_the_analytic_normals() {
     for y in 0..h {
         for x in 0..w {
             let (hit, inside) = sphere_pixel(&cam, x, y, w, h);
-            let (Some(t), true) = (hit, inside > 2.0) else { continue };
-            let ray = cam.reference().unwrap().ray(x as f64 + 0.5, y as f64 + 0.5, w, h);
+            let (Some(t), true) = (hit, inside > 2.0) else {
+                continue;
+            };
+            let ray = cam
+                .reference()
+                .unwrap()
+                .ray(x as f64 + 0.5, y as f64 + 0.5, w, h);
             let p = [0, 1, 2].map(|k| cam.eye[k] + t * ray[k]);
             let i = light.ambient + light.diffuse * dot(p, dir).max(0.0);
             let want = PATCH_COLOR.g() as f64 * i;
@@ -157,7 +186,10 @@ fn the_teapot_renders_two_sided_without_garbage() {
                 if id >= 0 {
                     // Within the teapot's reach from the eye (it fits a ball of radius 4).
                     let far = dot(eye, eye).sqrt() + 4.0;
-                    assert!(d.is_finite() && d > 0.0 && (d as f64) < far, "view {k}: {d}");
+                    assert!(
+                        d.is_finite() && d > 0.0 && (d as f64) < far,
+                        "view {k}: {d}"
+                    );
                 } else {
                     assert!(d.is_infinite());
                 }

@@ -118,15 +118,27 @@ pub struct PatchWorkspace<
     active: Vec<ActiveTri<S::Payload<P>>, ACTIVE>,
 }
 
-impl<P: RowPixel, S: Shading, const W: usize, const H: usize, const SUBS: usize, const ACTIVE: usize>
-    PatchWorkspace<P, S, W, H, SUBS, ACTIVE>
+impl<
+        P: RowPixel,
+        S: Shading,
+        const W: usize,
+        const H: usize,
+        const SUBS: usize,
+        const ACTIVE: usize,
+    > PatchWorkspace<P, S, W, H, SUBS, ACTIVE>
 {
     /// Size of this workspace in bytes.
     pub const BYTES: usize = core::mem::size_of::<Self>();
 
     const VALID: () = {
-        assert!(W >= 1 && W <= crate::project::MAX_SCREEN, "width must be 1..=2048");
-        assert!(H >= 1 && H <= crate::project::MAX_SCREEN, "height must be 1..=2048");
+        assert!(
+            W >= 1 && W <= crate::project::MAX_SCREEN,
+            "width must be 1..=2048"
+        );
+        assert!(
+            H >= 1 && H <= crate::project::MAX_SCREEN,
+            "height must be 1..=2048"
+        );
         assert!(SUBS < NO_ENTRY as usize, "SUBS must be below 65535");
     };
 
@@ -257,7 +269,11 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
         self.heads.fill(NO_ENTRY);
         let capacity = self.next.len();
         for (k, link) in self.next.iter_mut().enumerate() {
-            *link = if k + 1 < capacity { (k + 1) as u16 } else { NO_ENTRY };
+            *link = if k + 1 < capacity {
+                (k + 1) as u16
+            } else {
+                NO_ENTRY
+            };
         }
         self.free = if capacity > 0 { 0 } else { NO_ENTRY };
         let count = self.model.points().len();
@@ -389,7 +405,10 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
         if S::PER_VERTEX {
             return Rgb888::new(0, 0, 0);
         }
-        shade(self.model.color(patch as usize), self.intensity(net.normal(u, v)))
+        shade(
+            self.model.color(patch as usize),
+            self.intensity(net.normal(u, v)),
+        )
     }
 
     /// The surface point at `(u, v)` in eye space, lit there for Gouraud shading.
@@ -433,7 +452,12 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
     ) {
         const SIDE: usize = (1 << super::MAX_LEVEL) + 1;
         let Piece { levels, is, js } = piece;
-        let at = |i: u8, j: u8| [tessellate::grid(i as u32, levels.u), tessellate::grid(j as u32, levels.v)];
+        let at = |i: u8, j: u8| {
+            [
+                tessellate::grid(i as u32, levels.u),
+                tessellate::grid(j as u32, levels.v),
+            ]
+        };
         let empty = ClipVertex {
             p: EyePoint {
                 x: I16F16::ZERO,
@@ -452,9 +476,12 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
         for j in js[0]..js[1] {
             points(self, j + 1, &mut above);
             for (k, i) in (is[0]..is[1]).enumerate() {
-                let (Some(&a), Some(&b), Some(&c), Some(&d)) =
-                    (below.get(k), below.get(k + 1), above.get(k + 1), above.get(k))
-                else {
+                let (Some(&a), Some(&b), Some(&c), Some(&d)) = (
+                    below.get(k),
+                    below.get(k + 1),
+                    above.get(k + 1),
+                    above.get(k),
+                ) else {
                     break;
                 };
                 let corners = [a, b, c, d];
@@ -540,7 +567,9 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
         let levels = tessellate::levels(&self.screen_net(&net), self.tolerance);
         self.stats.capped += levels.capped as u32;
         for side in 0..4 {
-            tessellate::border(&levels, side, |t| self.triangle::<S>(patch, &net, t, row, f));
+            tessellate::border(&levels, side, |t| {
+                self.triangle::<S>(patch, &net, t, row, f)
+            });
         }
         let (is, js) = tessellate::interior(&levels);
         if is[0] < is[1] && js[0] < js[1] {

@@ -249,7 +249,8 @@ mod tests {
     #[test]
     fn points_match_the_polynomial() {
         let pts = saddle();
-        let model = PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
+        let model =
+            PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
         let net = Net::of(&model, 0);
         for (u, v) in [(0.0, 0.0), (0.25, 0.5), (1.0, 0.75), (0.5, 1.0), (0.1, 0.9)] {
             let p = dehomogenize(net.point((u * 65536.0) as u32, (v * 65536.0) as u32));
@@ -258,7 +259,9 @@ mod tests {
             assert!((p[1].to_num::<f64>() - y).abs() < 1e-3);
             assert!((p[2].to_num::<f64>() - x * y).abs() < 1e-3);
             // Normal of z = x·y: (−y, −x, 1).
-            let n = net.normal((u * 65536.0) as u32, (v * 65536.0) as u32).unwrap();
+            let n = net
+                .normal((u * 65536.0) as u32, (v * 65536.0) as u32)
+                .unwrap();
             let len = |n: [f64; 3]| (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
             let n = n.map(|c| c as f64);
             let e = [-y, -x, 1.0];
@@ -269,7 +272,12 @@ mod tests {
 
     #[test]
     fn edges_do_not_depend_on_direction() {
-        let q = [[1000, -7, 3, 65536], [5, 99999, 17, 60000], [-3000, 4, 2, 70000], [12, 13, 14, 65536]];
+        let q = [
+            [1000, -7, 3, 65536],
+            [5, 99999, 17, 60000],
+            [-3000, 4, 2, 70000],
+            [12, 13, 14, 65536],
+        ];
         let r = [q[3], q[2], q[1], q[0]];
         for t in [0, 1, 12345, 32768, 65535, 65536] {
             assert_eq!(edge_point(q, t), edge_point(r, PARAM_ONE - t));
@@ -279,7 +287,8 @@ mod tests {
     #[test]
     fn a_piece_has_the_same_surface() {
         let pts = saddle();
-        let model = PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
+        let model =
+            PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
         let net = Net::of(&model, 0);
         let piece = net.piece([16384, 49152], [0, 32768]);
         // The piece's corner (1, 1) is the patch's (0.75, 0.5).
@@ -302,7 +311,8 @@ mod tests {
             }
         }
         let pts = [p];
-        let model = PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
+        let model =
+            PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
         let net = Net::of(&model, 0);
         let n = net.normal(0, 0).expect("a normal at the apex");
         // Roughly along the cone's side: positive z component.

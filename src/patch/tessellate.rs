@@ -45,7 +45,12 @@ pub(crate) struct Levels {
 }
 
 /// Control point indices of the edges, in the order of [`Levels::edges`].
-const EDGES: [[usize; 4]; 4] = [[0, 4, 8, 12], [12, 13, 14, 15], [3, 7, 11, 15], [0, 1, 2, 3]];
+const EDGES: [[usize; 4]; 4] = [
+    [0, 4, 8, 12],
+    [12, 13, 14, 15],
+    [3, 7, 11, 15],
+    [0, 1, 2, 3],
+];
 
 /// An upper bound of the length of `d`: `max + min/2` of `|dx|, |dy|` (at most 12 % over).
 fn length(d: [i64; 2]) -> i64 {
@@ -94,24 +99,30 @@ pub(crate) fn levels(s: &ScreenNet, tol: i64) -> Levels {
         k
     });
     let along_u = largest(
-        (0..4).flat_map(|j| (0..2).map(move |i| (i, j))).map(|(i, j)| {
-            second_difference(at(4 * i + j), at(4 * (i + 1) + j), at(4 * (i + 2) + j))
-        }),
+        (0..4)
+            .flat_map(|j| (0..2).map(move |i| (i, j)))
+            .map(|(i, j)| {
+                second_difference(at(4 * i + j), at(4 * (i + 1) + j), at(4 * (i + 2) + j))
+            }),
     );
     let along_v = largest(
-        (0..4).flat_map(|i| (0..2).map(move |j| (i, j))).map(|(i, j)| {
-            second_difference(at(4 * i + j), at(4 * i + j + 1), at(4 * i + j + 2))
-        }),
+        (0..4)
+            .flat_map(|i| (0..2).map(move |j| (i, j)))
+            .map(|(i, j)| second_difference(at(4 * i + j), at(4 * i + j + 1), at(4 * i + j + 2))),
     );
-    let twist = largest((0..3).flat_map(|i| (0..3).map(move |j| (i, j))).map(|(i, j)| {
-        let (a, b, c, d) = (
-            at(4 * i + j)?,
-            at(4 * i + j + 1)?,
-            at(4 * (i + 1) + j)?,
-            at(4 * (i + 1) + j + 1)?,
-        );
-        Some(length([0, 1].map(|k| d[k] - b[k] - c[k] + a[k])))
-    }));
+    let twist = largest(
+        (0..3)
+            .flat_map(|i| (0..3).map(move |j| (i, j)))
+            .map(|(i, j)| {
+                let (a, b, c, d) = (
+                    at(4 * i + j)?,
+                    at(4 * i + j + 1)?,
+                    at(4 * (i + 1) + j)?,
+                    at(4 * (i + 1) + j + 1)?,
+                );
+                Some(length([0, 1].map(|k| d[k] - b[k] - c[k] + a[k])))
+            }),
+    );
     // Each of the three interior terms gets a third of the tolerance: ¾·m/n² ≤ tol/3.
     let (mut u, cu) = level(along_u, 9, tol);
     let (mut v, cv) = level(along_v, 9, tol);
@@ -169,7 +180,11 @@ pub(crate) fn border(l: &Levels, side: usize, mut f: impl FnMut([Uv; 3])) {
     let e = l.edges.get(side).copied().unwrap_or(0);
     let outer_count = 1u32 << e;
     // The side runs along u (sides 0, 2) or v (1, 3); its inner grid line is one step in.
-    let (run_level, depth_level) = if side % 2 == 0 { (l.u, l.v) } else { (l.v, l.u) };
+    let (run_level, depth_level) = if side % 2 == 0 {
+        (l.u, l.v)
+    } else {
+        (l.v, l.u)
+    };
     let inner_last = (1u32 << run_level) - 1;
     let step_in = grid(1, depth_level);
     let (edge_at, inner_at) = match side {
@@ -250,7 +265,12 @@ mod tests {
         for u in 1..=4u8 {
             for v in 1..=4u8 {
                 for edges in [[0, 0, 0, 0], [3, 1, 0, 5], [6, 6, 6, 6], [2, 4, 1, 3]] {
-                    let l = Levels { u, v, edges, capped: false };
+                    let l = Levels {
+                        u,
+                        v,
+                        edges,
+                        capped: false,
+                    };
                     let mut tris = Vec::new();
                     for side in 0..4 {
                         border(&l, side, |t| tris.push(t));

@@ -29,7 +29,9 @@ pub(crate) fn patch() -> Result<(), String> {
     step("patch firmware for every target (a no-op when built)");
     build_firmware_examples("firmware", &["patch"])?;
     for (target, machine) in FIRMWARE {
-        step(&format!("patch renderer (teapot) on QEMU {machine}, {target}"));
+        step(&format!(
+            "patch renderer (teapot) on QEMU {machine}, {target}"
+        ));
         let out = run_example(target, "firmware", "patch")?;
         print!("{out}");
         let hashes = frame_hashes(&out);

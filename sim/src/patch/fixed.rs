@@ -38,7 +38,10 @@ impl FixedPatches {
     /// library's envelope ([`patch::MAX_PATCH_COORD`], [`patch::MIN_WEIGHT`]..=[`patch::MAX_WEIGHT`]).
     pub fn new(model: &PatchModel) -> Result<Self, String> {
         let limit = patch::MAX_PATCH_COORD as f64;
-        let (lo, hi) = (patch::MIN_WEIGHT.to_num::<f64>(), patch::MAX_WEIGHT.to_num::<f64>());
+        let (lo, hi) = (
+            patch::MIN_WEIGHT.to_num::<f64>(),
+            patch::MAX_WEIGHT.to_num::<f64>(),
+        );
         let mut points = Vec::with_capacity(model.patches.len());
         let mut weights = Vec::with_capacity(model.patches.len());
         for (k, p) in model.patches.iter().enumerate() {
@@ -106,7 +109,9 @@ pub fn render_fixed(
         return Err(format!("patch images are 1..={MAX_SIZE} pixels per side"));
     }
     if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 256.0) {
-        return Err(format!("tolerance {tolerance}: want a number of pixels in (0, 256)"));
+        return Err(format!(
+            "tolerance {tolerance}: want a number of pixels in (0, 256)"
+        ));
     }
     let fixed = FixedPatches::new(model)?;
     let lib = fixed.model(PatchColors::Uniform(PATCH_COLOR))?;
@@ -115,8 +120,12 @@ pub fn render_fixed(
         model: &lib,
         transform: Transform::IDENTITY,
         camera: camera.fixed()?,
-        light: Light::new(f32s(light.direction), light.ambient as f32, light.diffuse as f32)
-            .map_err(|e| format!("light: {e}"))?,
+        light: Light::new(
+            f32s(light.direction),
+            light.ambient as f32,
+            light.diffuse as f32,
+        )
+        .map_err(|e| format!("light: {e}"))?,
     };
     let tolerance = Tolerance::from_num(tolerance);
     // The workspaces are large; build them on a thread with room for that in debug builds.
@@ -195,18 +204,30 @@ pub fn export_source(fixed: &FixedPatches, color: Rgb888, command: &str) -> Stri
     s += "use embedded_graphics::pixelcolor::Rgb888;\nuse fixed::types::I16F16;\n";
     s += "use scanline3d::patch::{ControlPoints, PatchColors, PatchModel};\n\n";
     s += "const fn c(bits: i32) -> I16F16 {\n    I16F16::from_bits(bits)\n}\n\n";
-    let _ = writeln!(s, "/// Control points, 16 per patch.\npub static POINTS: [ControlPoints; {n}] = [");
+    let _ = writeln!(
+        s,
+        "/// Control points, 16 per patch.\npub static POINTS: [ControlPoints; {n}] = ["
+    );
     for p in &fixed.points {
         s += "    [\n";
         for q in p {
-            let _ = writeln!(s, "        [c({}), c({}), c({})],", q[0].to_bits(), q[1].to_bits(), q[2].to_bits());
+            let _ = writeln!(
+                s,
+                "        [c({}), c({}), c({})],",
+                q[0].to_bits(),
+                q[1].to_bits(),
+                q[2].to_bits()
+            );
         }
         s += "    ],\n";
     }
     s += "];\n\n";
     let weights = match &fixed.weights {
         Some(w) => {
-            let _ = writeln!(s, "/// Weights, 16 per patch.\npub static WEIGHTS: [[I16F16; 16]; {n}] = [");
+            let _ = writeln!(
+                s,
+                "/// Weights, 16 per patch.\npub static WEIGHTS: [[I16F16; 16]; {n}] = ["
+            );
             for p in w {
                 let bits: Vec<String> = p.iter().map(|w| format!("c({})", w.to_bits())).collect();
                 let _ = writeln!(s, "    [{}],", bits.join(", "));
