@@ -40,7 +40,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Render an OBJ scene to PNG (and optionally id, depth and statistics files).
+    /// Render an OBJ scene, or a Bezier patch model (.bpt), to PNG (and optionally id, depth
+    /// and statistics files).
     Render(RenderArgs),
     /// Compare two id/depth image pairs, or re-render a scene with both renderers and compare.
     Compare(CompareArgs),
@@ -281,7 +282,8 @@ fn method(s: &str) -> Result<Method, String> {
 
 #[derive(Args, Debug)]
 struct RenderArgs {
-    /// The OBJ scene (polygons fan-triangulated in file order).
+    /// The OBJ scene (polygons fan-triangulated in file order), or a .bpt patch model (one id
+    /// per patch in file order; the camera and size options apply).
     scene: PathBuf,
     #[command(flatten)]
     view: View,
@@ -714,7 +716,10 @@ fn report_empty(ids: &[i32], camera: &CameraSpec) {
 }
 
 fn render(a: RenderArgs) -> Result<(), String> {
-    if a.scene.extension().is_some_and(|e| e == "bpt") {
+    if a.scene
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("bpt"))
+    {
         return render_patches(a);
     }
     let (spec, loaded) = spec_from(&a.scene, &a.view)?;
@@ -769,10 +774,11 @@ fn render(a: RenderArgs) -> Result<(), String> {
     )
 }
 
-/// `sim render MODEL.bpt`: a Bezier patch model (ids are patch indices in file order). Drawn
-/// two-sided unless `--cull`.
+/// `sim render MODEL.bpt`: a Bezier patch model (docs/patches.md); ids are patch indices in
+/// file order. Only the camera and size options of `View` apply, and `--cull` to the fixed
+/// renderer (two-sided without it).
 fn render_patches(a: RenderArgs) -> Result<(), String> {
-    use scanline3d_sim::patch::{fixed, parse};
+    use scanline3d_sim::patch::{fixed, parse, render::Reference};
     let model = parse::load(&a.scene)?;
     let v = &a.view;
     let camera = CameraSpec {
@@ -818,9 +824,24 @@ fn render_patches(a: RenderArgs) -> Result<(), String> {
             (r.image, json)
         }
         Renderer::Reference => {
-            return Err(
-                "the Bezier-clipping reference for .bpt scenes comes with branch patch-ref".into(),
-            )
+            let start = std::time::Instant::now();
+            let patches = model.patches.len();
+            let reference = Reference::new(
+                model,
+                camera.reference()?,
+                LightSpec::default().reference()?,
+            );
+            let (image, s) = reference.render(w, h);
+            let json = format!(
+                "{{\"renderer\": \"reference\", \"patches\": {patches}, \"width\": {w}, \"height\": {h}, \"hits\": {}, \"clip_rounds_mean\": {:.3}, \"clip_rounds_max\": {}, \"rays_split\": {}, \"capped\": {}, \"seconds\": {:.3}}}\n",
+                s.hits,
+                s.mean_rounds(),
+                s.max_rounds,
+                s.rays_split,
+                s.capped,
+                start.elapsed().as_secs_f64()
+            );
+            (image, json)
         }
     };
     report_empty(&image.ids, &camera);

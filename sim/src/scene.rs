@@ -248,7 +248,8 @@ impl LightSpec {
         )
         .map_err(|e| e.to_string())
     }
-    fn reference(&self) -> Result<reference::Light, String> {
+    /// The light for the f64 reference (direction normalised).
+    pub fn reference(&self) -> Result<reference::Light, String> {
         let direction = reference::normalize(self.direction).ok_or("light direction is zero")?;
         Ok(reference::Light {
             direction,

@@ -3,8 +3,10 @@
 //! ([`parse`]), and the reference renderer: ray tracing by Bezier clipping ([`clip`],
 //! [`render`]). `docs/patches.md` describes the format and the algorithm.
 
+pub mod clip;
 pub mod fixed;
 pub mod model;
 pub mod parse;
+pub mod render;
 
 pub use model::{Patch, PatchModel, TrimLoop};

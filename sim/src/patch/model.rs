@@ -80,10 +80,10 @@ impl PatchModel {
     pub fn bounds(&self) -> (V3, V3) {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
-        for p in self.patches.iter().flat_map(|p| p.points.iter()) {
+        for (a, b) in self.patches.iter().map(Patch::bounds) {
             for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
+                lo[k] = lo[k].min(a[k]);
+                hi[k] = hi[k].max(b[k]);
             }
         }
         (lo, hi)
@@ -254,8 +254,8 @@ impl Patch {
         })
     }
 
-    /// The control hull's diameter along its bounding box diagonal (0 for a point patch).
-    pub fn scale(&self) -> f64 {
+    /// Axis-aligned bounds of the control points (the patch lies inside: convex hull).
+    pub fn bounds(&self) -> (V3, V3) {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         for p in &self.points {
@@ -264,6 +264,12 @@ impl Patch {
                 hi[k] = hi[k].max(p[k]);
             }
         }
+        (lo, hi)
+    }
+
+    /// The length of the control points' bounding-box diagonal (0 for a point patch).
+    pub fn scale(&self) -> f64 {
+        let (lo, hi) = self.bounds();
         (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
     }
 
