@@ -354,10 +354,9 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
         let (nx, ny) = ((d[2] - d[3]) / 2, (d[5] - d[4]) / 2);
         let cx = (self.vp.width as i64) << SUB;
         let cy = (self.vp.height as i64) << SUB;
-        Some([
-            (cx * w + 2 * nx).div_euclid(2 * w),
-            (cy * w - 2 * ny).div_euclid(2 * w),
-        ])
+        // w > near > 0 here; `checked_` keeps the render path free of panics.
+        let div = |n: i64| n.checked_div_euclid(2 * w);
+        Some([div(cx * w + 2 * nx)?, div(cy * w - 2 * ny)?])
     }
 
     /// The projected control points of `net`.
@@ -390,37 +389,55 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
         }
         // One row of margin for the rounding of evaluated points and projection.
         let row = (lo[1] >> SUB) - 1;
-        Hull::FirstRow(row.clamp(0, self.vp.height as i64 - 1) as usize)
+        Hull::FirstRow(row.min(self.vp.height as i64 - 1).max(0) as usize)
     }
 
-    /// The light's intensity for a model-space normal (ambient where there is none).
-    fn intensity(&self, n: Option<[i64; 3]>) -> fixed::types::I2F30 {
-        self.lighting
-            .cross_product::<<A as Arithmetic>::Normals>(n.unwrap_or([0; 3]))
+
+    /// The colours of a surface of `patch`'s colour with normal `n` (model space), lit on
+    /// its front and, drawn two-sided, on its back (the normal reversed).
+    fn lit(&self, patch: u16, n: Option<[i64; 3]>) -> Sides<Rgb888> {
+        let base = self.model.color(patch as usize);
+        let n = n.unwrap_or([0; 3]);
+        let front = shade(base, self.lighting.cross_product::<<A as Arithmetic>::Normals>(n));
+        let back = if self.cull {
+            front
+        } else {
+            let reversed = n.map(|c| c.saturating_neg());
+            shade(base, self.lighting.cross_product::<<A as Arithmetic>::Normals>(reversed))
+        };
+        Sides { front, back }
     }
 
-    /// The lit flat colour of `patch` with its normal at `(u, v)` (black for Gouraud, which
+    /// The flat colours of `patch` with its normal at `(u, v)` (black for Gouraud, which
     /// colours vertices instead).
-    fn face<S: Shading>(&self, patch: u16, net: &Net, [u, v]: Uv) -> Rgb888 {
+    fn face<S: Shading>(&self, patch: u16, net: &Net, [u, v]: Uv) -> Sides<Rgb888> {
         if S::PER_VERTEX {
-            return Rgb888::new(0, 0, 0);
+            let black = Rgb888::new(0, 0, 0);
+            return Sides {
+                front: black,
+                back: black,
+            };
         }
-        shade(
-            self.model.color(patch as usize),
-            self.intensity(net.normal(u, v)),
-        )
+        self.lit(patch, net.normal(u, v))
     }
 
     /// The surface point at `(u, v)` in eye space, lit there for Gouraud shading.
-    fn vertex<S: Shading>(&self, patch: u16, net: &Net, [u, v]: Uv) -> ClipVertex {
-        ClipVertex {
+    fn vertex<S: Shading>(&self, patch: u16, net: &Net, [u, v]: Uv) -> Vertex {
+        let color = if S::PER_VERTEX {
+            let lit = self.lit(patch, net.normal(u, v));
+            Sides {
+                front: color_channels(lit.front),
+                back: color_channels(lit.back),
+            }
+        } else {
+            Sides {
+                front: [I16F16::ZERO; 3],
+                back: [I16F16::ZERO; 3],
+            }
+        };
+        Vertex {
             p: self.eye(net.point(u, v)),
-            color: if S::PER_VERTEX {
-                let base = self.model.color(patch as usize);
-                color_channels(shade(base, self.intensity(net.normal(u, v))))
-            } else {
-                [I16F16::ZERO; 3]
-            },
+            color,
         }
     }
 
@@ -458,15 +475,19 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
                 tessellate::grid(j as u32, levels.v),
             ]
         };
-        let empty = ClipVertex {
+        let zero = [I16F16::ZERO; 3];
+        let empty = Vertex {
             p: EyePoint {
                 x: I16F16::ZERO,
                 y: I16F16::ZERO,
                 w: I16F16::ZERO,
             },
-            color: [I16F16::ZERO; 3],
+            color: Sides {
+                front: zero,
+                back: zero,
+            },
         };
-        let points = |this: &Self, j: u8, out: &mut [ClipVertex; SIDE]| {
+        let points = |this: &Self, j: u8, out: &mut [Vertex; SIDE]| {
             for (slot, i) in out.iter_mut().zip(is[0]..=is[1]) {
                 *slot = this.vertex::<S>(patch, net, at(i, j));
             }
@@ -496,16 +517,22 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
         }
     }
 
-    /// Clips and projects triangle `cv` of `patch` and hands each screen piece to `f` (pieces
-    /// starting on or below `row`).
+    /// Clips and projects triangle `t` of `patch` and hands each screen piece to `f` (pieces
+    /// starting on or below `row`), with the colours of the side it shows.
     fn draw(
         &mut self,
         patch: u16,
-        cv: [ClipVertex; 3],
-        face: Rgb888,
+        t: [Vertex; 3],
+        face: Sides<Rgb888>,
         row: usize,
         f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
+        let back = shows_back(&t);
+        let face = if back { face.back } else { face.front };
+        let cv = t.map(|v| ClipVertex {
+            p: v.p,
+            color: if back { v.color.back } else { v.color.front },
+        });
         self.stats.frame.triangles_in += 1;
         let vp = self.vp;
         let project = |c: &ClipVertex| vp.project_as::<A::Projection>(&c.p, c.color, true);
@@ -642,4 +669,36 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> RowPieces<SUB> for PatchRows<'_
             }
         }
     }
+}
+
+/// Something with a value for each side of the surface.
+#[derive(Clone, Copy, Debug)]
+struct Sides<T> {
+    front: T,
+    back: T,
+}
+
+/// A tessellation vertex: its eye-space point and its (Gouraud) colours for either side.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    p: EyePoint,
+    color: Sides<[I16F16; 3]>,
+}
+
+/// Whether the camera (at the eye-space origin) sees the back of triangle `t`: its normal
+/// `(b − a) × (c − a)` (in `(x, y, −w)`, counter-clockwise = front) points away from the eye.
+/// Coordinates are cut to 22 bits first, so the cross product is below 2^47 and its dot
+/// product with a point below 2^70 (`i128`).
+fn shows_back(t: &[Vertex; 3]) -> bool {
+    let v = t.map(|v| [v.p.x, v.p.y, v.p.w].map(|c| (c.to_bits() >> 8) as i64));
+    let v = v.map(|p| [p[0], p[1], -p[2]]);
+    let d = |a: [i64; 3], b: [i64; 3]| [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let (e1, e2) = (d(v[0], v[1]), d(v[0], v[2]));
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
+    let dot: i128 = (0..3).map(|k| n[k] as i128 * v[0][k] as i128).sum();
+    dot > 0
 }

@@ -221,8 +221,13 @@ pub(crate) fn dehomogenize(h: Hom) -> Vertex {
         // A polynomial patch: nothing to divide.
         return [0, 1, 2].map(|k| I16F16::from_bits(h[k] as i32));
     }
+    // Weights are below 2^21 bits and `h` below 2^32, so nothing here overflows; `checked_`
+    // keeps the render path free of panics.
     let w = w.max(1);
-    [0, 1, 2].map(|k| I16F16::from_bits(((h[k] << 17) + w).div_euclid(2 * w) as i32))
+    [0, 1, 2].map(|k| {
+        let q = ((h[k] << 17) + w).checked_div_euclid(2 * w).unwrap_or(0);
+        I16F16::from_bits(q as i32)
+    })
 }
 
 #[cfg(test)]
