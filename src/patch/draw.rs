@@ -392,18 +392,24 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
         Hull::FirstRow(row.min(self.vp.height as i64 - 1).max(0) as usize)
     }
 
-
     /// The colours of a surface of `patch`'s colour with normal `n` (model space), lit on
     /// its front and, drawn two-sided, on its back (the normal reversed).
     fn lit(&self, patch: u16, n: Option<[i64; 3]>) -> Sides<Rgb888> {
         let base = self.model.color(patch as usize);
         let n = n.unwrap_or([0; 3]);
-        let front = shade(base, self.lighting.cross_product::<<A as Arithmetic>::Normals>(n));
+        let front = shade(
+            base,
+            self.lighting.cross_product::<<A as Arithmetic>::Normals>(n),
+        );
         let back = if self.cull {
             front
         } else {
             let reversed = n.map(|c| c.saturating_neg());
-            shade(base, self.lighting.cross_product::<<A as Arithmetic>::Normals>(reversed))
+            shade(
+                base,
+                self.lighting
+                    .cross_product::<<A as Arithmetic>::Normals>(reversed),
+            )
         };
         Sides { front, back }
     }
