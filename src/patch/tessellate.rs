@@ -180,11 +180,8 @@ pub(crate) fn border(l: &Levels, side: usize, mut f: impl FnMut([Uv; 3])) {
     let e = l.edges.get(side).copied().unwrap_or(0);
     let outer_count = 1u32 << e;
     // The side runs along u (sides 0, 2) or v (1, 3); its inner grid line is one step in.
-    let (run_level, depth_level) = if side % 2 == 0 {
-        (l.u, l.v)
-    } else {
-        (l.v, l.u)
-    };
+    let along_u = matches!(side, 0 | 2);
+    let (run_level, depth_level) = if along_u { (l.u, l.v) } else { (l.v, l.u) };
     let inner_last = (1u32 << run_level) - 1;
     let step_in = grid(1, depth_level);
     let (edge_at, inner_at) = match side {
@@ -194,7 +191,7 @@ pub(crate) fn border(l: &Levels, side: usize, mut f: impl FnMut([Uv; 3])) {
         _ => (0, step_in),
     };
     let point = |run: u32, fixed: u32| -> Uv {
-        if side % 2 == 0 {
+        if along_u {
             [run, fixed]
         } else {
             [fixed, run]
@@ -289,10 +286,10 @@ mod tests {
                                 2 => pv == PARAM_ONE,
                                 _ => pu == 0,
                             };
-                            for side in 0..4 {
+                            for (side, &level) in edges.iter().enumerate() {
                                 if on(side) {
-                                    let run = if side % 2 == 0 { pu } else { pv };
-                                    let step = grid(1, edges[side]);
+                                    let run = if matches!(side, 0 | 2) { pu } else { pv };
+                                    let step = grid(1, level);
                                     assert_eq!(run % step, 0, "{l:?} side {side}");
                                 }
                             }

@@ -45,7 +45,11 @@ impl FixedPatches {
         let mut points = Vec::with_capacity(model.patches.len());
         let mut weights = Vec::with_capacity(model.patches.len());
         for (k, p) in model.patches.iter().enumerate() {
-            if p.points.iter().flatten().any(|c| !(c.abs() <= limit)) {
+            if p.points
+                .iter()
+                .flatten()
+                .any(|c| !c.is_finite() || c.abs() > limit)
+            {
                 return Err(format!(
                     "patch {k}: a coordinate is beyond ±{limit}, the fixed-point envelope"
                 ));
