@@ -257,6 +257,35 @@ fn closed_patch_models_have_no_holes_over_random_views_and_tolerances() {
 }
 
 #[test]
+fn the_exact_sphere_has_no_holes_at_its_poles_or_seams() {
+    // sim/scenes/patches/sphere.bpt: 8 rational patches, each with an edge collapsed to a pole.
+    use scanline3d_sim::patch::{fixed::FixedPatches, parse};
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("sim/scenes/patches/sphere.bpt");
+    let fixed = FixedPatches::new(&parse::load(&path).unwrap()).unwrap();
+    let weights = fixed.weights.clone().unwrap();
+    let model = fixed
+        .model(PatchColors::Uniform(Rgb888::new(200, 180, 90)))
+        .unwrap();
+    let mut rng = Rng(0x5eed_0f_5a4e_7e11);
+    for view in 0..10 {
+        let mut cam = random_view(&mut rng);
+        // The unit sphere: come closer than for the cube.
+        cam.eye = cam.eye.map(|c| c * 0.7);
+        let tolerance = [0.25, 0.5, 1.0, 2.0, 4.0][view % 5];
+        let (ids, stats) = render::<512>(&model, &cam, tolerance);
+        let what = format!("sphere, view {view}, tolerance {tolerance}");
+        assert_eq!(
+            (stats.late, stats.overflows, stats.frame.dropped),
+            (0, 0, 0),
+            "{what}"
+        );
+        let cover = reference_cover(&cam, &fixed.points, &weights);
+        check_cover(&ids, &cover, tolerance.ceil() as usize + 1, &what);
+    }
+}
+
+#[test]
 fn a_full_subdivision_buffer_is_reported_and_changes_nothing_else() {
     let (points, weights) = puffy_cube(1, false);
     let model = PatchModel::new(
