@@ -62,7 +62,8 @@
 //! [`depth`] format) or a [`resolve`] method, with [`shading`] → [`sink`]. [`options`] and
 //! [`stats`] are what a frame takes and reports; [`config`], [`method`] and [`renderer`] put
 //! them behind one call. An optional [`cache`] keeps each vertex's transform and projection
-//! for the frame, trading RAM for set-up time.
+//! for the frame, trading RAM for set-up time. [`patch`] feeds the same pipeline with
+//! Bezier patches from flash, tessellated row by row as the rows reach them.
 //!
 //! ## Rules
 //!
@@ -109,6 +110,7 @@ pub mod math;
 pub mod metaball;
 pub mod method;
 pub mod options;
+pub mod patch;
 pub mod preset;
 // A pipeline stage: public only with the feature `internals` (measurement firmware, tests).
 #[cfg(feature = "internals")]

@@ -575,9 +575,49 @@ pub(crate) fn drive<
         cull: options.cull_back_faces,
         stages: core::marker::PhantomData::<(C, A)>,
     };
-    walk_rows::<P, S, SUB, K, R>(
-        ws.heads, ws.next, ws.active, &pieces, resolve, width, sink, stats,
-    )
+    let mut rows = Buckets {
+        heads: ws.heads,
+        next: ws.next,
+        pieces: &pieces,
+    };
+    let height = ws.heads.len();
+    walk_rows::<P, S, SUB, K, R>(height, ws.active, &mut rows, resolve, width, sink, stats)
+}
+
+/// What pass 2 activates on each row: the pieces that start there (in any order that is the
+/// same from frame to frame).
+pub(crate) trait RowPieces<const SUB: u32> {
+    /// Calls `f(vertices, face colour, triangle id, sort key)` for each screen piece activated
+    /// on `row` (rows come in order, each once per frame).
+    fn each_row_piece<S: Shading>(
+        &mut self,
+        row: usize,
+        f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    );
+}
+
+/// Row buckets (heads and links of entry lists) over pieces looked up by entry.
+pub(crate) struct Buckets<'a, A> {
+    pub(crate) heads: &'a [u16],
+    pub(crate) next: &'a [u16],
+    pub(crate) pieces: &'a A,
+}
+
+impl<const SUB: u32, A: ActivePieces<SUB>> RowPieces<SUB> for Buckets<'_, A> {
+    #[inline(always)]
+    fn each_row_piece<S: Shading>(
+        &mut self,
+        row: usize,
+        mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        // Rows are below `height`, entries below the bucket capacity.
+        let mut entry = internal(self.heads.get(row).copied(), NO_ENTRY);
+        while entry != NO_ENTRY {
+            let e = entry as usize;
+            entry = internal(self.next.get(e).copied(), NO_ENTRY);
+            self.pieces.each_piece::<S>(e, &mut f);
+        }
+    }
 }
 
 /// Where pass 2 gets the pieces of a bucket entry from.
@@ -653,16 +693,14 @@ pub(crate) fn walk_rows<
     K: RowSink<P>,
     R: Resolve<P, S>,
 >(
-    heads: &[u16],
-    next: &[u16],
+    height: usize,
     active: &mut VecView<ActiveTri<S::Payload<P>, R::Key>>,
-    pieces: &impl ActivePieces<SUB>,
+    pieces: &mut impl RowPieces<SUB>,
     resolve: &mut R,
     width: i32,
     sink: &mut K,
     mut stats: FrameStats,
 ) -> Result<FrameStats, RenderError<K::Error>> {
-    let height = heads.len();
     let band = resolve.band_rows().max(1);
     active.clear();
     // Last row covered by any dropped piece so far: rows up to it are incomplete.
@@ -685,13 +723,9 @@ pub(crate) fn walk_rows<
         }
         for row in y0..y1 {
             let y = row as i32;
-            // Activate this row's bucket.
-            // Rows are below `height`, entries below the bucket capacity.
-            let mut entry = internal(heads.get(row).copied(), NO_ENTRY);
-            while entry != NO_ENTRY {
-                let e = entry as usize;
-                entry = internal(next.get(e).copied(), NO_ENTRY);
-                pieces.each_piece::<S>(e, |s, face, id, key| {
+            // Activate this row's pieces.
+            {
+                pieces.each_row_piece::<S>(row, |s, face, id, key| {
                     let (Some(walk), Some(solver)) = (
                         TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32),
                         PlaneSolver::new(&s),

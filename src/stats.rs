@@ -95,6 +95,10 @@ pub enum CapacityKind {
     /// ([`NewellWorkspace`](crate::resolve::NewellWorkspace)): list steps (outputs, moves and
     /// splits), at most [`newell::step_limit`](crate::resolve::newell::step_limit)`(PIECES)`.
     SortSteps,
+    /// Patches waiting in row buckets (`SUBS` of a
+    /// [`PatchWorkspace`](crate::patch::PatchWorkspace)): every patch whose control hull is on
+    /// screen needs one at the start of a frame.
+    Patches,
 }
 
 impl core::fmt::Display for CapacityKind {
@@ -106,6 +110,7 @@ impl core::fmt::Display for CapacityKind {
             Self::BspStack => "BSP traversal stack (STACK)",
             Self::WindowStack => "Warnock window stack (STACK)",
             Self::SortSteps => "Newell sort steps",
+            Self::Patches => "patches waiting in row buckets (SUBS)",
         })
     }
 }

@@ -323,6 +323,13 @@ impl Lighting {
             e1[2] * e2[0] - e1[0] * e2[2],
             e1[0] * e2[1] - e1[1] * e2[0],
         ];
+        self.cross_product::<N>(n)
+    }
+
+    /// Intensity of a surface whose model-space normal is the cross product `n` of two model
+    /// tangents (each component within ±2^62; any non-zero scale), with the cosine taken at
+    /// precision `N`. Mirroring needs no sign fix here: the cofactor matrix maps cross products.
+    pub fn cross_product<N: NormalPrecision>(&self, n: [i64; 3]) -> I2F30 {
         match self.normal_to_world(n) {
             Some(w) => self.intensity_of_world_normal::<N>(w),
             None => self.ambient,

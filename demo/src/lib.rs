@@ -34,6 +34,7 @@ const fn c(bits: i32) -> I16F16 {
 include!(concat!(env!("OUT_DIR"), "/demo_meshes.rs"));
 
 pub mod metaballs;
+pub mod patches;
 
 /// The hidden-surface test scenes of `sim hsr` as static meshes (`HSR_MESHES[level]`, the
 /// objects of one scene in instance order), generated from `scanline3d_meshgen::hsr_scene`.

@@ -19,7 +19,8 @@
 //! ray stack, with a stack too small for the depth limit so the overflow path is linked too,
 //! without and with a bounding-volume hierarchy (exported, and built at run time) and with a
 //! uniform grid built at run time. And it runs the fixed-point metaball ray caster
-//! (`scanline3d::metaball`).
+//! (`scanline3d::metaball`) and the scanline Bezier patch renderer (`scanline3d::patch`, flat
+//! and Gouraud, with and without culling, with a subdivision buffer that overflows).
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -219,6 +220,11 @@ mod firmware {
         let mut cached =
             Workspace::<Rgb565, Flat, 240, 240, 640, 80, 3, Depth, 1024>::new(Rgb565::new(0, 0, 0));
         let mut metaballs = demo::metaballs::PanelCaster::new(Rgb565::new(0, 0, 0));
+        let mut patches = demo::patches::PanelPatches::new(Rgb565::new(0, 0, 0));
+        let mut small_patches =
+            scanline3d::patch::PatchWorkspace::<Rgb565, Gouraud<PerPixel>, 64, 48, 40, 64>::new(
+                Rgb565::new(0, 0, 0),
+            );
         let instances = demo::instances();
         let mut frame = 0;
         loop {
@@ -251,6 +257,17 @@ mod firmware {
                     every_method::<Gouraud<PerPixel>>(&scene, &cube, &mut sink);
                     core::hint::black_box(sink.hash());
                 }
+            }
+            // The scanline Bezier patch renderer: the teapot, flat and two-sided, and Gouraud
+            // with back faces culled in a small workspace whose subdivision buffer overflows.
+            let mut sink = scanline3d::sink::HashSink::new();
+            let drawn = demo::patches::render_frame(&mut patches, black_box(frame), &mut sink);
+            core::hint::black_box((&drawn, sink.hash()));
+            if let Ok(scene) = demo::patches::scene(black_box(frame)) {
+                let options = RenderOptions::default().with_back_face_culling(true);
+                let tolerance = black_box(scanline3d::patch::Tolerance::ONE);
+                let small = small_patches.render(&scene, &options, tolerance, &mut sink);
+                core::hint::black_box((&small, sink.hash()));
             }
             // The fixed-point tracer, with room for its ray tree and with too little.
             let options = black_box(scanline3d::trace::TraceOptions::default());

@@ -302,6 +302,14 @@ struct RenderArgs {
     /// Which renderer.
     #[arg(long, value_enum, default_value = "fixed")]
     renderer: Renderer,
+    /// Patch scenes (.bpt), fixed renderer: flatness tolerance in pixels (screen-space
+    /// distance between the surface and its triangles, estimated from the control points).
+    #[arg(long, default_value_t = 0.5)]
+    tolerance: f64,
+    /// Patch scenes (.bpt), fixed renderer: Gouraud shading (normals from the patch
+    /// derivatives at each vertex) instead of flat.
+    #[arg(long)]
+    gouraud: bool,
 }
 
 /// How `sim metaball` renders.
@@ -578,7 +586,37 @@ fn export_traced(scene: &std::path::Path, out: &std::path::Path) -> Result<(), S
     Ok(())
 }
 
+/// `sim export MODEL.bpt --out f.rs`: a patch model as static fixed-point data.
+fn export_patches(scene: &std::path::Path, out: &std::path::Path) -> Result<(), String> {
+    use scanline3d_sim::patch::{fixed, parse};
+    let fixed = fixed::FixedPatches::new(&parse::load(scene)?)?;
+    let source = fixed::export_source(&fixed, fixed::PATCH_COLOR, &export_command_line());
+    let source = scanline3d_sim::export::rustfmt(&source).unwrap_or(source);
+    std::fs::write(out, source).map_err(|e| format!("{}: {e}", out.display()))?;
+    say!(
+        "wrote {} ({} patches{}{})",
+        out.display(),
+        fixed.points.len(),
+        if fixed.weights.is_some() {
+            ", rational"
+        } else {
+            ""
+        },
+        if fixed.trimmed > 0 {
+            ", trims dropped: the scanline renderer does not trim"
+        } else {
+            ""
+        }
+    );
+    Ok(())
+}
+
 fn export_command(a: ExportArgs) -> Result<(), String> {
+    if let Some(scene) =
+        (a.views.scene.as_ref()).filter(|p| p.extension().is_some_and(|e| e == "bpt"))
+    {
+        return export_patches(scene, &a.out);
+    }
     if let Some(scene) =
         (a.views.scene.as_ref()).filter(|p| p.extension().is_some_and(|e| e == "scene"))
     {
@@ -737,20 +775,54 @@ fn render(a: RenderArgs) -> Result<(), String> {
 }
 
 /// `sim render MODEL.bpt`: a Bezier patch model (docs/patches.md); ids are patch indices in
-/// file order. Only the camera and size options of `View` apply.
+/// file order. Only the camera and size options of `View` apply, and `--cull` to the fixed
+/// renderer (two-sided without it).
 fn render_patches(a: RenderArgs) -> Result<(), String> {
-    use scanline3d_sim::patch::{parse, render::Reference};
+    use scanline3d_sim::patch::{fixed, parse, render::Reference};
     let model = parse::load(&a.scene)?;
+    let v = &a.view;
     let camera = CameraSpec {
-        eye: a.view.eye,
-        target: a.view.target,
-        up: a.view.up,
-        fovy: a.view.fov,
-        near: a.view.near,
-        far: a.view.far,
+        eye: v.eye,
+        target: v.target,
+        up: v.up,
+        fovy: v.fov,
+        near: v.near,
+        far: v.far,
     };
-    let (w, h) = a.view.size;
-    let (image, json) = match a.renderer {
+    camera.fixed()?;
+    let (w, h) = v.size;
+    let (image, stats_json) = match a.renderer {
+        Renderer::Fixed => {
+            let shading = if a.gouraud {
+                fixed::PatchShading::Gouraud
+            } else {
+                fixed::PatchShading::Flat
+            };
+            let light = LightSpec::default();
+            let r = fixed::render_fixed(
+                &model,
+                &camera,
+                &light,
+                (w, h),
+                a.tolerance,
+                v.faces.cull,
+                shading,
+            )?;
+            let trimmed = fixed::FixedPatches::new(&model)?.trimmed;
+            if trimmed > 0 {
+                let _ = writeln!(
+                    std::io::stderr(),
+                    "sim: {trimmed} trimmed patches drawn untrimmed: the scanline patch renderer does not trim"
+                );
+            }
+            let s = r.stats;
+            let f = s.frame;
+            let json = format!(
+                "{{\"renderer\": \"fixed\", \"patches\": {}, \"tolerance\": {}, \"width\": {w}, \"height\": {h}, \"triangles\": {}, \"patches_culled\": {}, \"pieces\": {}, \"pieces_culled\": {}, \"overflows\": {}, \"capped\": {}, \"late\": {}, \"culled\": {}, \"clipped\": {}, \"drawn\": {}, \"fragments\": {}, \"peak_active\": {}, \"dropped\": {}}}\n",
+                model.patches.len(), a.tolerance, f.triangles_in, s.patches_culled, s.pieces, s.pieces_culled, s.overflows, s.capped, s.late, f.culled, f.clipped, f.activated, f.fragments, f.peak_active, f.dropped
+            );
+            (r.image, json)
+        }
         Renderer::Reference => {
             let start = std::time::Instant::now();
             let patches = model.patches.len();
@@ -771,12 +843,6 @@ fn render_patches(a: RenderArgs) -> Result<(), String> {
             );
             (image, json)
         }
-        Renderer::Fixed => {
-            return Err(format!(
-                "{}: the fixed-point patch renderer is not in this build; use --renderer reference",
-                a.scene.display()
-            ))
-        }
     };
     report_empty(&image.ids, &camera);
     write_outputs(
@@ -785,7 +851,7 @@ fn render_patches(a: RenderArgs) -> Result<(), String> {
         a.ids.as_deref(),
         a.depth.as_deref(),
         a.stats.as_deref(),
-        &json,
+        &stats_json,
     )
 }
 

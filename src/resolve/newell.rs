@@ -88,7 +88,7 @@
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::options::{RenderOptions, MAX_INSTANCES};
-use crate::render::{internal, viewport, walk_rows, ActiveTri, NO_ENTRY};
+use crate::render::{internal, viewport, walk_rows, ActiveTri, Buckets, NO_ENTRY};
 use crate::resolve::common::{check_sizes, render_whole_target, sort_by_key};
 use crate::resolve::depth_sort::Painter;
 use crate::resolve::store::{self, StoredPieces, StoredTriangle};
@@ -299,11 +299,16 @@ impl<
             background: self.background,
             spans: 0,
         };
-        walk_rows::<P, S, SUB_BITS, K, _>(
+        let height = heads.len();
+        let mut rows = Buckets {
             heads,
-            &self.next,
+            next: &self.next,
+            pieces: &pieces,
+        };
+        walk_rows::<P, S, SUB_BITS, K, _>(
+            height,
             self.active.as_mut_view(),
-            &pieces,
+            &mut rows,
             &mut painter,
             width as i32,
             sink,

@@ -11,6 +11,8 @@ mod hsr_scenes;
 mod metaball_firmware;
 mod module_graph;
 mod newell;
+mod patch_cover;
+mod patch_firmware;
 mod patterns;
 mod render;
 mod resolve;

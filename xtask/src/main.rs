@@ -13,6 +13,7 @@ mod install;
 mod lean;
 mod metaball;
 mod package;
+mod patch;
 mod peers;
 mod profile;
 mod speed;
@@ -164,6 +165,7 @@ fn main() -> ExitCode {
         "trace" => install().and_then(|_| trace::trace()),
         "lean" => install().and_then(|_| lean()),
         "metaball" => install().and_then(|_| metaball::metaball()),
+        "patch" => install().and_then(|_| patch::patch()),
         "package" => install().and_then(|_| package()),
         "peers" => peers(),
         // The trade table and, in the same command, the peers (`docs/peers.md`).
@@ -198,7 +200,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | trace | metaball | lean | package | hsr-table | peers | tradeoff | profile [VARIANT [cache]] | speed [before|after|doc] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | trace | metaball | patch | lean | package | hsr-table | peers | tradeoff | profile [VARIANT [cache]] | speed [before|after|doc] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }

@@ -87,12 +87,13 @@ pub(crate) fn test() -> Result<(), String> {
     step("library for every target: no_std, the panic-never link check, the firmware examples");
     build_firmware_examples(
         "firmware",
-        &["panic_never", "firmware", "trace", "metaball"],
+        &["panic_never", "firmware", "trace", "metaball", "patch"],
     )?;
     package()?;
     firmware()?;
     crate::trace::trace()?;
     crate::metaball::metaball()?;
+    crate::patch::patch()?;
     lean()?;
     fuzz_with(fuzz_build, FUZZ_SECONDS_IN_TEST)?;
     println!("\nxtask: {} passed, {} failed", totals.0, totals.1);

@@ -233,12 +233,20 @@ pub fn roots(patch: &Patch, origin: V3, dir: V3, stats: &mut ClipStats) -> Vec<R
         *e = [dot(n1, x) - h[3] * k1, dot(n2, x) - h[3] * k2];
     }
     let largest = grid.iter().flatten().fold(0.0_f64, |m, e| m.max(e.abs()));
+    let zero = ZERO * largest;
+    // Most rays that enter a patch's box pass beside the patch: the whole control net on one
+    // side of a plane through the ray. Settled here, that costs one round.
+    let one_side = |k: usize| grid.iter().all(|e| e[k] > zero) || grid.iter().all(|e| e[k] < -zero);
+    if one_side(0) || one_side(1) {
+        stats.rounds += 1;
+        return Vec::new();
+    }
     let mut found = Vec::new();
     let mut stack = vec![Region {
         grid,
         u: (0.0, 1.0),
         v: (0.0, 1.0),
-        zero: ZERO * largest,
+        zero,
     }];
     let dd = dot(dir, dir);
     'regions: while let Some(mut r) = stack.pop() {

@@ -4,6 +4,7 @@
 //! [`render`]). `docs/patches.md` describes the format and the algorithm.
 
 pub mod clip;
+pub mod fixed;
 pub mod model;
 pub mod parse;
 pub mod render;

@@ -1,0 +1,710 @@
+//! The patch renderer: patches filed under their first row, tessellated and split as the rows
+//! come, their triangles walked by the span z-buffer.
+//!
+//! # Memory (bytes)
+//!
+//! `4·W` depth row + `size_of::<P>()·W` pixels + `2·H` bucket heads + `SUBS · 8` for patches
+//! and pieces waiting in buckets + `ACTIVE ·` an active triangle (about 100 for flat shading).
+//! See [`PatchWorkspace::BYTES`].
+
+use super::eval::{dehomogenize, Net};
+use super::tessellate::{self, Levels, ScreenNet, Uv};
+use super::{PatchModel, Tolerance};
+use crate::arithmetic::Arithmetic;
+use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping};
+use crate::depth::Depth;
+use crate::options::RenderOptions;
+use crate::project::{ScreenVertex, Viewport};
+use crate::raster::{color_channels, first_row, signed_area, xy, TriangleWalk};
+use crate::render::{walk_rows, ActiveTri, RowPieces, NO_ENTRY};
+use crate::scene::{Camera, Light, Transform};
+use crate::shading::Shading;
+use crate::sink::{RowPixel, RowSink};
+use crate::stats::{CapacityKind, FrameStats, RenderError};
+use crate::vertex::{shade, EyePoint, Lighting, ModelView, TransformPrecision};
+use crate::workspace::SpanZBuffer;
+use embedded_graphics::pixelcolor::Rgb888;
+use fixed::types::I16F16;
+use heapless::Vec;
+
+/// A patch model placed in the world and seen by a camera.
+#[derive(Clone, Copy, Debug)]
+pub struct PatchScene<'a> {
+    /// The patches.
+    pub model: &'a PatchModel<'a>,
+    /// Model to world.
+    pub transform: Transform,
+    /// The camera.
+    pub camera: Camera,
+    /// The light.
+    pub light: Light,
+}
+
+/// What one patch frame did: the triangle pipeline's [`FrameStats`] (its `triangles_in` are
+/// the triangles tessellation made) and the patch stages' counts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PatchStats {
+    /// The triangle pipeline's statistics.
+    pub frame: FrameStats,
+    /// Patches whose control hull is off screen, behind the near plane or beyond the far
+    /// plane: never tessellated.
+    pub patches_culled: u32,
+    /// Interior pieces taken from the row buckets (each patch's whole interior counts one).
+    pub pieces: u32,
+    /// Interior pieces dropped because their control hull is off screen.
+    pub pieces_culled: u32,
+    /// Splits not made because `SUBS` was full: that piece was tessellated at once, so its
+    /// triangles wait on the active list longer (the image is the same unless `ACTIVE`
+    /// overflows too, which `frame.dropped` reports).
+    pub overflows: u32,
+    /// Patches drawn coarser than the tolerance asks: some level reached
+    /// [`MAX_LEVEL`](super::MAX_LEVEL), or a control point was not in front of the near plane
+    /// (drawn at the finest level).
+    pub capped: u32,
+    /// Triangles that began above the row that made them (the rows above were lost). The
+    /// control-hull bound makes this 0; it is counted so a test can hold it to that.
+    pub late: u32,
+}
+
+/// A patch or a piece of its interior waiting in a row bucket.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Entry {
+    patch: u16,
+    /// `None`: the whole patch, not tessellated yet. `Some`: interior cells `is × js` of a
+    /// patch tessellated at `levels` (`u`, `v`).
+    piece: Option<Piece>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Piece {
+    levels: Levels,
+    is: [u8; 2],
+    js: [u8; 2],
+}
+
+const EMPTY: Entry = Entry {
+    patch: 0,
+    piece: None,
+};
+
+/// Pieces of at most this many cells are tessellated, not split further: a split costs a
+/// control-hull bound (32 blossoms, 16 transforms), about as much as a few triangles.
+const LEAF_CELLS: u32 = 4;
+
+/// All the memory a patch render needs, sized at compile time.
+///
+/// * `P`, `S`: pixel type and shading, as for [`Workspace`](crate::Workspace);
+/// * `W × H`: the target size (1..=2048 each);
+/// * `SUBS`: patches and interior pieces that may wait in row buckets at once: at least the
+///   patches on screen (else [`RenderError::Capacity`] before any row is sent); beyond that,
+///   more room lets pieces be split finer so their triangles are made nearer their rows.
+///   When full, a piece is tessellated whole and [`PatchStats::overflows`] counts it;
+/// * `ACTIVE`: triangles that may be on the active list at once (more are dropped and
+///   reported, as for meshes).
+pub struct PatchWorkspace<
+    P: RowPixel,
+    S: Shading,
+    const W: usize,
+    const H: usize,
+    const SUBS: usize = 256,
+    const ACTIVE: usize = 256,
+> {
+    depth: [Depth; W],
+    pixels: [P; W],
+    background: P,
+    heads: [u16; H],
+    next: [u16; SUBS],
+    entries: [Entry; SUBS],
+    active: Vec<ActiveTri<S::Payload<P>>, ACTIVE>,
+}
+
+impl<
+        P: RowPixel,
+        S: Shading,
+        const W: usize,
+        const H: usize,
+        const SUBS: usize,
+        const ACTIVE: usize,
+    > PatchWorkspace<P, S, W, H, SUBS, ACTIVE>
+{
+    /// Size of this workspace in bytes.
+    pub const BYTES: usize = core::mem::size_of::<Self>();
+
+    const VALID: () = {
+        assert!(
+            W >= 1 && W <= crate::project::MAX_SCREEN,
+            "width must be 1..=2048"
+        );
+        assert!(
+            H >= 1 && H <= crate::project::MAX_SCREEN,
+            "height must be 1..=2048"
+        );
+        assert!(SUBS < NO_ENTRY as usize, "SUBS must be below 65535");
+    };
+
+    /// An empty workspace whose background pixels are `background`.
+    pub const fn new(background: P) -> Self {
+        #[allow(clippy::let_unit_value)]
+        let () = Self::VALID;
+        PatchWorkspace {
+            depth: [Depth::ZERO; W],
+            pixels: [background; W],
+            background,
+            heads: [NO_ENTRY; H],
+            next: [NO_ENTRY; SUBS],
+            entries: [EMPTY; SUBS],
+            active: Vec::new(),
+        }
+    }
+
+    /// Renders `scene` with flatness `tolerance` (pixels; below one sub-pixel counts as one),
+    /// handing each of the `H` rows to `sink` once, top to bottom.
+    pub fn render<const SUB: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
+        &mut self,
+        scene: &PatchScene<'_>,
+        options: &RenderOptions<SUB, C, A>,
+        tolerance: Tolerance,
+        sink: &mut K,
+    ) -> Result<PatchStats, RenderError<K::Error>> {
+        self.render_sized(W, H, scene, options, tolerance, sink)
+    }
+
+    /// Renders a `width × height` target (at most `W × H`; else
+    /// [`RenderError::InvalidTarget`]), as [`Self::render`] does the whole one.
+    pub fn render_sized<const SUB: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
+        &mut self,
+        width: usize,
+        height: usize,
+        scene: &PatchScene<'_>,
+        options: &RenderOptions<SUB, C, A>,
+        tolerance: Tolerance,
+        sink: &mut K,
+    ) -> Result<PatchStats, RenderError<K::Error>> {
+        let camera = &scene.camera;
+        let (Some(depth), Some(pixels), Some(heads)) = (
+            self.depth.get_mut(..width),
+            self.pixels.get_mut(..width),
+            self.heads.get_mut(..height),
+        ) else {
+            return Err(RenderError::InvalidTarget);
+        };
+        let vp = Viewport::<SUB>::new(width, height, camera.focal(), camera.near(), camera.far())
+            .ok_or(RenderError::InvalidTarget)?;
+        let model = scene.model;
+        let bits = model.max_abs_bits();
+        let mv = ModelView::new(&scene.transform, &camera.view().world_to_eye, bits)
+            .map_err(|error| RenderError::Transform { instance: 0, error })?;
+        let mut rows = PatchRows::<SUB, C, A> {
+            model,
+            mv: A::Transform::prepare(mv, bits),
+            lighting: Lighting::new(&scene.light, &scene.transform),
+            vp,
+            heads,
+            next: &mut self.next,
+            entries: &mut self.entries,
+            free: 0,
+            tolerance: ((tolerance.to_bits() as i64) << SUB >> 8).max(1),
+            cull: options.cull_back_faces,
+            polygon: ClipPolygon::new(),
+            stats: PatchStats::default(),
+            clipping: core::marker::PhantomData,
+        };
+        rows.file_patches()?;
+        let mut resolve = SpanZBuffer::new(depth, pixels, self.background);
+        let frame = walk_rows::<P, S, SUB, K, _>(
+            height,
+            self.active.as_mut_view(),
+            &mut rows,
+            &mut resolve,
+            width as i32,
+            sink,
+            FrameStats::default(),
+        )?;
+        let mut stats = rows.stats;
+        let counts = stats.frame;
+        stats.frame = FrameStats {
+            triangles_in: counts.triangles_in,
+            culled: counts.culled,
+            clipped: counts.clipped,
+            rejected: counts.rejected,
+            unclipped: counts.unclipped,
+            bucketed: counts.bucketed,
+            ..frame
+        };
+        Ok(stats)
+    }
+}
+
+/// Where a control hull lies.
+enum Hull {
+    /// Off screen, behind the near plane or beyond the far plane.
+    Culled,
+    /// No triangle of the surface inside starts above this row.
+    FirstRow(usize),
+}
+
+/// The frame's patch state: what pass 2 activates row by row.
+struct PatchRows<'a, 'm, const SUB: u32, C, A: Arithmetic> {
+    model: &'m PatchModel<'m>,
+    mv: <A::Transform as TransformPrecision>::Matrix,
+    lighting: Lighting,
+    vp: Viewport<SUB>,
+    heads: &'a mut [u16],
+    next: &'a mut [u16],
+    entries: &'a mut [Entry],
+    /// Head of the free-entry list (threaded through `next`).
+    free: u16,
+    /// Flatness tolerance in sub-pixels.
+    tolerance: i64,
+    cull: bool,
+    polygon: ClipPolygon,
+    stats: PatchStats,
+    clipping: core::marker::PhantomData<C>,
+}
+
+impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
+    /// Pass 1: every patch whose control hull is on screen goes into the bucket of the hull's
+    /// first row, in reverse order so each bucket lists patches in ascending order.
+    fn file_patches<E>(&mut self) -> Result<(), RenderError<E>> {
+        self.heads.fill(NO_ENTRY);
+        let capacity = self.next.len();
+        for (k, link) in self.next.iter_mut().enumerate() {
+            *link = if k + 1 < capacity {
+                (k + 1) as u16
+            } else {
+                NO_ENTRY
+            };
+        }
+        self.free = if capacity > 0 { 0 } else { NO_ENTRY };
+        let count = self.model.points().len();
+        let mut needed = 0;
+        for patch in (0..count).rev() {
+            match self.hull(&Net::of(self.model, patch)) {
+                Hull::Culled => self.stats.patches_culled += 1,
+                Hull::FirstRow(row) => {
+                    needed += 1;
+                    let entry = Entry {
+                        // Below MAX_PATCHES, checked by PatchModel::new.
+                        patch: patch as u16,
+                        piece: None,
+                    };
+                    // Filing fails only when full; the error below reports it.
+                    let _ = self.file(entry, row);
+                }
+            }
+        }
+        if needed > capacity {
+            return Err(RenderError::Capacity {
+                what: CapacityKind::Patches,
+                needed,
+                capacity,
+            });
+        }
+        Ok(())
+    }
+
+    /// Puts `entry` in `row`'s bucket; `false` if no entry is free.
+    fn file(&mut self, entry: Entry, row: usize) -> bool {
+        let slot = self.free;
+        let (Some(e), Some(link), Some(head)) = (
+            self.entries.get_mut(slot as usize),
+            self.next.get_mut(slot as usize),
+            self.heads.get_mut(row),
+        ) else {
+            return false;
+        };
+        *e = entry;
+        self.free = *link;
+        *link = *head;
+        *head = slot;
+        true
+    }
+
+    /// Takes the first entry of `row`'s bucket, freeing its slot.
+    fn take(&mut self, row: usize) -> Option<Entry> {
+        let head = self.heads.get_mut(row)?;
+        let slot = *head;
+        let (Some(&entry), Some(link)) = (
+            self.entries.get(slot as usize),
+            self.next.get_mut(slot as usize),
+        ) else {
+            return None;
+        };
+        *head = *link;
+        *link = self.free;
+        self.free = slot;
+        Some(entry)
+    }
+
+    /// A model point in eye space.
+    #[inline]
+    fn eye(&self, h: super::eval::Hom) -> EyePoint {
+        A::Transform::apply(&self.mv, &dehomogenize(h))
+    }
+
+    /// Screen position (sub-pixels, unrounded range) of an eye point in front of the near
+    /// plane; `None` otherwise.
+    fn screen(&self, p: &EyePoint) -> Option<[i64; 2]> {
+        let d = self.vp.clip_distances(p);
+        if d[0] <= 0 {
+            return None;
+        }
+        let w = p.w.to_bits() as i64;
+        // The guard planes are g·w ± n: their difference gives n = ax·x (or ay·y) exactly.
+        let (nx, ny) = ((d[2] - d[3]) / 2, (d[5] - d[4]) / 2);
+        let cx = (self.vp.width as i64) << SUB;
+        let cy = (self.vp.height as i64) << SUB;
+        // w > near > 0 here; `checked_` keeps the render path free of panics.
+        let div = |n: i64| n.checked_div_euclid(2 * w);
+        Some([div(cx * w + 2 * nx)?, div(cy * w - 2 * ny)?])
+    }
+
+    /// The projected control points of `net`.
+    fn screen_net(&self, net: &Net) -> ScreenNet {
+        net.h.map(|h| self.screen(&self.eye(h)))
+    }
+
+    /// Where the control hull of `net` lies (the surface is inside it: positive weights).
+    fn hull(&self, net: &Net) -> Hull {
+        let eye = net.h.map(|h| self.eye(h));
+        let (near, far) = (self.vp.near, self.vp.far);
+        if eye.iter().all(|p| p.w < near) || eye.iter().all(|p| p.w > far) {
+            return Hull::Culled;
+        }
+        let mut lo = [i64::MAX; 2];
+        let mut hi = [i64::MIN; 2];
+        for p in &eye {
+            let Some(s) = self.screen(p) else {
+                // Crossing the near plane: no screen bound, so from the top.
+                return Hull::FirstRow(0);
+            };
+            for k in 0..2 {
+                lo[k] = lo[k].min(s[k]);
+                hi[k] = hi[k].max(s[k]);
+            }
+        }
+        let size = [self.vp.width as i64, self.vp.height as i64].map(|n| n << SUB);
+        if hi[0] < 0 || hi[1] < 0 || lo[0] > size[0] || lo[1] > size[1] {
+            return Hull::Culled;
+        }
+        // One row of margin for the rounding of evaluated points and projection.
+        let row = (lo[1] >> SUB) - 1;
+        Hull::FirstRow(row.min(self.vp.height as i64 - 1).max(0) as usize)
+    }
+
+    /// The colours of a surface of `patch`'s colour with normal `n` (model space), lit on
+    /// its front and, drawn two-sided, on its back (the normal reversed).
+    fn lit(&self, patch: u16, n: Option<[i64; 3]>) -> Sides<Rgb888> {
+        let base = self.model.color(patch as usize);
+        let n = n.unwrap_or([0; 3]);
+        let front = shade(
+            base,
+            self.lighting.cross_product::<<A as Arithmetic>::Normals>(n),
+        );
+        let back = if self.cull {
+            front
+        } else {
+            let reversed = n.map(|c| c.saturating_neg());
+            shade(
+                base,
+                self.lighting
+                    .cross_product::<<A as Arithmetic>::Normals>(reversed),
+            )
+        };
+        Sides { front, back }
+    }
+
+    /// The flat colours of `patch` with its normal at `(u, v)` (black for Gouraud, which
+    /// colours vertices instead).
+    fn face<S: Shading>(&self, patch: u16, net: &Net, [u, v]: Uv) -> Sides<Rgb888> {
+        if S::PER_VERTEX {
+            let black = Rgb888::new(0, 0, 0);
+            return Sides {
+                front: black,
+                back: black,
+            };
+        }
+        self.lit(patch, net.normal(u, v))
+    }
+
+    /// The surface point at `(u, v)` in eye space, lit there for Gouraud shading.
+    fn vertex<S: Shading>(&self, patch: u16, net: &Net, [u, v]: Uv) -> Vertex {
+        let color = if S::PER_VERTEX {
+            let lit = self.lit(patch, net.normal(u, v));
+            Sides {
+                front: color_channels(lit.front),
+                back: color_channels(lit.back),
+            }
+        } else {
+            Sides {
+                front: [I16F16::ZERO; 3],
+                back: [I16F16::ZERO; 3],
+            }
+        };
+        Vertex {
+            p: self.eye(net.point(u, v)),
+            color,
+        }
+    }
+
+    /// Tessellates triangle `uv` of `patch` (control net `net`) and draws it ([`Self::draw`]),
+    /// flat-shaded with the normal at its parameter centroid.
+    fn triangle<S: Shading>(
+        &mut self,
+        patch: u16,
+        net: &Net,
+        uv: [Uv; 3],
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        let mid = |k: usize| uv.iter().map(|p| p[k]).sum::<u32>() / 3;
+        let face = self.face::<S>(patch, net, [mid(0), mid(1)]);
+        let cv = uv.map(|p| self.vertex::<S>(patch, net, p));
+        self.draw(patch, cv, face, row, f);
+    }
+
+    /// Draws interior cells `is × js`, each grid point evaluated once (two rows of points at a
+    /// time), each cell flat-shaded with the normal at its centre.
+    fn cells<S: Shading>(
+        &mut self,
+        patch: u16,
+        net: &Net,
+        piece: Piece,
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        const SIDE: usize = (1 << super::MAX_LEVEL) + 1;
+        let Piece { levels, is, js } = piece;
+        let at = |i: u8, j: u8| {
+            [
+                tessellate::grid(i as u32, levels.u),
+                tessellate::grid(j as u32, levels.v),
+            ]
+        };
+        let zero = [I16F16::ZERO; 3];
+        let empty = Vertex {
+            p: EyePoint {
+                x: I16F16::ZERO,
+                y: I16F16::ZERO,
+                w: I16F16::ZERO,
+            },
+            color: Sides {
+                front: zero,
+                back: zero,
+            },
+        };
+        let points = |this: &Self, j: u8, out: &mut [Vertex; SIDE]| {
+            for (slot, i) in out.iter_mut().zip(is[0]..=is[1]) {
+                *slot = this.vertex::<S>(patch, net, at(i, j));
+            }
+        };
+        let (mut below, mut above) = ([empty; SIDE], [empty; SIDE]);
+        points(self, js[0], &mut below);
+        for j in js[0]..js[1] {
+            points(self, j + 1, &mut above);
+            for (k, i) in (is[0]..is[1]).enumerate() {
+                let (Some(&a), Some(&b), Some(&c), Some(&d)) = (
+                    below.get(k),
+                    below.get(k + 1),
+                    above.get(k + 1),
+                    above.get(k),
+                ) else {
+                    break;
+                };
+                let corners = [a, b, c, d];
+                let centre = |p: [u32; 2], q: [u32; 2]| [(p[0] + q[0]) / 2, (p[1] + q[1]) / 2];
+                let face = self.face::<S>(patch, net, centre(at(i, j), at(i + 1, j + 1)));
+                for t in tessellate::CELL_TRIANGLES {
+                    let cv = t.map(|k| corners.get(k).copied().unwrap_or(a));
+                    self.draw(patch, cv, face, row, f);
+                }
+            }
+            below = above;
+        }
+    }
+
+    /// Clips and projects triangle `t` of `patch` and hands each screen piece to `f` (pieces
+    /// starting on or below `row`), with the colours of the side it shows.
+    fn draw(
+        &mut self,
+        patch: u16,
+        t: [Vertex; 3],
+        face: Sides<Rgb888>,
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        let back = shows_back(&t);
+        let face = if back { face.back } else { face.front };
+        let cv = t.map(|v| ClipVertex {
+            p: v.p,
+            color: if back { v.color.back } else { v.color.front },
+        });
+        self.stats.frame.triangles_in += 1;
+        let vp = self.vp;
+        let project = |c: &ClipVertex| vp.project_as::<A::Projection>(&c.p, c.color, true);
+        let mut emit = |s: [ScreenVertex<SUB>; 3], stats: &mut PatchStats| {
+            let area = signed_area(&s);
+            // Front faces have negative area in y-down screen coordinates.
+            if area == 0 {
+                return;
+            }
+            if self.cull && area > 0 {
+                stats.frame.culled += 1;
+                return;
+            }
+            let (w, h) = (vp.width as i32, vp.height as i32);
+            let Some(first) = first_row(&s, w, h) else {
+                return;
+            };
+            if (first as usize) < row {
+                stats.late += 1;
+                if TriangleWalk::new::<SUB>(s.each_ref().map(xy), row as i32, h).is_none() {
+                    return;
+                }
+            }
+            stats.frame.bucketed += 1;
+            f(s, face, patch as u32, 0);
+        };
+        let mut stats = self.stats;
+        match C::clip(&vp, &cv, &mut self.polygon) {
+            Clipped::Outside => stats.frame.rejected += 1,
+            Clipped::Skipped => stats.frame.unclipped += 1,
+            Clipped::Inside => {
+                if let [Some(a), Some(b), Some(c)] = cv.each_ref().map(project) {
+                    emit([a, b, c], &mut stats);
+                }
+            }
+            Clipped::Polygon => {
+                stats.frame.clipped += 1;
+                let mut fan = self.polygon.iter().filter_map(project);
+                if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
+                    for c in fan {
+                        emit([a, b, c], &mut stats);
+                        b = c;
+                    }
+                }
+            }
+        }
+        self.stats = stats;
+    }
+
+    /// A whole patch's first row has come: tessellate its boundary ring now and hand its
+    /// interior on as a piece.
+    fn patch<S: Shading>(
+        &mut self,
+        patch: u16,
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        let net = Net::of(self.model, patch as usize);
+        let levels = tessellate::levels(&self.screen_net(&net), self.tolerance);
+        self.stats.capped += levels.capped as u32;
+        for side in 0..4 {
+            tessellate::border(&levels, side, |t| {
+                self.triangle::<S>(patch, &net, t, row, f)
+            });
+        }
+        let (is, js) = tessellate::interior(&levels);
+        if is[0] < is[1] && js[0] < js[1] {
+            self.piece::<S>(patch, &net, Piece { levels, is, js }, row, f);
+        }
+    }
+
+    /// An interior piece whose row has come: tessellate it if small, else split it in two
+    /// and file each half under its own control hull's first row (this row if it starts
+    /// here).
+    fn piece<S: Shading>(
+        &mut self,
+        patch: u16,
+        net: &Net,
+        piece: Piece,
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        self.stats.pieces += 1;
+        let Piece { levels, is, js } = piece;
+        let (ni, nj) = ((is[1] - is[0]) as u32, (js[1] - js[0]) as u32);
+        if ni * nj <= LEAF_CELLS {
+            self.cells::<S>(patch, net, piece, row, f);
+            return;
+        }
+        let halves = if ni >= nj {
+            let mid = is[0] + (ni / 2) as u8;
+            [([is[0], mid], js), ([mid, is[1]], js)]
+        } else {
+            let mid = js[0] + (nj / 2) as u8;
+            [(is, [js[0], mid]), (is, [mid, js[1]])]
+        };
+        for (is, js) in halves {
+            let half = Piece { levels, is, js };
+            let range = |r: [u8; 2], level: u8| r.map(|k| tessellate::grid(k as u32, level));
+            let hull = self.hull(&net.piece(range(is, levels.u), range(js, levels.v)));
+            let first = match hull {
+                Hull::Culled => {
+                    self.stats.pieces_culled += 1;
+                    continue;
+                }
+                Hull::FirstRow(first) => first.max(row),
+            };
+            let entry = Entry {
+                patch,
+                piece: Some(half),
+            };
+            if !self.file(entry, first) {
+                self.stats.overflows += 1;
+                self.cells::<S>(patch, net, half, row, f);
+            }
+        }
+    }
+}
+
+impl<const SUB: u32, C: Clipping, A: Arithmetic> RowPieces<SUB> for PatchRows<'_, '_, SUB, C, A> {
+    fn each_row_piece<S: Shading>(
+        &mut self,
+        row: usize,
+        mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        // Pieces filed under this row while it is processed are taken in the same loop.
+        while let Some(entry) = self.take(row) {
+            match entry.piece {
+                None => self.patch::<S>(entry.patch, row, &mut f),
+                Some(piece) => {
+                    let net = Net::of(self.model, entry.patch as usize);
+                    self.piece::<S>(entry.patch, &net, piece, row, &mut f);
+                }
+            }
+        }
+    }
+}
+
+/// Something with a value for each side of the surface.
+#[derive(Clone, Copy, Debug)]
+struct Sides<T> {
+    front: T,
+    back: T,
+}
+
+/// A tessellation vertex: its eye-space point and its (Gouraud) colours for either side.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    p: EyePoint,
+    color: Sides<[I16F16; 3]>,
+}
+
+/// Whether the camera (at the eye-space origin) sees the back of triangle `t`: its normal
+/// `(b − a) × (c − a)` (in `(x, y, −w)`, counter-clockwise = front) points away from the eye.
+/// Coordinates are cut to 22 bits first, so the cross product is below 2^47 and its dot
+/// product with a point below 2^70 (`i128`).
+fn shows_back(t: &[Vertex; 3]) -> bool {
+    let v = t.map(|v| [v.p.x, v.p.y, v.p.w].map(|c| (c.to_bits() >> 8) as i64));
+    let v = v.map(|p| [p[0], p[1], -p[2]]);
+    let d = |a: [i64; 3], b: [i64; 3]| [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let (e1, e2) = (d(v[0], v[1]), d(v[0], v[2]));
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
+    let dot: i128 = (0..3).map(|k| n[k] as i128 * v[0][k] as i128).sum();
+    dot > 0
+}

@@ -1,0 +1,326 @@
+//! Evaluation of a rational bicubic patch in homogeneous fixed point: points (direction
+//! independent on the boundary, so neighbours agree bit for bit), sub-patch control nets by
+//! blossoming, and normals from the partial derivatives.
+//!
+//! # Bit budget
+//!
+//! A homogeneous control point is `(ω·x, ω·y, ω·z, ω)` in I48F16 bits ([`Hom`]): coordinates
+//! within ±2^12 and weights within [1/16, 16] ([`super::MAX_WEIGHT`]) give components below
+//! 2^16 in value, 2^32 in bits. De Casteljau steps are convex combinations, so every
+//! intermediate stays below 2^32 bits; a step multiplies a difference (below 2^33) by a
+//! parameter (at most 2^16): below 2^49. Derivatives are 3 differences (2^35); the tangent
+//! of the projected surface `H_u·ω − H·ω_u` multiplies them by a weight (2^20): below 2^56.
+
+use super::{PatchModel, Weight, PARAM_ONE};
+use crate::math::fit_bits;
+use crate::scene::Vertex;
+use fixed::types::I16F16;
+
+/// A homogeneous point `(ω·x, ω·y, ω·z, ω)`, each component I48F16 bits in an `i64`.
+pub(crate) type Hom = [i64; 4];
+
+/// `a + (b − a)·t` for a parameter `t` in [0, 1] (I16F16 bits), rounded to nearest: exact
+/// at `t = 0` and `t = 1`.
+#[inline(always)]
+fn lerp(a: Hom, b: Hom, t: u32) -> Hom {
+    let t = t as i64;
+    [0, 1, 2, 3].map(|k| a[k] + (((b[k] - a[k]) * t + (1 << 15)) >> 16))
+}
+
+/// The blossom `f(t₀, t₁, t₂)` of the cubic with control points `q`: de Casteljau with a
+/// different parameter at each level. `f(a, a, a)` is the curve's point at `a`, and the
+/// blossoms at `(a,a,a), (a,a,b), (a,b,b), (b,b,b)` are the control points of its piece over
+/// `[a, b]`.
+#[inline]
+fn blossom(q: [Hom; 4], t: [u32; 3]) -> Hom {
+    let [a, b, c, d] = q;
+    let (ab, bc, cd) = (lerp(a, b, t[0]), lerp(b, c, t[0]), lerp(c, d, t[0]));
+    let (abc, bcd) = (lerp(ab, bc, t[1]), lerp(bc, cd, t[1]));
+    lerp(abc, bcd, t[2])
+}
+
+/// The point at `t` of the cubic `q` and its derivative `q'(t)`.
+#[inline]
+fn point_and_tangent(q: [Hom; 4], t: u32) -> (Hom, Hom) {
+    let [a, b, c, d] = q;
+    let (ab, bc, cd) = (lerp(a, b, t), lerp(b, c, t), lerp(c, d, t));
+    let (abc, bcd) = (lerp(ab, bc, t), lerp(bc, cd, t));
+    (
+        lerp(abc, bcd, t),
+        [0, 1, 2, 3].map(|k| 3 * (bcd[k] - abc[k])),
+    )
+}
+
+/// The point at `t` of a boundary curve, computed the same way whichever end the caller
+/// starts from: the curve is walked from its lexicographically smaller end. Two patches that
+/// share an edge (the same four control points, in either order) get identical points.
+#[inline]
+pub(crate) fn edge_point(q: [Hom; 4], t: u32) -> Hom {
+    let reversed = (q[3], q[2]) < (q[0], q[1]);
+    if reversed {
+        let [a, b, c, d] = q;
+        blossom([d, c, b, a], [PARAM_ONE - t; 3])
+    } else {
+        blossom(q, [t; 3])
+    }
+}
+
+/// The 16 homogeneous control points of a patch (or of a piece of one), row-major:
+/// `h[4·i + j]` is `P_ij`, `u` along `i`, `v` along `j`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Net {
+    pub(crate) h: [Hom; 16],
+}
+
+impl Net {
+    /// The control net of patch `index` of `model` (validated, so in the envelope).
+    pub(crate) fn of(model: &PatchModel<'_>, index: usize) -> Net {
+        let zero = [[I16F16::ZERO; 3]; 16];
+        let points = model.points().get(index).unwrap_or(&zero);
+        let one = [Weight::ONE; 16];
+        let weights = match model.weights() {
+            Some(w) => w.get(index).unwrap_or(&one),
+            None => &one,
+        };
+        let mut h = [[0i64; 4]; 16];
+        for ((out, p), w) in h.iter_mut().zip(points).zip(weights) {
+            let w = w.to_bits() as i64;
+            *out = [
+                (p[0].to_bits() as i64 * w) >> 16,
+                (p[1].to_bits() as i64 * w) >> 16,
+                (p[2].to_bits() as i64 * w) >> 16,
+                w,
+            ];
+        }
+        Net { h }
+    }
+
+    #[inline(always)]
+    fn get(&self, i: usize, j: usize) -> Hom {
+        // i, j < 4 at every call site.
+        self.h.get(4 * i + j).copied().unwrap_or([0; 4])
+    }
+
+    /// The curve `P_i0 .. P_i3` (fixed `u` index, along `v`).
+    #[inline(always)]
+    fn along_v(&self, i: usize) -> [Hom; 4] {
+        [0, 1, 2, 3].map(|j| self.get(i, j))
+    }
+
+    /// The curve `P_0j .. P_3j` (fixed `v` index, along `u`).
+    #[inline(always)]
+    fn along_u(&self, j: usize) -> [Hom; 4] {
+        [0, 1, 2, 3].map(|i| self.get(i, j))
+    }
+
+    /// The surface point at `(u, v)`. On the boundary it depends only on that edge's four
+    /// control points, evaluated direction-independently ([`edge_point`]).
+    pub(crate) fn point(&self, u: u32, v: u32) -> Hom {
+        if v == 0 {
+            edge_point(self.along_u(0), u)
+        } else if v == PARAM_ONE {
+            edge_point(self.along_u(3), u)
+        } else if u == 0 {
+            edge_point(self.along_v(0), v)
+        } else if u == PARAM_ONE {
+            edge_point(self.along_v(3), v)
+        } else {
+            let c = [0, 1, 2, 3].map(|j| blossom(self.along_u(j), [u; 3]));
+            blossom(c, [v; 3])
+        }
+    }
+
+    /// The control net of the piece over `[u0, u1] × [v0, v1]`.
+    pub(crate) fn piece(&self, u: [u32; 2], v: [u32; 2]) -> Net {
+        let ts = |[a, b]: [u32; 2]| [[a, a, a], [a, a, b], [a, b, b], [b, b, b]];
+        let mut cut_u = [[0i64; 4]; 16];
+        for j in 0..4 {
+            let q = self.along_u(j);
+            for (i, t) in ts(u).into_iter().enumerate() {
+                if let Some(slot) = cut_u.get_mut(4 * i + j) {
+                    *slot = blossom(q, t);
+                }
+            }
+        }
+        let cut_u = Net { h: cut_u };
+        let mut h = [[0i64; 4]; 16];
+        for i in 0..4 {
+            let q = cut_u.along_v(i);
+            for (j, t) in ts(v).into_iter().enumerate() {
+                if let Some(slot) = h.get_mut(4 * i + j) {
+                    *slot = blossom(q, t);
+                }
+            }
+        }
+        Net { h }
+    }
+
+    /// The model-space normal direction at `(u, v)`: `S_u × S_v` of the dehomogenized
+    /// surface (any scale), or `None` where it vanishes. A collapsed edge (a cone tip, a lid's
+    /// centre) has a zero tangent at its corners: there the normal is taken a little way
+    /// towards the patch centre, where it tends to the corner's limit normal.
+    pub(crate) fn normal(&self, u: u32, v: u32) -> Option<[i64; 3]> {
+        let half = PARAM_ONE / 2;
+        let towards = |p: u32, shift: u32| {
+            if p < half {
+                p + ((half - p) >> shift)
+            } else {
+                p - ((p - half) >> shift)
+            }
+        };
+        self.normal_at(u, v).or_else(|| {
+            [8, 5, 2]
+                .into_iter()
+                .find_map(|shift| self.normal_at(towards(u, shift), towards(v, shift)))
+        })
+    }
+
+    fn normal_at(&self, u: u32, v: u32) -> Option<[i64; 3]> {
+        let mut c = [[0i64; 4]; 4];
+        let mut cu = [[0i64; 4]; 4];
+        for j in 0..4 {
+            let (p, d) = point_and_tangent(self.along_u(j), u);
+            if let (Some(cj), Some(cuj)) = (c.get_mut(j), cu.get_mut(j)) {
+                *cj = p;
+                *cuj = d;
+            }
+        }
+        let (h, hv) = point_and_tangent(c, v);
+        let hu = blossom(cu, [v; 3]);
+        // S = H/ω, so S_u ∝ H_u·ω − H·ω_u (the positive factor 1/ω² dropped).
+        let tangent = |d: Hom| -> Option<[i64; 3]> {
+            let w = h[3] >> 4;
+            let dw = d[3] >> 4;
+            let t = [0, 1, 2].map(|k| (d[k] >> 4) * w - (h[k] >> 4) * dw);
+            // Below this a tangent is rounding noise (a few units of its last bits), and
+            // scaling it up would invent a direction.
+            let largest = t.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
+            if largest < 1 << 18 {
+                return None;
+            }
+            fit_bits(t, 30)
+        };
+        let (a, b) = (tangent(hu)?, tangent(hv)?);
+        let n = [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ];
+        // Tangents that are (nearly) parallel give no usable direction.
+        let largest = n.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
+        (largest >= 1 << 40).then_some(n)
+    }
+}
+
+/// A homogeneous point as a model vertex (I16F16), rounded to nearest. The weight is
+/// positive (a convex combination of weights of at least 1/16).
+#[inline]
+pub(crate) fn dehomogenize(h: Hom) -> Vertex {
+    let w = h[3];
+    if w == 1 << 16 {
+        // A polynomial patch: nothing to divide.
+        return [0, 1, 2].map(|k| I16F16::from_bits(h[k] as i32));
+    }
+    // Weights are below 2^21 bits and `h` below 2^32, so nothing here overflows; `checked_`
+    // keeps the render path free of panics.
+    let w = w.max(1);
+    [0, 1, 2].map(|k| {
+        let q = ((h[k] << 17) + w).checked_div_euclid(2 * w).unwrap_or(0);
+        I16F16::from_bits(q as i32)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::patch::{PatchColors, PatchModel};
+    use embedded_graphics::pixelcolor::Rgb888;
+
+    fn c(v: f64) -> I16F16 {
+        I16F16::from_num(v)
+    }
+
+    /// A bicubic patch `z = x·y` over [0, 3]² (control points on a grid, `z = i·j`).
+    fn saddle() -> [[[I16F16; 3]; 16]; 1] {
+        let mut p = [[I16F16::ZERO; 3]; 16];
+        for i in 0..4 {
+            for j in 0..4 {
+                p[4 * i + j] = [c(i as f64), c(j as f64), c((i * j) as f64)];
+            }
+        }
+        [p]
+    }
+
+    #[test]
+    fn points_match_the_polynomial() {
+        let pts = saddle();
+        let model =
+            PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
+        let net = Net::of(&model, 0);
+        for (u, v) in [(0.0, 0.0), (0.25, 0.5), (1.0, 0.75), (0.5, 1.0), (0.1, 0.9)] {
+            let p = dehomogenize(net.point((u * 65536.0) as u32, (v * 65536.0) as u32));
+            let (x, y) = (3.0 * u, 3.0 * v);
+            assert!((p[0].to_num::<f64>() - x).abs() < 1e-3, "{u} {v}");
+            assert!((p[1].to_num::<f64>() - y).abs() < 1e-3);
+            assert!((p[2].to_num::<f64>() - x * y).abs() < 1e-3);
+            // Normal of z = x·y: (−y, −x, 1).
+            let n = net
+                .normal((u * 65536.0) as u32, (v * 65536.0) as u32)
+                .unwrap();
+            let len = |n: [f64; 3]| (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            let n = n.map(|c| c as f64);
+            let e = [-y, -x, 1.0];
+            let cos = (n[0] * e[0] + n[1] * e[1] + n[2] * e[2]) / (len(n) * len(e));
+            assert!(cos > 0.9999, "{u} {v}: {cos}");
+        }
+    }
+
+    #[test]
+    fn edges_do_not_depend_on_direction() {
+        let q = [
+            [1000, -7, 3, 65536],
+            [5, 99999, 17, 60000],
+            [-3000, 4, 2, 70000],
+            [12, 13, 14, 65536],
+        ];
+        let r = [q[3], q[2], q[1], q[0]];
+        for t in [0, 1, 12345, 32768, 65535, 65536] {
+            assert_eq!(edge_point(q, t), edge_point(r, PARAM_ONE - t));
+        }
+    }
+
+    #[test]
+    fn a_piece_has_the_same_surface() {
+        let pts = saddle();
+        let model =
+            PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
+        let net = Net::of(&model, 0);
+        let piece = net.piece([16384, 49152], [0, 32768]);
+        // The piece's corner (1, 1) is the patch's (0.75, 0.5).
+        let a = dehomogenize(piece.point(PARAM_ONE, PARAM_ONE));
+        let b = dehomogenize(net.point(49152, 32768));
+        for k in 0..3 {
+            assert!((a[k] - b[k]).abs() <= I16F16::from_bits(4));
+        }
+    }
+
+    #[test]
+    fn a_collapsed_corner_has_a_normal() {
+        // A cone: the v = 0 edge collapsed to the apex (0, 0, 1).
+        let mut p = [[I16F16::ZERO; 3]; 16];
+        for i in 0..4 {
+            for j in 0..4 {
+                let r = j as f64 / 3.0;
+                let a = i as f64 * 0.5;
+                p[4 * i + j] = [c(r * a.cos()), c(r * a.sin()), c(1.0 - r)];
+            }
+        }
+        let pts = [p];
+        let model =
+            PatchModel::new(&pts, None, PatchColors::Uniform(Rgb888::new(255, 255, 255))).unwrap();
+        let net = Net::of(&model, 0);
+        let n = net.normal(0, 0).expect("a normal at the apex");
+        // Roughly along the cone's side: positive z component.
+        assert!(n[2] != 0);
+    }
+}

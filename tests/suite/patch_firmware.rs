@@ -1,0 +1,47 @@
+//! The patch firmware's frames: the host draws them through the same code
+//! (`scanline3d_demo::patches`) and must reproduce the hashes the firmware prints on QEMU
+//! (`cargo xtask patch` compares them run by run); the firmware's teapot is the exported
+//! `teapot.bpt`.
+
+use scanline3d::sink::HashSink;
+use scanline3d_demo::patches::{self, PanelPatches};
+
+/// Printed by `cargo run --profile firmware --example patch --target thumbv7em-none-eabihf`
+/// for frames 0, 8 and 16; a change here means the drawn pixels changed.
+const FIRMWARE_HASHES: [u32; 3] = [0xa9095c16, 0x36825c4a, 0xec00b30f];
+
+#[test]
+fn host_reproduces_firmware_patch_hashes() {
+    let mut ws = Box::new(PanelPatches::new(
+        embedded_graphics::pixelcolor::Rgb565::new(0, 0, 0),
+    ));
+    let hashes: Vec<u32> = [0, 8, 16]
+        .iter()
+        .map(|&frame| {
+            let mut sink = HashSink::new();
+            let stats = patches::render_frame(&mut ws, frame, &mut sink).unwrap();
+            eprintln!("frame {frame}: {stats:?}");
+            assert!(
+                stats.frame.pixels_written > 5000,
+                "frame {frame}: {stats:?}"
+            );
+            assert_eq!(
+                (stats.overflows, stats.late, stats.frame.dropped),
+                (0, 0, 0),
+                "frame {frame}: {stats:?}"
+            );
+            sink.hash()
+        })
+        .collect();
+    assert_eq!(hashes, FIRMWARE_HASHES, "{hashes:08x?}");
+}
+
+#[test]
+fn firmware_teapot_is_the_exported_model() {
+    use scanline3d_sim::patch::{fixed, parse};
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let model = parse::load(&dir.join("sim/scenes/patches/teapot.bpt")).unwrap();
+    let fixed = fixed::FixedPatches::new(&model).unwrap();
+    assert_eq!(patches::MODEL.points(), &fixed.points[..]);
+    assert!(patches::MODEL.weights().is_none() && fixed.weights.is_none());
+}
