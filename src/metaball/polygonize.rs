@@ -143,6 +143,19 @@ impl<const V: usize, const T: usize> PolyMesh<V, T> {
         )
     }
 
+    /// Makes the surface face inward, for an eye inside it: every normal negated and every
+    /// triangle wound the other way (back-face culling then keeps the faces seen from inside).
+    pub fn turn_inside_out(&mut self) {
+        let n = self.vertex_count;
+        for normal in self.normals.iter_mut().take(n) {
+            *normal = normal.map(|c| c.saturating_neg());
+        }
+        let t = self.triangle_count;
+        for triangle in self.triangles.iter_mut().take(t) {
+            triangle.swap(1, 2);
+        }
+    }
+
     fn clear(&mut self) {
         self.vertex_count = 0;
         self.triangle_count = 0;

@@ -39,7 +39,7 @@ pub struct Polygonized {
 }
 
 /// Polygonizes `frame` of `scene` on a grid of `cells` per axis (one of [`GRIDS`]) and renders
-/// it. Back faces are culled unless the eye is inside the surface.
+/// it, back faces culled (the mesh turned inside out when the eye is inside the surface).
 pub fn render_polygonized(
     scene: &MetaScene,
     frame: u32,
@@ -87,6 +87,11 @@ fn render_grid<const S: usize>(
     let stats = grid
         .polygonize(&metaballs, &mut mesh)
         .map_err(|e| format!("polygonize: {e}"))?;
+    let eye_inside =
+        super::reference::Reference::new(scene, frame, camera.reference()?)?.g(camera.eye) > 0.0;
+    if eye_inside {
+        mesh.turn_inside_out();
+    }
     let library_mesh = mesh.mesh().map_err(|e| e.to_string())?;
     let instances = [Instance {
         mesh: &library_mesh,
