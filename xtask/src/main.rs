@@ -163,6 +163,7 @@ fn main() -> ExitCode {
         "trace" => install().and_then(|_| trace::trace()),
         "lean" => install().and_then(|_| lean()),
         "metaball" => install().and_then(|_| metaball::metaball()),
+        "metaball-trade" => install().and_then(|_| metaball::metaball_trade()),
         "package" => install().and_then(|_| package()),
         "peers" => peers(),
         // The trade table and, in the same command, the peers (`docs/peers.md`).
@@ -192,7 +193,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | trace | metaball | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | trace | metaball | metaball-trade | lean | package | hsr-table | peers | tradeoff | profile [VARIANT] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }

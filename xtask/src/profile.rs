@@ -6,7 +6,7 @@
 //! built-ins charged to the call site that entered them (`llvm-addr2line`; the release profile
 //! keeps debug info).
 
-use crate::tradeoff::{build_tradeoff, run_on_qemu_with};
+use crate::tradeoff::{build_example_with_cfgs, run_on_qemu_with};
 use crate::{root, step};
 use std::collections::HashMap;
 use std::io::BufRead;
@@ -88,7 +88,7 @@ pub fn profile(variant: &str) -> Result<(), String> {
         "trade-off firmware, {variant} alone, for {TARGET}"
     ));
     let cfg = format!("scanline3d_variant=\"{}\"", variant.replace([':', '-'], ""));
-    let elf = build_tradeoff(Some(TARGET), &[cfg], None)?;
+    let elf = build_example_with_cfgs("tradeoff", Some(TARGET), &[cfg], None)?;
     let log = root().join("target/profile-trace.log");
     step("run on QEMU, logging every executed block (a few GB, removed afterwards)");
     let out = run_on_qemu_with(

@@ -61,9 +61,11 @@ fn corpus_frames(output: &str) -> Vec<CorpusFrame> {
         .collect()
 }
 
-/// Builds `firmware/examples/tradeoff.rs` with the firmware profile for `target` (the host if `None`) with extra
-/// `--cfg`s; with `corpus`, also the generated corpus at that path. Returns the ELF path.
-pub(crate) fn build_tradeoff(
+/// Builds `firmware/examples/EXAMPLE.rs` with the firmware profile for `target` (the host if
+/// `None`) with extra `--cfg`s (the example alone is recompiled); with `corpus`, also the
+/// generated corpus at that path. Returns the ELF path.
+pub(crate) fn build_example_with_cfgs(
+    example: &str,
     target: Option<&str>,
     cfgs: &[String],
     corpus: Option<&std::path::Path>,
@@ -76,7 +78,7 @@ pub(crate) fn build_tradeoff(
         "--profile",
         "firmware",
     ]);
-    cmd.args(["--example", "tradeoff"]);
+    cmd.args(["--example", example]);
     if let Some(t) = target {
         cmd.args(["--target", t]);
     }
@@ -93,7 +95,7 @@ pub(crate) fn build_tradeoff(
     if let Some(t) = target {
         elf.push(t);
     }
-    Ok(elf.join("firmware/examples/tradeoff"))
+    Ok(elf.join("firmware/examples").join(example))
 }
 
 /// Runs a firmware ELF with the runner `.cargo/config.toml` gives for `target` (QEMU with a
@@ -237,7 +239,7 @@ fn demo_on_target(
         "trade-off firmware, {name} alone, on QEMU: {target}"
     ));
     // The cfg goes to the example alone (the final compilation unit).
-    let elf = build_tradeoff(Some(target), &[cfg_of(name)], None)?;
+    let elf = build_example_with_cfgs("tradeoff", Some(target), &[cfg_of(name)], None)?;
     let flash = flash_bytes(&elf)?;
     let out = run_on_qemu(target, &elf)?;
     let f = frames(&out);
@@ -311,7 +313,7 @@ pub fn tradeoff() -> Result<(), String> {
     std::fs::write(&corpus_file, corpus).map_err(|e| e.to_string())?;
 
     step("host hashes of the trade-off example (demo orbit and corpus)");
-    let host_elf = build_tradeoff(None, &[], Some(&corpus_file))?;
+    let host_elf = build_example_with_cfgs("tradeoff", None, &[], Some(&corpus_file))?;
     let host = Command::new(&host_elf)
         .output()
         .map_err(|e| e.to_string())?;
@@ -340,7 +342,8 @@ pub fn tradeoff() -> Result<(), String> {
 
             // The same variant over every corpus view (a separate image: the corpus data would
             // swamp the flash figure).
-            let elf = build_tradeoff(Some(target), &[variant], Some(&corpus_file))?;
+            let elf =
+                build_example_with_cfgs("tradeoff", Some(target), &[variant], Some(&corpus_file))?;
             let out = run_on_qemu(target, &elf)?;
             let mine: Vec<_> = corpus_frames(&out)
                 .into_iter()
