@@ -18,8 +18,8 @@
 //! scene and camera set-up, every intersection test, shadows, reflection, refraction and the
 //! ray stack, with a stack too small for the depth limit so the overflow path is linked too,
 //! without and with a bounding-volume hierarchy (exported, and built at run time) and with a
-//! uniform grid built at run time. And it runs the fixed-point metaball ray caster
-//! (`scanline3d::metaball`).
+//! uniform grid built at run time. And it runs the fixed-point metaball ray caster and the
+//! metaball polygonizer with the span z-buffer drawing its mesh (`scanline3d::metaball`).
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -219,6 +219,7 @@ mod firmware {
         let mut cached =
             Workspace::<Rgb565, Flat, 240, 240, 640, 80, 3, Depth, 1024>::new(Rgb565::new(0, 0, 0));
         let mut metaballs = demo::metaballs::PanelCaster::new(Rgb565::new(0, 0, 0));
+        let mut polygonized = demo::metaballs::Poly8::new(Rgb565::new(0, 0, 0));
         let instances = demo::instances();
         let mut frame = 0;
         loop {
@@ -226,6 +227,10 @@ mod firmware {
             let mut sink = scanline3d::sink::HashSink::new();
             let cast = demo::metaballs::render_frame(&mut metaballs, black_box(frame), &mut sink);
             core::hint::black_box((&cast, sink.hash()));
+            // The metaball polygonizer (marching tetrahedra) and its mesh drawn.
+            let mesh = polygonized.polygonize(black_box(frame));
+            let drawn = polygonized.draw(&mut sink);
+            core::hint::black_box((&mesh, &drawn, sink.hash()));
             if let Ok(scene) = demo::scene(&instances, frame, demo::ORBIT_FRAMES) {
                 let out = demo::render_panel_frame(&mut ws, &scene);
                 core::hint::black_box(&out);
