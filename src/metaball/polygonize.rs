@@ -83,7 +83,8 @@ pub struct PolyStats {
 }
 
 /// A polygonized surface: positions, outward normals, colours and the largest ball at each
-/// vertex, and triangles wound counter-clockwise from outside. `V·28 + T·6` bytes.
+/// vertex, and triangles wound counter-clockwise from outside: [`Self::BYTES`] = `29·V + 6·T`
+/// bytes plus two counters (`usize`), rounded up to 4.
 pub struct PolyMesh<const V: usize, const T: usize> {
     vertices: [Vertex; V],
     normals: [Vertex; V],
@@ -254,8 +255,8 @@ impl Lattice {
 }
 
 /// The polygonizer's memory for a grid of `S` samples per axis and up to `N` balls: two layers
-/// of samples and the crossings of the edges in both layers and between them.
-/// [`Self::BYTES`] = `S²·24 + N·48` bytes or so, whatever the scene.
+/// of samples and the crossings of the edges in both layers and between them:
+/// [`Self::BYTES`] = `28·S² + 56·N` bytes (rounded up to 8), whatever the scene.
 pub struct Polygonizer<const S: usize, const N: usize> {
     balls: [GridBall; N],
     /// `g` at the grid points of layers `z` and `z + 1` (by parity of the layer).
@@ -660,6 +661,28 @@ mod tests {
                     assert_eq!(tet[i] & tet[j], tet[i]);
                 }
             }
+        }
+    }
+
+    #[test]
+    fn memory_is_as_documented() {
+        assert_eq!(
+            Polygonizer::<17, 6>::BYTES,
+            (28 * 17 * 17 + 56 * 6usize).next_multiple_of(8)
+        );
+        assert_eq!(
+            Polygonizer::<33, 1>::BYTES,
+            (28 * 33 * 33 + 56usize).next_multiple_of(8)
+        );
+        let counters = 2 * core::mem::size_of::<usize>();
+        for (bytes, v, t) in [
+            (PolyMesh::<2048, 4096>::BYTES, 2048, 4096),
+            (PolyMesh::<5, 3>::BYTES, 5, 3),
+        ] {
+            assert_eq!(
+                bytes,
+                (29 * v + 6 * t + counters).next_multiple_of(counters / 2)
+            );
         }
     }
 
