@@ -22,7 +22,7 @@ use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 /// at most `EPSILON_T · L / |g'|` in front of the surface (see `docs/metaballs.md`).
 pub const EPSILON_T: Wide = Wide::from_bits(1 << (32 - 14));
 /// Most march steps per ray.
-pub const MAX_STEPS: u32 = 400;
+pub const MAX_STEPS: u32 = 1024;
 
 /// A perspective camera for the caster (`gluLookAt` + `gluPerspective`, pixel centres at
 /// `(c + ½, r + ½)`); the ray direction's component along the view axis is 1, so the ray
