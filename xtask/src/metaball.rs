@@ -322,18 +322,17 @@ fn write_trade(
 /// `docs/metaball-trade.png`: thumbv6m instructions per frame (x, log) against the worst
 /// frame's PSNR (y), one point per method.
 fn plot_trade(accuracy: &[Accuracy], measured: &[Vec<OnTarget>]) -> Result<(), String> {
+    use crate::tradeoff::{plot_canvas, PLOT_AREA};
     use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
     use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
     use embedded_graphics::prelude::*;
-    use embedded_graphics::primitives::{Circle, Line, PrimitiveStyle, Rectangle};
+    use embedded_graphics::primitives::{Circle, Line, PrimitiveStyle};
     use embedded_graphics::text::Text;
-    let (w, h) = (640usize, 400usize);
-    let mut img = scanline3d_sim::scene::RgbImage {
-        width: w,
-        height: h,
-        pixels: vec![[255; 3]; w * h],
-    };
-    let (left, right, top, bottom) = (70i32, 610i32, 30i32, 350i32);
+    let mut img = plot_canvas(
+        "thumbv6m instructions per frame (QEMU, log scale), six balls at 120x120",
+        "PSNR of the worst animation frame vs the f64 reference (dB)",
+    )?;
+    let (left, right, top, bottom) = PLOT_AREA;
     let xs: Vec<f64> = measured.iter().map(|m| m[1].instructions.log10()).collect();
     let ys: Vec<f64> = accuracy.iter().map(|a| a.psnr_min).collect();
     let (x0, x1) = (
@@ -349,24 +348,6 @@ fn plot_trade(accuracy: &[Accuracy], measured: &[Vec<OnTarget>]) -> Result<(), S
     let black = PrimitiveStyle::with_stroke(Rgb888::BLACK, 1);
     let text = MonoTextStyle::new(&FONT_6X10, Rgb888::BLACK);
     let e = |_| "drawing failed".to_string();
-    Rectangle::with_corners(Point::new(left, top), Point::new(right, bottom))
-        .into_styled(black)
-        .draw(&mut img)
-        .map_err(e)?;
-    Text::new(
-        "thumbv6m instructions per frame (QEMU, log scale), six balls at 120x120",
-        Point::new(left + 60, 385),
-        text,
-    )
-    .draw(&mut img)
-    .map_err(e)?;
-    Text::new(
-        "PSNR of the worst animation frame vs the f64 reference (dB)",
-        Point::new(left, 20),
-        text,
-    )
-    .draw(&mut img)
-    .map_err(e)?;
     let mut decade = x0;
     while decade <= x1 {
         for m in [1.0, 2.0, 5.0] {
@@ -419,7 +400,7 @@ fn plot_trade(accuracy: &[Accuracy], measured: &[Vec<OnTarget>]) -> Result<(), S
         .map_err(e)?;
     }
     let path = root().join("docs/metaball-trade.png");
-    scanline3d_sim::scene::write_png(&path, w, h, &img.pixels)?;
+    scanline3d_sim::scene::write_png(&path, img.width, img.height, &img.pixels)?;
     println!("wrote {}", path.display());
     Ok(())
 }

@@ -573,16 +573,46 @@ pub fn tradeoff() -> Result<(), String> {
     Ok(())
 }
 
-/// `docs/tradeoff.png`: thumbv6m instructions per frame (x) against mean id mismatches (y, log
-/// scale), one point per variant, the Pareto front joined.
-fn plot(rows: &[Row], front: &[bool]) -> Result<(), String> {
+/// The plot area of [`plot_canvas`]: left, right, top, bottom.
+pub(crate) const PLOT_AREA: (i32, i32, i32, i32) = (70, 610, 30, 350);
+
+/// A white 640×400 plot: the frame of [`PLOT_AREA`], `x_label` under it and `y_label` above it.
+pub(crate) fn plot_canvas(
+    x_label: &str,
+    y_label: &str,
+) -> Result<scanline3d_sim::scene::RgbImage, String> {
     let (w, h) = (640usize, 400usize);
     let mut img = scanline3d_sim::scene::RgbImage {
         width: w,
         height: h,
         pixels: vec![[255; 3]; w * h],
     };
-    let (left, right, top, bottom) = (70i32, 610i32, 30i32, 350i32);
+    let (left, right, top, bottom) = PLOT_AREA;
+    let text = MonoTextStyle::new(&FONT_6X10, Rgb888::BLACK);
+    let e = |_| "drawing failed".to_string();
+    Rectangle::with_corners(Point::new(left, top), Point::new(right, bottom))
+        .into_styled(PrimitiveStyle::with_stroke(Rgb888::BLACK, 1))
+        .draw(&mut img)
+        .map_err(e)?;
+    let x_at = left + (right - left - 6 * x_label.len() as i32) / 2;
+    Text::new(x_label, Point::new(x_at, 385), text)
+        .draw(&mut img)
+        .map_err(e)?;
+    Text::new(y_label, Point::new(left, 20), text)
+        .draw(&mut img)
+        .map_err(e)?;
+    Ok(img)
+}
+
+/// `docs/tradeoff.png`: thumbv6m instructions per frame (x) against mean id mismatches (y, log
+/// scale), one point per variant, the Pareto front joined.
+fn plot(rows: &[Row], front: &[bool]) -> Result<(), String> {
+    let mut img = plot_canvas(
+        "thumbv6m instructions per frame (demo orbit, QEMU)",
+        "mean id mismatches vs f64 reference (%, log)",
+    )?;
+    let (w, h) = (img.width, img.height);
+    let (left, right, top, bottom) = PLOT_AREA;
     let xs: Vec<f64> = rows.iter().map(|r| r.instructions[1]).collect();
     let ys: Vec<f64> = rows.iter().map(|r| r.mean_id.max(1e-4).log10()).collect();
     let (x0, x1) = (
@@ -598,24 +628,6 @@ fn plot(rows: &[Row], front: &[bool]) -> Result<(), String> {
     let black = PrimitiveStyle::with_stroke(Rgb888::BLACK, 1);
     let text = MonoTextStyle::new(&FONT_6X10, Rgb888::BLACK);
     let e = |_| "drawing failed".to_string();
-    Rectangle::with_corners(Point::new(left, top), Point::new(right, bottom))
-        .into_styled(black)
-        .draw(&mut img)
-        .map_err(e)?;
-    Text::new(
-        "thumbv6m instructions per frame (demo orbit, QEMU)",
-        Point::new(left + 120, 385),
-        text,
-    )
-    .draw(&mut img)
-    .map_err(e)?;
-    Text::new(
-        "mean id mismatches vs f64 reference (%, log)",
-        Point::new(left, 20),
-        text,
-    )
-    .draw(&mut img)
-    .map_err(e)?;
     for k in 0..=4 {
         let x = x0 + (x1 - x0) * k as f64 / 4.0;
         Text::new(

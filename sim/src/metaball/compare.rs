@@ -47,13 +47,7 @@ pub fn render_fixed(
     .map_err(|e| e.to_string())?;
     let (d, a, di) = scene.light;
     let light = Light::new(f(d), a as f32, di as f32).map_err(|e| e.to_string())?;
-    let mut image = Image {
-        width: w,
-        height: h,
-        ids: vec![-1; w * h],
-        depth: vec![f32::INFINITY; w * h],
-        color: vec![[0; 3]; w * h],
-    };
+    let mut image = Image::background(w, h);
     let near = camera.near;
     let stats = {
         let mut caster: Box<Caster<Rgb888, MAX_WIDTH, MAX_BALLS>> =

@@ -109,13 +109,7 @@ fn render_grid<const S: usize>(
     let eye_inside =
         super::reference::Reference::new(scene, frame, camera.reference()?)?.g(camera.eye) > 0.0;
     let options = RenderOptions::default().with_back_face_culling(!eye_inside);
-    let mut image = Image {
-        width: w,
-        height: h,
-        ids: vec![-1; w * h],
-        depth: vec![f32::INFINITY; w * h],
-        color: vec![[0; 3]; w * h],
-    };
+    let mut image = Image::background(w, h);
     let frame_stats = draw(
         Rgb888::BLACK,
         &library_scene,
