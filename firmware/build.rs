@@ -21,6 +21,11 @@ fn main() {
     // `examples/firmware.rs` and `examples/tradeoff.rs` with `--cfg scanline3d_vertex_cache`
     // render with a vertex cache (`cargo xtask firmware` and `cargo xtask speed` measure both).
     println!("cargo::rustc-check-cfg=cfg(scanline3d_vertex_cache)");
+    // `examples/metaball.rs` ray casts, or with `--cfg scanline3d_meta="poly16"` polygonizes
+    // on that grid (`cargo xtask metaball-trade` measures each).
+    println!(
+        "cargo::rustc-check-cfg=cfg(scanline3d_meta, values(\"poly8\", \"poly16\", \"poly24\", \"poly32\"))"
+    );
     if std::env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
         return;
     }

@@ -18,9 +18,10 @@
 //! scene and camera set-up, every intersection test, shadows, reflection, refraction and the
 //! ray stack, with a stack too small for the depth limit so the overflow path is linked too,
 //! without and with a bounding-volume hierarchy (exported, and built at run time) and with a
-//! uniform grid built at run time. And it runs the fixed-point metaball ray caster
-//! (`scanline3d::metaball`) and the scanline Bezier patch renderer (`scanline3d::patch`, flat
-//! and Gouraud, with and without culling, with a subdivision buffer that overflows).
+//! uniform grid built at run time. And it runs the fixed-point metaball ray caster and the
+//! metaball polygonizer with the span z-buffer drawing its mesh (`scanline3d::metaball`), and
+//! the scanline Bezier patch renderer (`scanline3d::patch`, flat and Gouraud, with and without
+//! culling, with a subdivision buffer that overflows).
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -225,6 +226,7 @@ mod firmware {
             scanline3d::patch::PatchWorkspace::<Rgb565, Gouraud<PerPixel>, 64, 48, 40, 64>::new(
                 Rgb565::new(0, 0, 0),
             );
+        let mut polygonized = demo::metaballs::Poly8::new(Rgb565::new(0, 0, 0));
         let instances = demo::instances();
         let mut frame = 0;
         loop {
@@ -232,6 +234,10 @@ mod firmware {
             let mut sink = scanline3d::sink::HashSink::new();
             let cast = demo::metaballs::render_frame(&mut metaballs, black_box(frame), &mut sink);
             core::hint::black_box((&cast, sink.hash()));
+            // The metaball polygonizer (marching tetrahedra) and its mesh drawn.
+            let mesh = polygonized.polygonize(black_box(frame));
+            let drawn = polygonized.draw(&mut sink);
+            core::hint::black_box((&mesh, &drawn, sink.hash()));
             if let Ok(scene) = demo::scene(&instances, frame, demo::ORBIT_FRAMES) {
                 let out = demo::render_panel_frame(&mut ws, &scene);
                 core::hint::black_box(&out);

@@ -310,15 +310,47 @@ struct RenderArgs {
     /// derivatives at each vertex) instead of flat.
     #[arg(long)]
     gouraud: bool,
+    /// A `.meta` scene: the animation frame.
+    #[arg(long)]
+    frame: Option<u32>,
+    /// A `.meta` scene: raycast (default), polygonize:N (N cells per axis: 8, 12, 16, 20, 24,
+    /// 32, 48 or 64) or reference.
+    #[arg(long, value_parser = meta_method)]
+    method: Option<MetaMethod>,
+    /// A `.meta` scene: also write method | reference | mismatch map to this PNG and print the
+    /// comparison.
+    #[arg(long)]
+    beside: Option<PathBuf>,
 }
 
-/// How `sim metaball` renders.
-#[derive(Clone, Copy, Debug, ValueEnum, PartialEq)]
+/// How a `.meta` scene is rendered (`--method`).
+#[derive(Clone, Copy, Debug, PartialEq)]
 enum MetaMethod {
     /// The library's fixed-point ray caster.
     Raycast,
+    /// The library's marching tetrahedra on a grid of N cells per axis, drawn by the span
+    /// z-buffer.
+    Polygonize(usize),
     /// The f64 reference: Bernstein form and Bezier clipping.
     Reference,
+}
+
+fn meta_method(s: &str) -> Result<MetaMethod, String> {
+    use scanline3d_sim::metaball::polygonized::GRIDS;
+    match s {
+        "raycast" => Ok(MetaMethod::Raycast),
+        "reference" => Ok(MetaMethod::Reference),
+        _ => s
+            .strip_prefix("polygonize:")
+            .and_then(|n| n.parse().ok())
+            .filter(|n| GRIDS.contains(n))
+            .map(MetaMethod::Polygonize)
+            .ok_or_else(|| {
+                format!(
+                    "'{s}': expected raycast, reference or polygonize:N with N one of {GRIDS:?}"
+                )
+            }),
+    }
 }
 
 #[derive(Args, Debug)]
@@ -328,8 +360,9 @@ struct MetaballArgs {
     /// Animation frame (centres interpolated between keys).
     #[arg(long, default_value_t = 0)]
     frame: u32,
-    /// Renderer.
-    #[arg(long, value_enum, default_value = "raycast")]
+    /// Renderer: raycast, polygonize:N (N cells per axis: 8, 12, 16, 20, 24, 32, 48 or 64) or
+    /// reference.
+    #[arg(long, value_parser = meta_method, default_value = "raycast")]
     method: MetaMethod,
     /// Eye position X,Y,Z.
     #[arg(long, value_parser = vec3, allow_hyphen_values = true, default_value = "0,1.5,5")]
@@ -716,6 +749,29 @@ fn report_empty(ids: &[i32], camera: &CameraSpec) {
 }
 
 fn render(a: RenderArgs) -> Result<(), String> {
+    if a.scene.extension().is_some_and(|e| e == "meta") {
+        let v = a.view;
+        return metaball_command(MetaballArgs {
+            scene: a.scene,
+            frame: a.frame.unwrap_or(0),
+            method: a.method.unwrap_or(MetaMethod::Raycast),
+            eye: v.eye,
+            target: v.target,
+            up: v.up,
+            fov: v.fov,
+            near: v.near,
+            far: v.far,
+            size: v.size,
+            out: a.out,
+            ids: a.ids,
+            depth: a.depth,
+            stats: a.stats,
+            beside: a.beside,
+        });
+    }
+    if a.frame.is_some() || a.method.is_some() || a.beside.is_some() {
+        return Err("--frame, --method and --beside are for .meta scenes".into());
+    }
     if a.scene
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("bpt"))
@@ -985,6 +1041,7 @@ fn trace(a: TraceArgs) -> Result<(), String> {
 }
 
 fn metaball_command(a: MetaballArgs) -> Result<(), String> {
+    use scanline3d_sim::metaball::polygonized::render_polygonized;
     use scanline3d_sim::metaball::{compare::render_fixed, reference::Reference, MetaScene};
     let scene = MetaScene::load(&a.scene)?;
     scene
@@ -1009,6 +1066,14 @@ fn metaball_command(a: MetaballArgs) -> Result<(), String> {
             );
             (image, json)
         }
+        MetaMethod::Polygonize(cells) => {
+            let p = render_polygonized(&scene, a.frame, &camera, (w, h), cells)?;
+            let json = format!(
+                "{{\"renderer\": \"polygonize\", \"cells\": {cells}, \"frame\": {}, \"width\": {w}, \"height\": {h}, \"vertices\": {}, \"triangles\": {}, \"culled\": {}, \"pixels_written\": {}}}\n",
+                a.frame, p.mesh.vertices, p.mesh.triangles, p.frame.culled, p.frame.pixels_written
+            );
+            (p.image, json)
+        }
         MetaMethod::Reference => {
             let reference = Reference::new(&scene, a.frame, camera.reference()?)?;
             let (image, iterations) = reference.render(w, h);
@@ -1027,7 +1092,9 @@ fn metaball_command(a: MetaballArgs) -> Result<(), String> {
     if let Some(path) = &a.beside {
         let reference = Reference::new(&scene, a.frame, camera.reference()?)?;
         let (caster, expected) = match a.method {
-            MetaMethod::Raycast => (image.clone(), reference.render(w, h).0),
+            MetaMethod::Raycast | MetaMethod::Polygonize(_) => {
+                (image.clone(), reference.render(w, h).0)
+            }
             MetaMethod::Reference => (
                 render_fixed(&scene, a.frame, &camera, w, h)?.0,
                 image.clone(),

@@ -331,6 +331,19 @@ pub struct Image {
     pub color: Vec<[u8; 3]>,
 }
 
+impl Image {
+    /// A `width × height` image of background: no id, infinite depth, black.
+    pub fn background(width: usize, height: usize) -> Image {
+        Image {
+            width,
+            height,
+            ids: vec![-1; width * height],
+            depth: vec![f32::INFINITY; width * height],
+            color: vec![[0; 3]; width * height],
+        }
+    }
+}
+
 impl Scene {
     /// A scene over the given primitives; builds the BVH.
     pub fn new(

@@ -9,7 +9,7 @@
 //! [`MAX_STEPS`] (a near-tangent graze) is counted as a miss and reported in [`CastStats::capped`].
 
 use super::{
-    field, field_slope, mul, wide_from_f32, Ball, MetaballError, Metaballs, Wide,
+    field, field_slope, mul, wide_from_f32, Ball, Blend, MetaballError, Metaballs, Wide,
     FIELD_LIPSCHITZ_WIDE,
 };
 use super::{MAX_COORD, MAX_FAR, MIN_NEAR};
@@ -22,7 +22,7 @@ use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 /// at most `EPSILON_T · L / |g'|` in front of the surface (see `docs/metaballs.md`).
 pub const EPSILON_T: Wide = Wide::from_bits(1 << (32 - 14));
 /// Most march steps per ray.
-pub const MAX_STEPS: u32 = 400;
+pub const MAX_STEPS: u32 = 1024;
 
 /// A perspective camera for the caster (`gluLookAt` + `gluPerspective`, pixel centres at
 /// `(c + ½, r + ½)`); the ray direction's component along the view axis is 1, so the ray
@@ -470,24 +470,12 @@ impl Frame<'_> {
 
     fn shade(&self, rays: &[RayBall], d: [Wide; 3], t: Wide, inside: bool) -> Option<Hit> {
         let mut gradient = [Wide::ZERO; 3];
-        let mut best = (Wide::MIN, 0u8);
-        let mut weight = Wide::ZERO;
-        let mut rgb = [Wide::ZERO; 3];
+        let mut blend = Blend::new();
         for ray in rays {
             let (Some(ball), Some(s)) = (self.balls.get(usize::from(ray.ball)), ray.s(t)) else {
                 continue;
             };
-            let contribution = ball.density * field(s);
-            if contribution > best.0 {
-                best = (contribution, ray.ball);
-            }
-            if contribution > Wide::ZERO {
-                weight += contribution;
-                let c = ball.color;
-                for (acc, channel) in rgb.iter_mut().zip([c.r(), c.g(), c.b()]) {
-                    *acc += contribution.saturating_mul_int(i64::from(channel));
-                }
-            }
+            blend.add(ball.density * field(s), usize::from(ray.ball), ball.color);
             // ∇(q·f(s)) = q·f'(s)·2(p − c)/R², p − c = t·d − offset.
             let k = ball.density * field_slope(s) * ball.inv_r2 * Wide::from_num(2);
             for (g, (di, oi)) in gradient.iter_mut().zip(d.iter().zip(ball.offset)) {
@@ -509,32 +497,10 @@ impl Frame<'_> {
                 intensity += self.light.diffuse * n_dot_l;
             }
         }
-        let intensity = intensity.min(Wide::ONE);
-        let fallback = self
-            .balls
-            .get(usize::from(best.1))
-            .map_or(Rgb888::BLACK, |b| b.color);
-        let inv_weight = quotient(Wide::ONE, weight);
-        let channel = |i: usize, fallback: u8| -> u8 {
-            let base = rgb
-                .get(i)
-                .zip(inv_weight)
-                .map(|(acc, inv)| *acc * inv)
-                .unwrap_or(Wide::from_num(fallback));
-            let v = (base * intensity).round().to_num::<i64>();
-            v.clamp(0, 255) as u8
-        };
-        let color = Rgb888::new(
-            channel(0, fallback.r()),
-            channel(1, fallback.g()),
-            channel(2, fallback.b()),
-        );
+        let (color, ball) =
+            blend.finish(intensity.min(Wide::ONE), self.balls.iter().map(|b| b.color));
         let depth = quotient(self.camera.near, t).map_or(Depth::ZERO, Depth::saturating_from_num);
-        Some(Hit {
-            color,
-            ball: best.1,
-            depth,
-        })
+        Some(Hit { color, ball, depth })
     }
 }
 
@@ -579,7 +545,7 @@ fn ray_ball(
 /// fractional bits and is rounded up, so the quotient's magnitude never exceeds the exact one
 /// (the march's step stays safe); relative error ≤ 2^-16 / denominator. `None` for a
 /// denominator below 2^-16 or `|numerator| ≥ 2^15` (the field sum is below 2^12, normals ≤ 1).
-fn quotient(numerator: Wide, denominator: Wide) -> Option<Wide> {
+pub(super) fn quotient(numerator: Wide, denominator: Wide) -> Option<Wide> {
     let den = (denominator.to_bits() >> 16) + 1;
     if den <= 1 {
         return None;

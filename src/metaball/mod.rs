@@ -33,10 +33,13 @@
 //! With those, `|w × d|` ≤ 2^12 per axis and `|w × d|²` ≤ 3·2^24, below I32F32's 2^31; near ≥ 1/256 and far ≤ [`MAX_FAR`] = 1024 bound the ray parameter.
 
 mod cast;
+mod polygonize;
 
 pub use cast::{CastError, CastStats, Caster, MetaCamera, EPSILON_T, MAX_STEPS};
+pub use polygonize::{PolyMesh, PolyStats, PolygonizeError, Polygonizer, MAX_SAMPLES};
 
-use embedded_graphics::pixelcolor::Rgb888;
+use cast::quotient;
+use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::{I16F16, I32F32};
 
 /// Scene coordinates, radii, densities and the threshold: I16F16.
@@ -243,6 +246,66 @@ const FIELD_WIDE: [Wide; 4] = [
 #[inline(always)]
 fn field_coefficients() -> [Wide; 4] {
     FIELD_WIDE
+}
+
+/// The colour and id at a surface point: the colours of the balls with positive `q·f` there,
+/// weighted by it, and the ball with the largest `q·f`.
+pub(crate) struct Blend {
+    best: (Wide, u8),
+    weight: Wide,
+    rgb: [Wide; 3],
+}
+
+impl Blend {
+    pub(crate) fn new() -> Self {
+        Blend {
+            best: (Wide::MIN, 0),
+            weight: Wide::ZERO,
+            rgb: [Wide::ZERO; 3],
+        }
+    }
+
+    /// Adds ball `index`'s `q·f` and colour.
+    pub(crate) fn add(&mut self, contribution: Wide, index: usize, color: Rgb888) {
+        if contribution > self.best.0 {
+            self.best = (contribution, u8::try_from(index).unwrap_or(u8::MAX));
+        }
+        if contribution > Wide::ZERO {
+            self.weight += contribution;
+            for (acc, channel) in self.rgb.iter_mut().zip([color.r(), color.g(), color.b()]) {
+                *acc += contribution.saturating_mul_int(i64::from(channel));
+            }
+        }
+    }
+
+    /// The blended colour times `intensity` (at most 1) and the largest ball; `colors` are the
+    /// balls' colours, for a point with no positive contribution (the largest ball's then).
+    pub(crate) fn finish(
+        &self,
+        intensity: Wide,
+        mut colors: impl Iterator<Item = Rgb888>,
+    ) -> (Rgb888, u8) {
+        let fallback = colors
+            .nth(usize::from(self.best.1))
+            .unwrap_or(Rgb888::BLACK);
+        let inv_weight = quotient(Wide::ONE, self.weight);
+        let channel = |i: usize, fallback: u8| -> u8 {
+            let base = self
+                .rgb
+                .get(i)
+                .zip(inv_weight)
+                .map(|(acc, inv)| *acc * inv)
+                .unwrap_or(Wide::from_num(fallback));
+            let v = (base * intensity).round().to_num::<i64>();
+            v.clamp(0, 255) as u8
+        };
+        let color = Rgb888::new(
+            channel(0, fallback.r()),
+            channel(1, fallback.g()),
+            channel(2, fallback.b()),
+        );
+        (color, self.best.1)
+    }
 }
 
 #[cfg(test)]

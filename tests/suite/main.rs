@@ -9,6 +9,7 @@ mod firmware_hashes;
 mod hostile;
 mod hsr_scenes;
 mod metaball_firmware;
+mod metaball_polygonize;
 mod module_graph;
 mod newell;
 mod patch_cover;

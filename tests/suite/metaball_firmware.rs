@@ -28,6 +28,30 @@ fn host_reproduces_firmware_metaball_hashes() {
     assert_eq!(hashes, FIRMWARE_HASHES, "{hashes:08x?}");
 }
 
+/// Printed by the same example built with `--cfg scanline3d_meta="poly16"` (`cargo xtask
+/// metaball` runs it): frames 0, 2, 4 polygonized on 16 cells per axis and drawn by the span
+/// z-buffer.
+const POLY16_FIRMWARE_HASHES: [u32; 3] = [0xbbd42de6, 0x2422b085, 0xd7598d1d];
+
+#[test]
+fn host_reproduces_firmware_polygonized_hashes() {
+    let mut poly: Box<metaballs::Poly16> = Box::new(metaballs::Poly16::new(
+        embedded_graphics::pixelcolor::Rgb565::new(0, 0, 0),
+    ));
+    let hashes: Vec<u32> = [0, 2, 4]
+        .iter()
+        .map(|&frame| {
+            let mesh = poly.polygonize(frame).unwrap();
+            assert!(mesh.triangles > 1000, "frame {frame}: {mesh:?}");
+            let mut sink = HashSink::new();
+            let stats = poly.draw(&mut sink).unwrap();
+            assert!(stats.pixels_written > 1000, "frame {frame}: {stats:?}");
+            sink.hash()
+        })
+        .collect();
+    assert_eq!(hashes, POLY16_FIRMWARE_HASHES, "{hashes:08x?}");
+}
+
 #[test]
 fn firmware_balls_are_the_six_meta_scene() {
     let scene = MetaScene::parse(SIX_BALLS, "six.meta").unwrap();

@@ -166,6 +166,7 @@ fn main() -> ExitCode {
         "lean" => install().and_then(|_| lean()),
         "metaball" => install().and_then(|_| metaball::metaball()),
         "patch" => install().and_then(|_| patch::patch()),
+        "metaball-trade" => install().and_then(|_| metaball::metaball_trade()),
         "package" => install().and_then(|_| package()),
         "peers" => peers(),
         // The trade table and, in the same command, the peers (`docs/peers.md`).
@@ -200,7 +201,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | trace | metaball | patch | lean | package | hsr-table | peers | tradeoff | profile [VARIANT [cache]] | speed [before|after|doc] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | trace | metaball | metaball-trade | patch | lean | package | hsr-table | peers | tradeoff | profile [VARIANT [cache]] | speed [before|after|doc] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }

@@ -6,7 +6,7 @@
 //! built-ins charged to the call site that entered them (`llvm-addr2line`; the release profile
 //! keeps debug info).
 
-use crate::tradeoff::{build_tradeoff, run_on_qemu_with};
+use crate::tradeoff::{build_example_with_cfgs, run_on_qemu_with};
 use crate::{root, step};
 use std::collections::HashMap;
 use std::io::BufRead;
@@ -95,7 +95,7 @@ pub fn profile(variant: &str, cache: bool) -> Result<(), String> {
     if cache {
         cfgs.push("scanline3d_vertex_cache".into());
     }
-    let elf = build_tradeoff(Some(TARGET), &cfgs, None)?;
+    let elf = build_example_with_cfgs("tradeoff", Some(TARGET), &cfgs, None)?;
     let log = root().join("target/profile-trace.log");
     step("run on QEMU, logging every executed block (a few GB, removed afterwards)");
     let out = run_on_qemu_with(

@@ -8,7 +8,7 @@
 //! the saved labels (`before`: the code before issue 19's set-up rework, `after`: the current
 //! code). `cargo xtask speed doc` only rewrites `docs/speed.md` from the saved figures.
 
-use crate::tradeoff::{build_tradeoff, run_on_qemu_with};
+use crate::tradeoff::{build_example_with_cfgs, run_on_qemu_with};
 use crate::{first_line, root, step, thousands};
 use std::collections::BTreeMap;
 use std::process::Command;
@@ -81,7 +81,7 @@ pub fn speed(label: &str) -> Result<(), String> {
     std::fs::write(&corpus_file, corpus).map_err(|e| e.to_string())?;
     let cfg = format!("scanline3d_variant=\"{VARIANT}\"");
     step("host hashes of the trade-off example");
-    let host_elf = build_tradeoff(None, &[], Some(&corpus_file))?;
+    let host_elf = build_example_with_cfgs("tradeoff", None, &[], Some(&corpus_file))?;
     let host_out = Command::new(&host_elf)
         .output()
         .map_err(|e| format!("{}: {e}", host_elf.display()))?;
@@ -108,7 +108,7 @@ fn measure(
         step(&format!(
             "{label}: variant {VARIANT}, {cfgs:?}, with the corpus on {target}"
         ));
-        let elf = build_tradeoff(Some(target), cfgs, Some(corpus_file))?;
+        let elf = build_example_with_cfgs("tradeoff", Some(target), cfgs, Some(corpus_file))?;
         let out = run_on_qemu_with(target, &elf, &[])?;
         let frames = parse(&out);
         if frames.is_empty() {

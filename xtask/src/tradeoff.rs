@@ -61,9 +61,11 @@ fn corpus_frames(output: &str) -> Vec<CorpusFrame> {
         .collect()
 }
 
-/// Builds `firmware/examples/tradeoff.rs` with the firmware profile for `target` (the host if `None`) with extra
-/// `--cfg`s; with `corpus`, also the generated corpus at that path. Returns the ELF path.
-pub(crate) fn build_tradeoff(
+/// Builds `firmware/examples/EXAMPLE.rs` with the firmware profile for `target` (the host if
+/// `None`) with extra `--cfg`s (the example alone is recompiled); with `corpus`, also the
+/// generated corpus at that path. Returns the ELF path.
+pub(crate) fn build_example_with_cfgs(
+    example: &str,
     target: Option<&str>,
     cfgs: &[String],
     corpus: Option<&std::path::Path>,
@@ -76,7 +78,7 @@ pub(crate) fn build_tradeoff(
         "--profile",
         "firmware",
     ]);
-    cmd.args(["--example", "tradeoff"]);
+    cmd.args(["--example", example]);
     if let Some(t) = target {
         cmd.args(["--target", t]);
     }
@@ -93,7 +95,7 @@ pub(crate) fn build_tradeoff(
     if let Some(t) = target {
         elf.push(t);
     }
-    Ok(elf.join("firmware/examples/tradeoff"))
+    Ok(elf.join("firmware/examples").join(example))
 }
 
 /// Runs a firmware ELF with the runner `.cargo/config.toml` gives for `target` (QEMU with a
@@ -237,7 +239,7 @@ fn demo_on_target(
         "trade-off firmware, {name} alone, on QEMU: {target}"
     ));
     // The cfg goes to the example alone (the final compilation unit).
-    let elf = build_tradeoff(Some(target), &[cfg_of(name)], None)?;
+    let elf = build_example_with_cfgs("tradeoff", Some(target), &[cfg_of(name)], None)?;
     let flash = flash_bytes(&elf)?;
     let out = run_on_qemu(target, &elf)?;
     let f = frames(&out);
@@ -311,7 +313,7 @@ pub fn tradeoff() -> Result<(), String> {
     std::fs::write(&corpus_file, corpus).map_err(|e| e.to_string())?;
 
     step("host hashes of the trade-off example (demo orbit and corpus)");
-    let host_elf = build_tradeoff(None, &[], Some(&corpus_file))?;
+    let host_elf = build_example_with_cfgs("tradeoff", None, &[], Some(&corpus_file))?;
     let host = Command::new(&host_elf)
         .output()
         .map_err(|e| e.to_string())?;
@@ -340,7 +342,8 @@ pub fn tradeoff() -> Result<(), String> {
 
             // The same variant over every corpus view (a separate image: the corpus data would
             // swamp the flash figure).
-            let elf = build_tradeoff(Some(target), &[variant], Some(&corpus_file))?;
+            let elf =
+                build_example_with_cfgs("tradeoff", Some(target), &[variant], Some(&corpus_file))?;
             let out = run_on_qemu(target, &elf)?;
             let mine: Vec<_> = corpus_frames(&out)
                 .into_iter()
@@ -570,16 +573,46 @@ pub fn tradeoff() -> Result<(), String> {
     Ok(())
 }
 
-/// `docs/tradeoff.png`: thumbv6m instructions per frame (x) against mean id mismatches (y, log
-/// scale), one point per variant, the Pareto front joined.
-fn plot(rows: &[Row], front: &[bool]) -> Result<(), String> {
+/// The plot area of [`plot_canvas`]: left, right, top, bottom.
+pub(crate) const PLOT_AREA: (i32, i32, i32, i32) = (70, 610, 30, 350);
+
+/// A white 640×400 plot: the frame of [`PLOT_AREA`], `x_label` under it and `y_label` above it.
+pub(crate) fn plot_canvas(
+    x_label: &str,
+    y_label: &str,
+) -> Result<scanline3d_sim::scene::RgbImage, String> {
     let (w, h) = (640usize, 400usize);
     let mut img = scanline3d_sim::scene::RgbImage {
         width: w,
         height: h,
         pixels: vec![[255; 3]; w * h],
     };
-    let (left, right, top, bottom) = (70i32, 610i32, 30i32, 350i32);
+    let (left, right, top, bottom) = PLOT_AREA;
+    let text = MonoTextStyle::new(&FONT_6X10, Rgb888::BLACK);
+    let e = |_| "drawing failed".to_string();
+    Rectangle::with_corners(Point::new(left, top), Point::new(right, bottom))
+        .into_styled(PrimitiveStyle::with_stroke(Rgb888::BLACK, 1))
+        .draw(&mut img)
+        .map_err(e)?;
+    let x_at = left + (right - left - 6 * x_label.len() as i32) / 2;
+    Text::new(x_label, Point::new(x_at, 385), text)
+        .draw(&mut img)
+        .map_err(e)?;
+    Text::new(y_label, Point::new(left, 20), text)
+        .draw(&mut img)
+        .map_err(e)?;
+    Ok(img)
+}
+
+/// `docs/tradeoff.png`: thumbv6m instructions per frame (x) against mean id mismatches (y, log
+/// scale), one point per variant, the Pareto front joined.
+fn plot(rows: &[Row], front: &[bool]) -> Result<(), String> {
+    let mut img = plot_canvas(
+        "thumbv6m instructions per frame (demo orbit, QEMU)",
+        "mean id mismatches vs f64 reference (%, log)",
+    )?;
+    let (w, h) = (img.width, img.height);
+    let (left, right, top, bottom) = PLOT_AREA;
     let xs: Vec<f64> = rows.iter().map(|r| r.instructions[1]).collect();
     let ys: Vec<f64> = rows.iter().map(|r| r.mean_id.max(1e-4).log10()).collect();
     let (x0, x1) = (
@@ -595,24 +628,6 @@ fn plot(rows: &[Row], front: &[bool]) -> Result<(), String> {
     let black = PrimitiveStyle::with_stroke(Rgb888::BLACK, 1);
     let text = MonoTextStyle::new(&FONT_6X10, Rgb888::BLACK);
     let e = |_| "drawing failed".to_string();
-    Rectangle::with_corners(Point::new(left, top), Point::new(right, bottom))
-        .into_styled(black)
-        .draw(&mut img)
-        .map_err(e)?;
-    Text::new(
-        "thumbv6m instructions per frame (demo orbit, QEMU)",
-        Point::new(left + 120, 385),
-        text,
-    )
-    .draw(&mut img)
-    .map_err(e)?;
-    Text::new(
-        "mean id mismatches vs f64 reference (%, log)",
-        Point::new(left, 20),
-        text,
-    )
-    .draw(&mut img)
-    .map_err(e)?;
     for k in 0..=4 {
         let x = x0 + (x1 - x0) * k as f64 / 4.0;
         Text::new(

@@ -47,13 +47,7 @@ pub fn render_fixed(
     .map_err(|e| e.to_string())?;
     let (d, a, di) = scene.light;
     let light = Light::new(f(d), a as f32, di as f32).map_err(|e| e.to_string())?;
-    let mut image = Image {
-        width: w,
-        height: h,
-        ids: vec![-1; w * h],
-        depth: vec![f32::INFINITY; w * h],
-        color: vec![[0; 3]; w * h],
-    };
+    let mut image = Image::background(w, h);
     let near = camera.near;
     let stats = {
         let mut caster: Box<Caster<Rgb888, MAX_WIDTH, MAX_BALLS>> =
@@ -122,7 +116,9 @@ pub struct MetaComparison {
     pub both: usize,
     /// Largest eye-depth error over pixels covered by both.
     pub max_depth_error: f64,
-    /// Pixels whose depth error exceeds the documented bound.
+    /// Mean eye-depth error over pixels covered by both.
+    pub mean_depth_error: f64,
+    /// Pixels whose depth error exceeds the ray caster's documented bound (see [`compare`]).
     pub depth_over_bound: usize,
     /// Colour PSNR over every pixel and channel (dB).
     pub psnr: f64,
@@ -141,11 +137,12 @@ impl std::fmt::Display for MetaComparison {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "coverage mismatches {} ({:.3} %), off the silhouette {}; depth: max error {:.2e}, over the bound {}; PSNR {:.2} dB; id mismatches {}",
+            "coverage mismatches {} ({:.3} %), off the silhouette {}; depth: max error {:.2e}, mean {:.2e}, over the caster's bound {}; PSNR {:.2} dB; id mismatches {}",
             self.coverage_mismatches,
             self.coverage_percent(),
             self.off_silhouette,
             self.max_depth_error,
+            self.mean_depth_error,
             self.depth_over_bound,
             self.psnr,
             self.id_mismatches
@@ -192,6 +189,7 @@ pub fn compare(fixed: &Image, reference: &Image, reference_scene: &Reference) ->
                 let tf = fixed.depth[i] as f64;
                 let error = (tf - t).abs();
                 m.max_depth_error = m.max_depth_error.max(error);
+                m.mean_depth_error += error;
                 // Mean value theorem: |g(t_f)| = |g'(ξ)|·|t − t_f| for some ξ between the two,
                 // and the march stopped with |g(t_f)| < EPSILON_T·L.
                 let (mut slope, mut lipschitz) = (f64::INFINITY, 0.0f64);
@@ -208,6 +206,7 @@ pub fn compare(fixed: &Image, reference: &Image, reference_scene: &Reference) ->
             }
         }
     }
+    m.mean_depth_error /= m.both.max(1) as f64;
     let mse = squared / (3 * w * h) as f64;
     m.psnr = if mse == 0.0 {
         f64::INFINITY

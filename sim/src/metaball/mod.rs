@@ -12,6 +12,7 @@
 //! a key sets frame 0), linear between keys and held after the last one.
 
 pub mod compare;
+pub mod polygonized;
 pub mod reference;
 
 use embedded_graphics::pixelcolor::Rgb888;

@@ -1,4 +1,4 @@
-//! `sim metaball`: renders a .meta file; bad input is one line on stderr and exit status 2.
+//! `sim render SCENE.meta` (and its alias `sim metaball`): renders a .meta file with each method; bad input is one line on stderr and exit status 2.
 
 use std::process::Command;
 
@@ -10,16 +10,20 @@ fn sim(args: &[&str]) -> std::process::Output {
 }
 
 #[test]
-fn renders_both_methods_with_ids_and_depth() {
+fn renders_every_method_with_ids_and_depth() {
     let dir = std::env::temp_dir().join(format!("metaball-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("six.meta");
     std::fs::write(&scene, scanline3d_sim::metaball::SIX_BALLS).unwrap();
-    for method in ["raycast", "reference"] {
-        let png = dir.join(format!("{method}.png"));
-        let ids = dir.join(format!("{method}.ids"));
+    for (command, method) in [
+        ("render", "raycast"),
+        ("render", "polygonize:16"),
+        ("metaball", "reference"),
+    ] {
+        let png = dir.join(format!("{}.png", method.replace(':', "_")));
+        let ids = dir.join(format!("{}.ids", method.replace(':', "_")));
         let out = sim(&[
-            "metaball",
+            command,
             scene.to_str().unwrap(),
             "--frame",
             "3",
@@ -41,7 +45,10 @@ fn renders_both_methods_with_ids_and_depth() {
         );
         let stdout = String::from_utf8_lossy(&out.stdout);
         assert!(
-            stdout.contains(&format!("\"renderer\": \"{method}\"")),
+            stdout.contains(&format!(
+                "\"renderer\": \"{}\"",
+                method.split(':').next().unwrap()
+            )),
             "{stdout}"
         );
         let ids = std::fs::read(&ids).unwrap();
@@ -74,10 +81,44 @@ fn bad_input_is_one_line_and_status_2() {
         let path = dir.join(format!("bad{i}.meta"));
         std::fs::write(&path, text).unwrap();
         let out = sim(&[
-            "metaball",
+            "render",
             path.to_str().unwrap(),
             "--out",
             dir.join("x.png").to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.contains(want), "{stderr}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_method_and_meta_options_on_obj_are_one_line_and_status_2() {
+    let dir = std::env::temp_dir().join(format!("metaball-opts-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let meta = dir.join("six.meta");
+    std::fs::write(&meta, scanline3d_sim::metaball::SIX_BALLS).unwrap();
+    let obj = dir.join("tri.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let png = dir.join("x.png");
+    let cases = [
+        (
+            meta.to_str().unwrap(),
+            "polygonize:7",
+            "polygonize:N with N one of",
+        ),
+        (obj.to_str().unwrap(), "raycast", "are for .meta scenes"),
+    ];
+    for (scene, method, want) in cases {
+        let out = sim(&[
+            "render",
+            scene,
+            "--method",
+            method,
+            "--out",
+            png.to_str().unwrap(),
         ]);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{stderr}");
