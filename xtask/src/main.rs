@@ -167,7 +167,7 @@ fn main() -> ExitCode {
         "metaball" => install().and_then(|_| metaball::metaball()),
         "patch" => install().and_then(|_| patch::patch()),
         "metaball-trade" => install().and_then(|_| metaball::metaball_trade()),
-        "package" => install().and_then(|_| package()),
+        "package" => install().and_then(|_| package()).and_then(|_| examples()),
         "peers" => peers(),
         // The trade table and, in the same command, the peers (`docs/peers.md`).
         "tradeoff" => install()

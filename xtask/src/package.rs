@@ -20,7 +20,12 @@ pub(crate) fn package() -> Result<(), String> {
         "--package",
         "scanline3d",
     ]))?;
-    downstream()?;
+    downstream()
+}
+
+/// The user-facing example crates: the RP2040 panel (built for thumbv6m, clippy as its
+/// compiler) and the desktop window (clippy).
+pub(crate) fn examples() -> Result<(), String> {
     step("example: RP2040 + ST7789 panel (builds; running needs the board)");
     for example in ["panel-rp2040", "window"] {
         let manifest = root().join(format!("examples/{example}/Cargo.toml"));

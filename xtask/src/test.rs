@@ -90,12 +90,22 @@ pub(crate) fn test() -> Result<(), String> {
         &["panic_never", "firmware", "trace", "metaball", "patch"],
     )?;
     package()?;
+    // The example crates compile (two jobs) while the firmware runs under QEMU, one core a
+    // run; their output interleaves.
+    let example_builds = std::thread::spawn(examples);
     firmware()?;
     crate::trace::trace()?;
     crate::metaball::metaball()?;
     crate::patch::patch()?;
-    lean()?;
+    example_builds
+        .join()
+        .map_err(|_| "the example build thread panicked".to_string())??;
+    // Likewise the lean firmware builds and runs beside the fuzzer, which takes one core.
+    let lean_step = std::thread::spawn(lean);
     fuzz_with(fuzz_build, FUZZ_SECONDS_IN_TEST)?;
+    lean_step
+        .join()
+        .map_err(|_| "the lean firmware thread panicked".to_string())??;
     println!("\nxtask: {} passed, {} failed", totals.0, totals.1);
     Ok(())
 }
