@@ -90,12 +90,16 @@ pub(crate) fn build_example_with_cfgs(
         cmd.args(["--cfg", "scanline3d_corpus"]);
         cmd.env("SCANLINE3D_CORPUS", path);
     }
-    run(&mut cmd)?;
-    let mut elf = root().join("target");
+    // A target build shares the target directory of `build_firmware_examples`, whose
+    // dependencies are then already compiled for that target and profile.
     if let Some(t) = target {
-        elf.push(t);
+        cmd.env("CARGO_TARGET_DIR", crate::firmware::firmware_target_dir(t));
     }
-    Ok(elf.join("firmware/examples").join(example))
+    run(&mut cmd)?;
+    Ok(match target {
+        Some(t) => crate::firmware::firmware_elf(t, "firmware", example),
+        None => root().join("target/firmware/examples").join(example),
+    })
 }
 
 /// Runs a firmware ELF with the runner `.cargo/config.toml` gives for `target` (QEMU with a
