@@ -110,9 +110,9 @@ fn grid_step(balls: &[Ball], grid: usize) -> [f64; 3] {
 #[test]
 fn random_scenes_give_closed_consistently_wound_meshes() {
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
-    let mut mesh: Box<Mesh> = Box::new(PolyMesh::new());
-    let mut small: Box<Polygonizer<9, 8>> = Box::new(Polygonizer::new());
-    let mut large: Box<Polygonizer<25, 8>> = Box::new(Polygonizer::new());
+    let mut mesh: Box<Mesh> = Box::default();
+    let mut small: Box<Polygonizer<9, 8>> = Box::default();
+    let mut large: Box<Polygonizer<25, 8>> = Box::default();
     let mut triangles = 0;
     for scene_index in 0..24 {
         let (balls, threshold) = random_scene(&mut rng);
@@ -164,8 +164,8 @@ fn single_ball_is_a_sphere_facing_out() {
         Rgb888::new(9, 9, 9),
     )];
     let scene = Metaballs::new(&balls, Coord::from_num(0.5)).unwrap();
-    let mut mesh: Box<Mesh> = Box::new(PolyMesh::new());
-    let mut grid: Box<Polygonizer<33, 1>> = Box::new(Polygonizer::new());
+    let mut mesh: Box<Mesh> = Box::default();
+    let mut grid: Box<Polygonizer<33, 1>> = Box::default();
     grid.polygonize(&scene, &mut mesh).unwrap();
     assert_closed(&mesh, "sphere");
     let centre = [0.25, -0.5, 0.125];

@@ -82,8 +82,8 @@ fn render_grid<const S: usize>(
 ) -> Result<Polygonized, String> {
     let balls = scene.library_balls(frame);
     let metaballs = Metaballs::new(&balls, scene.library_threshold()).map_err(|e| e.to_string())?;
-    let mut mesh: Box<HostMesh> = Box::new(PolyMesh::new());
-    let mut grid: Box<Polygonizer<S, { super::compare::MAX_BALLS }>> = Box::new(Polygonizer::new());
+    let mut mesh: Box<HostMesh> = Box::default();
+    let mut grid: Box<Polygonizer<S, { super::compare::MAX_BALLS }>> = Box::default();
     let stats = grid
         .polygonize(&metaballs, &mut mesh)
         .map_err(|e| format!("polygonize: {e}"))?;
