@@ -18,6 +18,7 @@ mod patch_model;
 mod presets;
 mod realworld;
 mod realworld_cli;
+mod run;
 mod trace;
 mod trace_fixed;
 mod vertex_cache;

@@ -1,25 +1,11 @@
 //! `sim render MODEL.bpt --renderer fixed` and `sim export MODEL.bpt` end to end.
 
 use std::path::PathBuf;
-use std::process::Command;
 
-fn sim(args: &[&str], dir: &std::path::Path) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_sim"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
+use crate::run::{scratch as scratch_dir, sim};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("scanline3d-patch-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    scratch_dir(&format!("patch-{name}"))
 }
 
 fn model(name: &str) -> String {
