@@ -32,9 +32,11 @@
 //!
 //! With those, `|w × d|` ≤ 2^12 per axis and `|w × d|²` ≤ 3·2^24, below I32F32's 2^31; near ≥ 1/256 and far ≤ [`MAX_FAR`] = 1024 bound the ray parameter.
 
+mod animation;
 mod cast;
 mod polygonize;
 
+pub use animation::{AnimatedBall, Animation, BallKey, KeyCoord};
 pub use cast::{CastError, CastStats, Caster, MetaCamera, EPSILON_T, MAX_STEPS};
 pub use polygonize::{PolyMesh, PolyStats, PolygonizeError, Polygonizer, MAX_SAMPLES};
 
@@ -62,6 +64,28 @@ pub const MIN_NEAR: f32 = 1.0 / 256.0;
 /// Most balls in a scene.
 pub const MAX_BALLS: usize = 64;
 
+/// [`MAX_COORD`] in I16F16 (exact; a test checks), for the `const` checks.
+const COORD_LIMIT: Coord = Coord::lit("64");
+/// [`MAX_DENSITY`] in I16F16 (exact).
+const DENSITY_LIMIT: Coord = Coord::lit("64");
+/// [`MIN_RADIUS`] in I16F16 (exact).
+const RADIUS_MIN: Coord = Coord::lit("0.0625");
+/// [`MAX_RADIUS`] in I16F16 (exact).
+const RADIUS_MAX: Coord = Coord::lit("32");
+
+/// Whether a ball is inside the envelope of the module's bit budget (centre, radius, density).
+const fn ball_in_envelope(centre: [Coord; 3], radius: Coord, density: Coord) -> bool {
+    let limit = COORD_LIMIT.to_bits().unsigned_abs();
+    let centre_ok = centre[0].to_bits().unsigned_abs() <= limit
+        && centre[1].to_bits().unsigned_abs() <= limit
+        && centre[2].to_bits().unsigned_abs() <= limit;
+    let radius_ok =
+        radius.to_bits() >= RADIUS_MIN.to_bits() && radius.to_bits() <= RADIUS_MAX.to_bits();
+    centre_ok
+        && radius_ok
+        && density.to_bits().unsigned_abs() <= DENSITY_LIMIT.to_bits().unsigned_abs()
+}
+
 /// The field polynomial's coefficients in `s = r²/R²`, lowest power first: `f(s) = Σ cₖ sᵏ`.
 pub const FIELD_COEFFICIENTS: [f64; 4] = [1.0, -22.0 / 9.0, 17.0 / 9.0, -4.0 / 9.0];
 
@@ -72,8 +96,8 @@ pub const FIELD_LIPSCHITZ: f64 = 1.59375;
 /// [`FIELD_LIPSCHITZ`] in I32F32 (exact: 51/32).
 const FIELD_LIPSCHITZ_WIDE: Wide = Wide::lit("1.59375");
 
-/// One ball.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// One ball (the default: all zero, black; outside the envelope until set).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Ball {
     /// Centre (world).
     pub centre: [Coord; 3],
@@ -132,6 +156,16 @@ pub enum MetaballError {
     },
     /// The threshold is not in `(0, MAX_DENSITY]`.
     Threshold,
+    /// Ball `index` of an [`Animation`] has no keys, or key frames that do not increase.
+    Keys {
+        /// Index of the ball in the slice.
+        index: usize,
+    },
+    /// The slice given to [`Animation::frame`] is shorter than the animation's `balls`.
+    Capacity {
+        /// Balls in the animation.
+        balls: usize,
+    },
     /// A degenerate camera (eye = target, up along the view), a field of view outside
     /// (0°, 120°], near/far outside [`MIN_NEAR`]..[`MAX_FAR`], a target wider than 4:1 or
     /// larger than 2048 per side, or an eye outside ±[`MAX_COORD`].
@@ -147,6 +181,10 @@ impl core::fmt::Display for MetaballError {
                 "ball {index}: centre within ±{MAX_COORD}, radius {MIN_RADIUS}..{MAX_RADIUS}, |density| ≤ {MAX_DENSITY}"
             ),
             MetaballError::Threshold => write!(f, "threshold must be in (0, {MAX_DENSITY}]"),
+            MetaballError::Keys { index } => {
+                write!(f, "ball {index}: keys must be one or more, in increasing frame order")
+            }
+            MetaballError::Capacity { balls } => write!(f, "room for fewer than {balls} balls"),
             MetaballError::Camera => write!(f, "camera outside the metaball caster's envelope"),
         }
     }
@@ -167,21 +205,12 @@ impl<'a> Metaballs<'a> {
         if balls.is_empty() || balls.len() > MAX_BALLS {
             return Err(MetaballError::BallCount);
         }
-        let max_coord = Coord::from_num(MAX_COORD);
-        let max_q = Coord::from_num(MAX_DENSITY);
         for (index, b) in balls.iter().enumerate() {
-            let centre_ok = b
-                .centre
-                .iter()
-                .all(|c| c.unsigned_abs() <= max_coord.unsigned_abs());
-            let radius_ok =
-                b.radius >= Coord::from_num(MIN_RADIUS) && b.radius <= Coord::from_num(MAX_RADIUS);
-            let density_ok = b.density.unsigned_abs() <= max_q.unsigned_abs();
-            if !(centre_ok && radius_ok && density_ok) {
+            if !ball_in_envelope(b.centre, b.radius, b.density) {
                 return Err(MetaballError::Ball { index });
             }
         }
-        if threshold <= Coord::ZERO || threshold > max_q {
+        if threshold <= Coord::ZERO || threshold > DENSITY_LIMIT {
             return Err(MetaballError::Threshold);
         }
         Ok(Metaballs { balls, threshold })
@@ -378,6 +407,14 @@ mod tests {
                 assert_eq!(mul(a, b), exact, "{a} × {b}");
             }
         }
+    }
+
+    #[test]
+    fn const_limits_are_the_documented_ones() {
+        assert_eq!(COORD_LIMIT, Coord::from_num(MAX_COORD));
+        assert_eq!(DENSITY_LIMIT, Coord::from_num(MAX_DENSITY));
+        assert_eq!(RADIUS_MIN, Coord::from_num(MIN_RADIUS));
+        assert_eq!(RADIUS_MAX, Coord::from_num(MAX_RADIUS));
     }
 
     #[test]
