@@ -61,7 +61,7 @@ fn vertex_normals(mesh: &MeshData) -> Vec<[i32; 3]> {
 }
 
 /// The shortest literal that parses back to exactly `v as f32` (the value the host uses).
-fn f32_literal(v: f64) -> String {
+pub(crate) fn f32_literal(v: f64) -> String {
     let s = format!("{:?}", v as f32);
     if s.contains('.') || s.contains('e') {
         s

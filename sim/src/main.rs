@@ -49,7 +49,8 @@ enum Command {
     /// buffer, numeric headroom, clipping, and accuracy per sub-pixel setting.
     Analyze(AnalyzeArgs),
     /// Write a scene as Rust source for firmware: static fixed-point arrays and the budget
-    /// `analyze` measures.
+    /// `analyze` measures (OBJ); a patch model (.bpt), traced scene (.scene) or metaball
+    /// scene (.meta) as its static data.
     Export(ExportArgs),
     /// Ray-trace a traced scene (issue 21's text format) to PNG, with optional id, depth and
     /// shadow images.
@@ -423,7 +424,7 @@ struct CompareArgs {
 /// The views `analyze` and `export` look from.
 #[derive(Args, Debug, Clone)]
 struct Views {
-    /// The OBJ scene (or --demo); for `export`, a traced `.scene` file too.
+    /// The OBJ scene (or --demo); for `export`, a `.bpt`, traced `.scene` or `.meta` file too.
     scene: Option<PathBuf>,
     /// The built-in demo scene seen from its 8-frame camera orbit (the firmware's views).
     #[arg(long, conflicts_with = "scene")]
@@ -532,7 +533,7 @@ struct ExportArgs {
     #[command(flatten)]
     views: Views,
     /// Output Rust file.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
     /// Also export vertex normals: the OBJ file's when it has them, else area-weighted ones
     /// (only Gouraud shading uses them).
@@ -593,9 +594,9 @@ fn export_command_line() -> String {
     let mut args = std::env::args().skip(1);
     let mut kept = vec!["sim".to_string()];
     while let Some(arg) = args.next() {
-        if arg == "--out" {
+        if arg == "--out" || arg == "-o" {
             args.next();
-        } else if !arg.starts_with("--out=") {
+        } else if !arg.starts_with("--out=") && !arg.starts_with("-o") {
             kept.push(arg);
         }
     }
@@ -615,6 +616,23 @@ fn export_traced(scene: &std::path::Path, out: &std::path::Path) -> Result<(), S
         fixed.objects().len(),
         fixed.materials.len(),
         fixed.lights.len()
+    );
+    Ok(())
+}
+
+/// `sim export SCENE.meta --out f.rs`: a metaball scene as static fixed-point data.
+fn export_metaballs(scene: &std::path::Path, out: &std::path::Path) -> Result<(), String> {
+    use scanline3d_sim::metaball::{fixed::FixedMeta, MetaScene};
+    let fixed = FixedMeta::new(&MetaScene::load(scene)?)
+        .map_err(|e| format!("{}: {e}", scene.display()))?;
+    let source = fixed.export_source(&export_command_line());
+    let source = scanline3d_sim::export::rustfmt(&source).unwrap_or(source);
+    std::fs::write(out, source).map_err(|e| format!("{}: {e}", out.display()))?;
+    say!(
+        "wrote {} ({} balls, {} frames)",
+        out.display(),
+        fixed.animated().len(),
+        fixed.frames
     );
     Ok(())
 }
@@ -654,6 +672,11 @@ fn export_command(a: ExportArgs) -> Result<(), String> {
         (a.views.scene.as_ref()).filter(|p| p.extension().is_some_and(|e| e == "scene"))
     {
         return export_traced(scene, &a.out);
+    }
+    if let Some(scene) =
+        (a.views.scene.as_ref()).filter(|p| p.extension().is_some_and(|e| e == "meta"))
+    {
+        return export_metaballs(scene, &a.out);
     }
     if a.views.demo {
         return Err("export takes an OBJ scene (the demo is already built in)".into());
@@ -1042,11 +1065,11 @@ fn trace(a: TraceArgs) -> Result<(), String> {
 
 fn metaball_command(a: MetaballArgs) -> Result<(), String> {
     use scanline3d_sim::metaball::polygonized::render_polygonized;
-    use scanline3d_sim::metaball::{compare::render_fixed, reference::Reference, MetaScene};
+    use scanline3d_sim::metaball::{
+        compare::render_fixed, fixed::FixedMeta, reference::Reference, MetaScene,
+    };
     let scene = MetaScene::load(&a.scene)?;
-    scene
-        .check(a.frame)
-        .map_err(|e| format!("{}: {e}", a.scene.display()))?;
+    FixedMeta::new(&scene).map_err(|e| format!("{}: {e}", a.scene.display()))?;
     let camera = CameraSpec {
         eye: a.eye,
         target: a.target,

@@ -1,11 +1,10 @@
 //! The firmware's metaball frames: the host casts them through the same code
 //! (`scanline3d_demo::metaballs`) and must reproduce the hashes the firmware prints on QEMU
-//! (`cargo xtask metaball` compares them run by run), and the firmware's balls are the
-//! `six.meta` scene's.
+//! (`cargo xtask metaball` compares them run by run). The balls are `sim export`'s of
+//! `six.meta` (`sim/tests/suite/metaball_cli.rs` checks the generated file is up to date).
 
 use scanline3d::sink::HashSink;
 use scanline3d_demo::metaballs::{self, PanelCaster};
-use scanline3d_sim::metaball::{MetaScene, SIX_BALLS};
 
 /// Printed by `cargo run --profile firmware --example metaball --target thumbv7em-none-eabihf`
 /// for frames 0, 2 and 4; a change here means the cast pixels changed.
@@ -50,19 +49,4 @@ fn host_reproduces_firmware_polygonized_hashes() {
         })
         .collect();
     assert_eq!(hashes, POLY16_FIRMWARE_HASHES, "{hashes:08x?}");
-}
-
-#[test]
-fn firmware_balls_are_the_six_meta_scene() {
-    let scene = MetaScene::parse(SIX_BALLS, "six.meta").unwrap();
-    assert_eq!(scene.threshold as f32, metaballs::THRESHOLD);
-    for frame in 0..=metaballs::FRAMES {
-        let host = scene.library_balls(frame);
-        let firmware = metaballs::balls(frame);
-        assert_eq!(host.len(), firmware.len());
-        for (h, f) in host.iter().zip(&firmware) {
-            // Both round the same f64 centre through f32 to I16F16.
-            assert_eq!(h, f, "frame {frame}");
-        }
-    }
 }

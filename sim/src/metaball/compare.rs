@@ -31,8 +31,9 @@ pub fn render_fixed(
     if w > MAX_WIDTH {
         return Err(format!("width {w} over the host caster's {MAX_WIDTH}"));
     }
-    let balls = scene.library_balls(frame);
-    let metaballs = Metaballs::new(&balls, scene.library_threshold()).map_err(|e| e.to_string())?;
+    let fixed = super::fixed::FixedMeta::new(scene)?;
+    let balls = fixed.balls_at(frame);
+    let metaballs = Metaballs::new(&balls, fixed.threshold).map_err(|e| e.to_string())?;
     let f = |v: [f64; 3]| v.map(|c| c as f32);
     let cam = MetaCamera::new(
         f(camera.eye),

@@ -12,11 +12,9 @@
 //! a key sets frame 0), linear between keys and held after the last one.
 
 pub mod compare;
+pub mod fixed;
 pub mod polygonized;
 pub mod reference;
-
-use embedded_graphics::pixelcolor::Rgb888;
-use scanline3d::metaball::{Ball, Coord, MetaballError, Metaballs};
 
 /// A `.meta` scene.
 #[derive(Clone, Debug, PartialEq)]
@@ -177,35 +175,6 @@ impl MetaScene {
     pub fn load(path: &std::path::Path) -> Result<MetaScene, String> {
         let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
         MetaScene::parse(&text, &path.display().to_string())
-    }
-
-    /// The balls at `frame` as the library's fixed-point data.
-    pub fn library_balls(&self, frame: u32) -> Vec<Ball> {
-        self.balls
-            .iter()
-            .map(|b| {
-                let [r, g, bl] = b.color8();
-                Ball::new(
-                    b.centre_at(frame).map(|c| c as f32),
-                    b.radius as f32,
-                    b.density as f32,
-                    Rgb888::new(r, g, bl),
-                )
-            })
-            .collect()
-    }
-
-    /// The threshold as the library's I16F16.
-    pub fn library_threshold(&self) -> Coord {
-        Coord::saturating_from_num(self.threshold)
-    }
-
-    /// Checks the scene against the library's envelope at `frame`.
-    pub fn check(&self, frame: u32) -> Result<(), String> {
-        let balls = self.library_balls(frame);
-        Metaballs::new(&balls, self.library_threshold())
-            .map(|_| ())
-            .map_err(|e: MetaballError| format!("{e}"))
     }
 }
 

@@ -80,8 +80,9 @@ fn render_grid<const S: usize>(
     w: usize,
     h: usize,
 ) -> Result<Polygonized, String> {
-    let balls = scene.library_balls(frame);
-    let metaballs = Metaballs::new(&balls, scene.library_threshold()).map_err(|e| e.to_string())?;
+    let fixed = super::fixed::FixedMeta::new(scene)?;
+    let balls = fixed.balls_at(frame);
+    let metaballs = Metaballs::new(&balls, fixed.threshold).map_err(|e| e.to_string())?;
     let mut mesh: Box<HostMesh> = Box::default();
     let mut grid: Box<Polygonizer<S, { super::compare::MAX_BALLS }>> = Box::default();
     let stats = grid

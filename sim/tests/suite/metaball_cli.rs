@@ -127,3 +127,64 @@ fn bad_method_and_meta_options_on_obj_are_one_line_and_status_2() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn the_firmware_scene_is_what_export_writes() {
+    let dir = crate::run::scratch("metaball-export");
+    // Run from the repository root so the header's command line is the one in the file.
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let out = dir.join("six.rs");
+    let (code, stdout, stderr) = crate::run::sim(
+        &[
+            "export",
+            "sim/src/metaball/six.meta",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &root,
+    );
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("(6 balls, 8 frames)"), "{stdout}");
+    let fresh = std::fs::read_to_string(&out).unwrap();
+    let committed = std::fs::read_to_string(root.join("demo/src/metaballs/six.rs")).unwrap();
+    assert_eq!(
+        fresh, committed,
+        "regenerate demo/src/metaballs/six.rs with `sim export sim/src/metaball/six.meta -o demo/src/metaballs/six.rs`"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn export_of_bad_input_is_one_line_and_status_2() {
+    let dir = crate::run::scratch("metaball-export-bad");
+    let cases = [
+        (
+            "threshold 0.5\nmetaball 0 0 0 one 1\n",
+            "bad0.meta:2: 'one' is not a finite number",
+        ),
+        (
+            "threshold 0.5\nmetaball 0 0 0 1 1\nkey 4 100 0 0\n",
+            "bad1.meta: ball 0: centre within",
+        ),
+        (
+            "threshold 100\nmetaball 0 0 0 1 1\n",
+            "bad2.meta: threshold must be in (0, 64]",
+        ),
+        (
+            "threshold 0.5\nmetaball 0 0 0 1 1\nkey 3 0 0 0\nkey 2 1 0 0\n",
+            "bad3.meta:4: key frames must increase",
+        ),
+    ];
+    for (i, (text, want)) in cases.iter().enumerate() {
+        std::fs::write(dir.join(format!("bad{i}.meta")), text).unwrap();
+        let (code, _, stderr) = crate::run::sim(
+            &["export", &format!("bad{i}.meta"), "--out", "bad.rs"],
+            &dir,
+        );
+        assert_eq!(code, 2, "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.starts_with(&format!("sim: {want}")), "{stderr}");
+        assert!(!dir.join("bad.rs").exists(), "case {i} wrote a file");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
