@@ -17,6 +17,54 @@
 //! field's value over its Lipschitz bound (it never steps over a root), restricted to where the
 //! ray crosses influence spheres.
 //!
+//! ## Scenes from `.meta` files
+//!
+//! `sim export SCENE.meta -o scene.rs` writes a scene as `static` data: the balls as
+//! [`AnimatedBall`]s (centres at key frames in [`KeyCoord`], linear between), the threshold, the
+//! frame count, the light, and `ANIMATION`, an [`Animation`] checked by a `const fn` when the
+//! firmware is compiled. The firmware includes the file as a module and casts a frame (the
+//! same with [`Polygonizer::polygonize`]):
+//!
+//! ```
+//! use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
+//! use scanline3d::metaball::{
+//!     AnimatedBall, Animation, Ball, BallKey, Caster, Coord, KeyCoord, MetaCamera,
+//! };
+//! use scanline3d::scene::Light;
+//! use scanline3d::sink::HashSink;
+//!
+//! // What `sim export` writes, shortened: one ball moving from x = −1 to x = 1 in 8 frames.
+//! const fn k(x: &str) -> [KeyCoord; 3] {
+//!     [KeyCoord::lit(x), KeyCoord::ZERO, KeyCoord::ZERO]
+//! }
+//! static BALLS: [AnimatedBall<'static>; 1] = [AnimatedBall {
+//!     keys: &[
+//!         BallKey { frame: 0, centre: k("-1") },
+//!         BallKey { frame: 8, centre: k("1") },
+//!     ],
+//!     radius: Coord::lit("1.5"),
+//!     density: Coord::ONE,
+//!     color: Rgb888::new(230, 77, 51),
+//! }];
+//! static ANIMATION: Animation<'static> = match Animation::new(&BALLS, Coord::lit("0.5")) {
+//!     Ok(a) => a,
+//!     Err(_) => panic!("outside the envelope"),
+//! };
+//!
+//! let mut caster: Caster<Rgb565, 64, 1> = Caster::new(Rgb565::new(0, 0, 0));
+//! let up = [0.0, 1.0, 0.0];
+//! let camera = MetaCamera::new([0.0, 0.0, 5.0], [0.0; 3], up, 50.0, 0.1, 100.0, 64, 48)?;
+//! let light = Light::new([0.4, 0.8, 0.6], 0.2, 0.8)?;
+//! let mut balls = [Ball::default(); 1];
+//! for frame in 0..8 {
+//!     let scene = ANIMATION.frame(frame, &mut balls)?;
+//!     let mut panel = HashSink::new();
+//!     let stats = caster.render(&scene, &camera, &light, &mut panel).ok();
+//!     assert!(stats.is_some_and(|s| s.hits > 0));
+//! }
+//! # Ok::<(), Box<dyn core::error::Error>>(())
+//! ```
+//!
 //! ## Bit budget
 //!
 //! Scene data is [`Coord`] (I16F16); everything per ray is [`Wide`] (I32F32, an `i64`).
