@@ -17,10 +17,26 @@
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
+/// On the host it draws the same frames with the same code and prints their hashes: a target
+/// for a host profiler (`valgrind --tool=callgrind`, see `docs/patch-scanline.md`).
 #[cfg(not(target_os = "none"))]
-fn main() {
-    println!("patch example: run it on a target, e.g.");
+fn main() -> Result<(), &'static str> {
+    use embedded_graphics::pixelcolor::Rgb565;
+    use scanline3d::sink::HashSink;
+    use scanline3d_demo::patches::{self, PanelPatches, FIRMWARE_FRAMES};
+    println!("patch example on the host; on a target, e.g.");
     println!("  cargo run --profile firmware --example patch --target thumbv7em-none-eabihf");
+    let mut ws = Box::new(PanelPatches::new(Rgb565::new(0, 0, 0)));
+    for frame in FIRMWARE_FRAMES {
+        let mut sink = HashSink::new();
+        let stats = patches::render_frame(&mut ws, frame, &mut sink)?;
+        println!(
+            "frame {frame} hash {:08x} triangles {}",
+            sink.hash(),
+            stats.frame.triangles_in
+        );
+    }
+    Ok(())
 }
 
 #[cfg(target_os = "none")]

@@ -352,8 +352,12 @@ pub fn tradeoff() -> Result<(), String> {
 
             // The same variant over every corpus view (a separate image: the corpus data would
             // swamp the flash figure).
-            let elf =
-                build_example_with_cfgs("tradeoff", Some(target), &[variant], Some((CORPUS, &corpus_file)))?;
+            let elf = build_example_with_cfgs(
+                "tradeoff",
+                Some(target),
+                &[variant],
+                Some((CORPUS, &corpus_file)),
+            )?;
             let out = run_on_qemu(target, &elf)?;
             let mine: Vec<_> = corpus_frames(&out)
                 .into_iter()

@@ -33,8 +33,9 @@ pub type PanelPatchesOf<P> = PatchWorkspace<P, Flat, SIDE, SIDE, SUBS, ACTIVE>;
 pub const FIRMWARE_FRAMES: [u32; 3] = [0, 8, 16];
 
 /// Triangles that may be active at once when a tessellated teapot mesh is drawn instead
-/// (`cargo xtask patch-trade` compares the two).
-pub const MESH_ACTIVE: usize = 4096;
+/// (`cargo xtask patch-trade` compares the two; its finest mesh, 65,280 triangles, needs
+/// about 620).
+pub const MESH_ACTIVE: usize = 1024;
 
 /// A mesh workspace for the same panel: `TRIS` triangles, [`MESH_ACTIVE`] active.
 pub type PanelMesh<P, const TRIS: usize> = Workspace<P, Flat, SIDE, SIDE, TRIS, MESH_ACTIVE>;

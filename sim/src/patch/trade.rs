@@ -248,8 +248,8 @@ pub fn tessellate(model: &PatchModel, n: usize) -> Result<TessellatedMesh, Strin
 const HOST_TRIS: usize = scanline3d::scene::MAX_SCENE_TRIANGLES;
 
 /// The mesh firmware's `frame` drawing `mesh` (`demo::render_mesh_frame`, the same code),
-/// rendered on the host into an id image of patch indices; also the triangles dropped from
-/// a full active list (an error if any: the image would not be the mesh's).
+/// rendered on the host into an id image of patch indices (triangles dropped from a full
+/// active list are an error: the image would not be the mesh's).
 pub fn mesh_frame(mesh: &TessellatedMesh, frame: u32) -> Result<Ids, String> {
     on_big_stack(move || {
         let vertices = mesh.fixed_vertices();
@@ -259,8 +259,12 @@ pub fn mesh_frame(mesh: &TessellatedMesh, frame: u32) -> Result<Ids, String> {
         ));
         let mut out = Ids::background(demo::SIDE * demo::SIDE);
         let patch_of = |t: i32| mesh.patch_of.get(t as usize).map_or(-1, |&p| i32::from(p));
-        let stats =
-            demo::render_mesh_frame(&mut ws, &lib, frame, &mut FnSink(id_sink(&mut out, patch_of)?))?;
+        let stats = demo::render_mesh_frame(
+            &mut ws,
+            &lib,
+            frame,
+            &mut FnSink(id_sink(&mut out, patch_of)?),
+        )?;
         if stats.dropped > 0 {
             return Err(format!(
                 "the {}-cell mesh, frame {frame}: {} triangles dropped from the active list",
@@ -390,6 +394,8 @@ pub fn mesh_source(mesh: &TessellatedMesh, command: &str) -> String {
 pub struct OnTarget {
     /// Instructions (QEMU) per frame, mean over the firmware's frames.
     pub instructions: f64,
+    /// Most triangles on the active list at once, over the frames.
+    pub peak_active: u64,
     /// The renderer's workspace (bytes).
     pub workspace: u64,
     /// Peak stack including the workspace (bytes).
@@ -428,8 +434,8 @@ fn millions(t: &Option<OnTarget>) -> String {
 /// The trade table (markdown): one row per entry of `rows`.
 pub fn table(rows: &[TradeRow]) -> String {
     let mut md = String::from(
-        "| model | coverage mismatches | id mismatches | farthest from the silhouette (px) | depth error, max relative | triangles per frame | data flash | thumbv7em instructions/frame | thumbv6m instructions/frame | workspace | peak stack (with workspace) | firmware image |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| model | coverage mismatches | id mismatches | farthest from the silhouette (px) | depth error, max relative | triangles per frame | data flash | thumbv7em instructions/frame | thumbv6m instructions/frame | peak active | workspace | peak stack (with workspace) | firmware image |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let a = &r.accuracy;
@@ -438,7 +444,7 @@ pub fn table(rows: &[TradeRow]) -> String {
         };
         let _ = writeln!(
             md,
-            "| {} | {:.3} % ({}) | {:.3} % ({}) | {} | {:.2e} | {:.0} | {} B | {} | {} | {} | {} | {} |",
+            "| {} | {:.3} % ({}) | {:.3} % ({}) | {} | {:.2e} | {:.0} | {} B | {} | {} | {} | {} | {} | {} |",
             r.name,
             a.percent(a.coverage),
             a.coverage,
@@ -450,6 +456,7 @@ pub fn table(rows: &[TradeRow]) -> String {
             crate::thousands(r.data_flash as u64),
             millions(&r.targets[0]),
             millions(&r.targets[1]),
+            r.targets[0].map_or("—".into(), |t| t.peak_active.to_string()),
             ram(|t| t.workspace),
             ram(|t| t.peak_stack),
             ram(|t| t.image),
@@ -476,7 +483,11 @@ mod tests {
         // 32 patches of 2×2 cells: 256 triangles, less those on the 8 collapsed edges (one
         // per collapsed edge cell: 2 cells × 8 patches).
         assert_eq!(mesh.triangles.len(), 256 - 16);
-        assert!(mesh.vertices.len() < 32 * 9, "{} vertices", mesh.vertices.len());
+        assert!(
+            mesh.vertices.len() < 32 * 9,
+            "{} vertices",
+            mesh.vertices.len()
+        );
         assert_eq!(mesh.patch_of.len(), mesh.triangles.len());
         assert_eq!(mesh.flash_bytes(), 12 * mesh.vertices.len() + 6 * 240);
         mesh.mesh(&mesh.fixed_vertices()).unwrap();
@@ -513,17 +524,26 @@ mod tests {
         let model = teapot();
         let coarse = (
             tessellate(&model, 2).unwrap(),
-            Mismatches { coverage: 9, ids: 20, ..patch },
+            Mismatches {
+                coverage: 9,
+                ids: 20,
+                ..patch
+            },
         );
         let fine = (
             tessellate(&model, 3).unwrap(),
-            Mismatches { coverage: 1, ids: 5, ..patch },
+            Mismatches {
+                coverage: 1,
+                ids: 5,
+                ..patch
+            },
         );
         let meshes = [coarse, fine];
         let picked = matching_mesh(&patch, &meshes).unwrap();
         assert_eq!(picked.0.cells, 3);
         let on = OnTarget {
             instructions: 2.5e6,
+            peak_active: 99,
             workspace: 1234,
             peak_stack: 5678,
             image: 40000,
@@ -549,7 +569,7 @@ mod tests {
         assert_eq!(lines.len(), 4);
         assert_eq!(
             lines[2],
-            "| patches, 0.5 px | 2.000 % (2) | 5.000 % (5) | 1 | 1.00e-2 | 100 | 6,144 B | 2.5 M | — | 1,234 B | 5,678 B | 40,000 B |"
+            "| patches, 0.5 px | 2.000 % (2) | 5.000 % (5) | 1 | 1.00e-2 | 100 | 6,144 B | 2.5 M | — | 99 | 1,234 B | 5,678 B | 40,000 B |"
         );
         assert!(lines[3].starts_with("| mesh 3×3 | 1.000 % (1) | 5.000 % (5) |"));
     }
