@@ -26,6 +26,13 @@ fn main() {
     println!(
         "cargo::rustc-check-cfg=cfg(scanline3d_meta, values(\"poly8\", \"poly16\", \"poly24\", \"poly32\"))"
     );
+    // `examples/patch.rs` with `--cfg scanline3d_patch_tolerance="1"` draws at that tolerance,
+    // with `--cfg scanline3d_patch_mesh` the tessellated mesh at `SCANLINE3D_PATCH_MESH`
+    // (`cargo xtask patch-trade` measures each).
+    println!(
+        "cargo::rustc-check-cfg=cfg(scanline3d_patch_tolerance, values(\"4\", \"2\", \"1\", \"0.5\", \"0.25\"))"
+    );
+    println!("cargo::rustc-check-cfg=cfg(scanline3d_patch_mesh)");
     if std::env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
         return;
     }

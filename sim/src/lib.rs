@@ -44,6 +44,20 @@ pub mod world;
 
 #[cfg(not(target_os = "none"))]
 use metrics::{ErrorBound, Metrics};
+
+/// `n` with thousands separators, as the README and the generated tables write figures.
+#[cfg(not(target_os = "none"))]
+pub fn thousands(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
 #[cfg(not(target_os = "none"))]
 use scene::SceneSpec;
 

@@ -131,18 +131,7 @@ pub(crate) fn stamp(command: &str) -> String {
     )
 }
 
-/// `n` with thousands separators, as the README writes figures.
-pub(crate) fn thousands(n: u64) -> String {
-    let digits = n.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
-}
+pub(crate) use scanline3d_sim::thousands;
 
 pub(crate) fn first_line(cmd: &mut Command) -> String {
     cmd.output()
@@ -167,6 +156,7 @@ fn main() -> ExitCode {
         "metaball" => install().and_then(|_| metaball::metaball()),
         "patch" => install().and_then(|_| patch::patch()),
         "metaball-trade" => install().and_then(|_| metaball::metaball_trade()),
+        "patch-trade" => install().and_then(|_| patch::patch_trade()),
         "package" => install().and_then(|_| package()).and_then(|_| examples()),
         "peers" => peers(),
         // The trade table and, in the same command, the peers (`docs/peers.md`).
@@ -201,7 +191,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | trace | metaball | metaball-trade | patch | lean | package | hsr-table | peers | tradeoff | profile [VARIANT [cache]] | speed [before|after|doc] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | trace | metaball | metaball-trade | patch | patch-trade | lean | package | hsr-table | peers | tradeoff | profile [VARIANT [cache]] | speed [before|after|doc] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }

@@ -81,7 +81,12 @@ pub fn speed(label: &str) -> Result<(), String> {
     std::fs::write(&corpus_file, corpus).map_err(|e| e.to_string())?;
     let cfg = format!("scanline3d_variant=\"{VARIANT}\"");
     step("host hashes of the trade-off example");
-    let host_elf = build_example_with_cfgs("tradeoff", None, &[], Some(&corpus_file))?;
+    let host_elf = build_example_with_cfgs(
+        "tradeoff",
+        None,
+        &[],
+        Some((crate::tradeoff::CORPUS, &corpus_file)),
+    )?;
     let host_out = Command::new(&host_elf)
         .output()
         .map_err(|e| format!("{}: {e}", host_elf.display()))?;
@@ -108,7 +113,12 @@ fn measure(
         step(&format!(
             "{label}: variant {VARIANT}, {cfgs:?}, with the corpus on {target}"
         ));
-        let elf = build_example_with_cfgs("tradeoff", Some(target), cfgs, Some(corpus_file))?;
+        let elf = build_example_with_cfgs(
+            "tradeoff",
+            Some(target),
+            cfgs,
+            Some((crate::tradeoff::CORPUS, corpus_file)),
+        )?;
         let out = run_on_qemu_with(target, &elf, &[])?;
         let frames = parse(&out);
         if frames.is_empty() {

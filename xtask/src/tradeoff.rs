@@ -61,14 +61,20 @@ fn corpus_frames(output: &str) -> Vec<CorpusFrame> {
         .collect()
 }
 
+/// The `--cfg` of the tradeoff firmware that includes the generated corpus (its path in
+/// `SCANLINE3D_CORPUS`).
+pub(crate) const CORPUS: &str = "scanline3d_corpus";
+
 /// Builds `firmware/examples/EXAMPLE.rs` with the firmware profile for `target` (the host if
-/// `None`) with extra `--cfg`s (the example alone is recompiled); with `corpus`, also the
-/// generated corpus at that path. Returns the ELF path.
+/// `None`) with extra `--cfg`s (the example alone is recompiled); with `generated` = (`cfg`,
+/// path), also `--cfg cfg` and the environment variable `cfg` in capitals naming the path, for
+/// an example that includes generated source from there (the corpus: [`CORPUS`]). Returns the
+/// ELF path.
 pub(crate) fn build_example_with_cfgs(
     example: &str,
     target: Option<&str>,
     cfgs: &[String],
-    corpus: Option<&std::path::Path>,
+    generated: Option<(&str, &std::path::Path)>,
 ) -> Result<std::path::PathBuf, String> {
     let mut cmd = cargo();
     cmd.args([
@@ -86,9 +92,9 @@ pub(crate) fn build_example_with_cfgs(
     for c in cfgs {
         cmd.args(["--cfg", c]);
     }
-    if let Some(path) = corpus {
-        cmd.args(["--cfg", "scanline3d_corpus"]);
-        cmd.env("SCANLINE3D_CORPUS", path);
+    if let Some((cfg, path)) = generated {
+        cmd.args(["--cfg", cfg]);
+        cmd.env(cfg.to_uppercase(), path);
     }
     // A target build shares the target directory of `build_firmware_examples`, whose
     // dependencies are then already compiled for that target and profile.
@@ -317,7 +323,7 @@ pub fn tradeoff() -> Result<(), String> {
     std::fs::write(&corpus_file, corpus).map_err(|e| e.to_string())?;
 
     step("host hashes of the trade-off example (demo orbit and corpus)");
-    let host_elf = build_example_with_cfgs("tradeoff", None, &[], Some(&corpus_file))?;
+    let host_elf = build_example_with_cfgs("tradeoff", None, &[], Some((CORPUS, &corpus_file)))?;
     let host = Command::new(&host_elf)
         .output()
         .map_err(|e| e.to_string())?;
@@ -346,8 +352,12 @@ pub fn tradeoff() -> Result<(), String> {
 
             // The same variant over every corpus view (a separate image: the corpus data would
             // swamp the flash figure).
-            let elf =
-                build_example_with_cfgs("tradeoff", Some(target), &[variant], Some(&corpus_file))?;
+            let elf = build_example_with_cfgs(
+                "tradeoff",
+                Some(target),
+                &[variant],
+                Some((CORPUS, &corpus_file)),
+            )?;
             let out = run_on_qemu(target, &elf)?;
             let mine: Vec<_> = corpus_frames(&out)
                 .into_iter()

@@ -9,9 +9,9 @@ pub use teapot::MODEL;
 
 use embedded_graphics::pixelcolor::Rgb565;
 use scanline3d::patch::{PatchScene, PatchStats, PatchWorkspace, Tolerance};
-use scanline3d::scene::{Camera, Light, SceneError, Transform};
-use scanline3d::sink::RowSink;
-use scanline3d::{Flat, RenderOptions};
+use scanline3d::scene::{Camera, Instance, Light, Mesh, Scene, SceneError, Transform};
+use scanline3d::sink::{RowPixel, RowSink};
+use scanline3d::{Flat, FrameStats, RenderOptions, Workspace};
 
 /// Side of the square panel.
 pub const SIDE: usize = 240;
@@ -25,17 +25,44 @@ pub const SUBS: usize = 512;
 pub const ACTIVE: usize = 2048;
 
 /// The workspace the firmware uses: RGB565 rows of [`SIDE`] pixels, flat shading.
-pub type PanelPatches = PatchWorkspace<Rgb565, Flat, SIDE, SIDE, SUBS, ACTIVE>;
+pub type PanelPatches = PanelPatchesOf<Rgb565>;
+/// [`PanelPatches`] for another pixel type (the host renders ids through it).
+pub type PanelPatchesOf<P> = PatchWorkspace<P, Flat, SIDE, SIDE, SUBS, ACTIVE>;
+
+/// The frames the patch firmware draws (every eighth of the turn).
+pub const FIRMWARE_FRAMES: [u32; 3] = [0, 8, 16];
+
+/// Triangles that may be active at once when a tessellated teapot mesh is drawn instead
+/// (`cargo xtask patch-trade` compares the two; its finest mesh, 65,280 triangles, needs
+/// about 620).
+pub const MESH_ACTIVE: usize = 1024;
+
+/// A mesh workspace for the same panel: `TRIS` triangles, [`MESH_ACTIVE`] active.
+pub type PanelMesh<P, const TRIS: usize> = Workspace<P, Flat, SIDE, SIDE, TRIS, MESH_ACTIVE>;
+
+/// The angle (radians about z) of `frame` (modulo [`FRAMES`]).
+pub fn angle(frame: u32) -> f32 {
+    core::f32::consts::TAU * (frame % FRAMES) as f32 / FRAMES as f32
+}
+
+/// The camera: above the teapot's spout side.
+pub fn camera() -> Result<Camera, SceneError> {
+    Camera::look_at([4.5, -6.0, 4.0], [0.0, 0.0, 1.2], [0.0, 0.0, 1.0])?
+        .perspective(45.0, 0.1, 100.0)
+}
+
+/// The light.
+pub fn light() -> Result<Light, SceneError> {
+    Light::new([0.4, -0.6, 1.0], 0.2, 0.8)
+}
 
 /// The teapot turned to `frame` (modulo [`FRAMES`]), seen from above its spout side.
 pub fn scene(frame: u32) -> Result<PatchScene<'static>, SceneError> {
-    let angle = core::f32::consts::TAU * (frame % FRAMES) as f32 / FRAMES as f32;
     Ok(PatchScene {
         model: &MODEL,
-        transform: Transform::rotation_z(angle),
-        camera: Camera::look_at([4.5, -6.0, 4.0], [0.0, 0.0, 1.2], [0.0, 0.0, 1.0])?
-            .perspective(45.0, 0.1, 100.0)?,
-        light: Light::new([0.4, -0.6, 1.0], 0.2, 0.8)?,
+        transform: Transform::rotation_z(angle(frame)),
+        camera: camera()?,
+        light: light()?,
     })
 }
 
@@ -47,8 +74,40 @@ pub fn render_frame<S: RowSink<Rgb565>>(
     frame: u32,
     sink: &mut S,
 ) -> Result<PatchStats, &'static str> {
+    render_frame_at(ws, frame, TOLERANCE, sink)
+}
+
+/// [`render_frame`] at another flatness `tolerance`, into any pixel type (an id image on the
+/// host: [`TriangleId`](scanline3d::sink::TriangleId) pixels are patch indices).
+pub fn render_frame_at<P: RowPixel, S: RowSink<P>>(
+    ws: &mut PanelPatchesOf<P>,
+    frame: u32,
+    tolerance: Tolerance,
+    sink: &mut S,
+) -> Result<PatchStats, &'static str> {
     let scene = scene(frame).map_err(|_| "scene")?;
     let options = RenderOptions::default().with_back_face_culling(false);
-    ws.render(&scene, &options, TOLERANCE, sink)
+    ws.render(&scene, &options, tolerance, sink)
         .map_err(|_| "render")
+}
+
+/// Draws `mesh` (a tessellation of the teapot) in place of the patches: the same turn,
+/// camera and light, two-sided.
+pub fn render_mesh_frame<P: RowPixel, S: RowSink<P>, const TRIS: usize>(
+    ws: &mut PanelMesh<P, TRIS>,
+    mesh: &Mesh<'_>,
+    frame: u32,
+    sink: &mut S,
+) -> Result<FrameStats, &'static str> {
+    let instances = [Instance {
+        mesh,
+        transform: Transform::rotation_z(angle(frame)),
+    }];
+    let scene = Scene {
+        instances: &instances,
+        camera: camera().map_err(|_| "scene")?,
+        light: light().map_err(|_| "scene")?,
+    };
+    let options = RenderOptions::default().with_back_face_culling(false);
+    ws.render(&scene, &options, sink).map_err(|_| "render")
 }
