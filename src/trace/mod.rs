@@ -45,14 +45,16 @@
 
 pub mod bvh;
 pub mod grid;
+pub mod hybrid;
 pub mod intersect;
 pub mod scene;
 pub mod shape;
 pub mod tracer;
 pub mod vector;
 
+pub use hybrid::ScreenBound;
 pub use intersect::Ray;
 pub use scene::{Colour, Light, LightKind, Material, Scene, TraceCamera, TraceSceneError};
 pub use shape::{Object, Plane, Polygon, Shape, ShapeError, Sphere, Triangle};
-pub use tracer::{PixelTrace, TraceError, TraceOptions, TraceStats, Tracer};
+pub use tracer::{PixelTrace, ShadowCache, TraceError, TraceOptions, TraceStats, Tracer};
 pub use vector::Vec3;
