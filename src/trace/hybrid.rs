@@ -137,11 +137,18 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                         Some(full)
                     } else {
                         // `as` saturates; truncation towards zero is inside the margin.
-                        let (x0, x1) = (x.0 as i32 - MARGIN, x.1 as i32 + MARGIN);
-                        let (y0, y1) = (y.0 as i32 - MARGIN, y.1 as i32 + MARGIN);
+                        let (x0, x1) = (
+                            (x.0 as i32).saturating_sub(MARGIN),
+                            (x.1 as i32).saturating_add(MARGIN),
+                        );
+                        let (y0, y1) = (
+                            (y.0 as i32).saturating_sub(MARGIN),
+                            (y.1 as i32).saturating_add(MARGIN),
+                        );
                         let (wi, hi) = (i32::from(w), i32::from(h));
                         (x1 >= 0 && y1 >= 0 && x0 < wi && y0 < hi).then(|| {
-                            let clamp = |v: i32, n: i32| v.clamp(0, n - 1) as u16;
+                            // max/min, not clamp: clamp's check for an empty range would link a panic.
+                            let clamp = |v: i32, n: i32| v.max(0).min(n - 1) as u16;
                             (clamp(x0, wi), clamp(x1, wi), clamp(y0, hi), clamp(y1, hi))
                         })
                     }

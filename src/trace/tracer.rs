@@ -4,7 +4,7 @@
 //! ## The shading model (the same as `sim`'s f64 reference)
 //!
 //! A ray's colour is the background if it hits nothing with `t ≥` [`EPSILON`] (primary rays:
-//! eye depth in `[near, far)`); otherwise the local term `KA·C·ambient + Σ KD·max(0, N·L)·C·I`
+//! eye depth in `[near, far)`; of equal `t` the smaller id wins); otherwise the local term `KA·C·ambient + Σ KD·max(0, N·L)·C·I`
 //! over the lights whose shadow ray reaches them unblocked (any object hit with
 //! `EPSILON ≤ t <` the light's distance blocks it), plus `KR·colour(R)` and `KT·colour(T)`.
 //! N faces the incoming ray; `R = d − 2(N·d)N`; `T` follows Snell's law from IOR 1 into the
