@@ -263,3 +263,77 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         Ok(stats)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trace::scene::{Colour, Material, Scene, TraceCamera};
+    use crate::trace::shape::{Object, Plane, Shape, Sphere};
+    use crate::trace::tracer::TraceOptions;
+    use fixed::types::I16F16;
+
+    fn v(x: f64, y: f64, z: f64) -> Vec3 {
+        let f = I16F16::from_num;
+        Vec3 {
+            x: f(x),
+            y: f(y),
+            z: f(z),
+        }
+    }
+
+    #[test]
+    fn screen_bounds_cover_what_is_seen_and_drop_what_is_behind() {
+        let sphere = |c: Vec3| Object {
+            shape: Shape::Sphere(Sphere::new(c, I16F16::ONE).unwrap()),
+            material: 0,
+        };
+        let objects = [
+            sphere(v(0.0, 0.0, 0.0)),  // in front, centred
+            sphere(v(0.0, 0.0, 20.0)), // behind the eye
+            sphere(v(40.0, 0.0, 0.0)), // off screen to the right
+            Object {
+                shape: Shape::Plane(Plane::new(v(0.0, 1.0, 0.0), I16F16::from_num(2)).unwrap()),
+                material: 0,
+            },
+        ];
+        let grey = Colour::new([I16F16::from_num(0.5); 3]).unwrap();
+        let materials = [Material::new(grey, [I16F16::ONE; 4], I16F16::ONE).unwrap()];
+        let scene = Scene::new(&objects, &materials, &[], Colour::BLACK, I16F16::ZERO).unwrap();
+        let camera = TraceCamera::new(
+            [0.0, 0.0, 5.0],
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            60.0,
+            0.1,
+            100.0,
+            40,
+            30,
+        )
+        .unwrap();
+        let tracer = Tracer::<4>::new(&scene, &camera, TraceOptions::default());
+        let mut bounds = [ScreenBound::default(); 4];
+        let (used, complete) = tracer.screen_bounds(&mut bounds);
+        assert!(complete);
+        assert_eq!(used, 2, "{bounds:?}");
+        let ball = bounds.iter().find(|b| b.object == 0).unwrap();
+        // The unit sphere at distance 5 under a 60° view 30 pixels high spans about 6 rows
+        // around the centre (radius · 15 / (5 · tan 30°) ≈ 5.2 pixels each way).
+        assert!(
+            ball.x0 <= 14 && ball.x1 >= 25 && ball.y0 <= 9 && ball.y1 >= 20,
+            "{ball:?}"
+        );
+        assert!(ball.x0 >= 8 && ball.x1 <= 31, "{ball:?}");
+        let plane = bounds.iter().find(|b| b.object == 3).unwrap();
+        assert_eq!((plane.x0, plane.x1, plane.y0, plane.y1), (0, 39, 0, 29));
+        // Each pixel the pure tracer sees the sphere in lies inside its rectangle.
+        for y in 0..30u16 {
+            for x in 0..40u16 {
+                if tracer.trace_pixel(x, y).0.id == Some(0) {
+                    assert!((ball.x0..=ball.x1).contains(&x) && (ball.y0..=ball.y1).contains(&y));
+                }
+            }
+        }
+        let mut small = [ScreenBound::default(); 1];
+        assert_eq!(tracer.screen_bounds(&mut small), (1, false));
+    }
+}
