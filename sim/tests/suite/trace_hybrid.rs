@@ -183,3 +183,32 @@ fn sim_trace_renders_in_hybrid_mode() {
     assert_eq!((ids, shadow, png), (pure_ids, pure_shadow, pure_png));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The method table's traced scene (100 triangles, 240×240: about 7 s in debug): the hybrid
+/// variant gives the frame of the variant with shadows, as `cargo xtask hsr-table` and its
+/// firmware run them.
+#[test]
+fn the_method_tables_hybrid_frame_is_the_shadow_frame() {
+    use scanline3d_sim::hsr::traced::{self, Variant};
+    use scanline3d_sim::scene::SceneSpec;
+    let mut buffers = Box::new(traced::Buffers::new().unwrap());
+    SceneSpec::hsr(0)
+        .unwrap()
+        .with_scene(|scene| buffers.fill(scene))
+        .unwrap()
+        .unwrap();
+    let mut frame = |variant| {
+        let mut sink = HashSink::new();
+        let stats = buffers
+            .with_tracer(variant, |t, h| {
+                traced::frame(t, h, Rgb565::new(0, 0, 0), &mut sink)
+            })
+            .unwrap()
+            .unwrap();
+        (sink.hash(), stats)
+    };
+    let (shadows, s) = frame(Variant::Shadows);
+    let (hybrid, h) = frame(Variant::Hybrid);
+    assert_eq!(shadows, hybrid);
+    assert_eq!((s.rays(), h.fallback_rows), (h.rays(), 0));
+}
