@@ -62,13 +62,14 @@ fn main() -> Result<(), String> {
     for level in 0..traced::TRACED_LEVELS {
         let mut buffers = Box::new(traced::Buffers::new()?);
         SceneSpec::hsr(level)?.with_scene(|scene| buffers.fill(scene))??;
-        for (variant, shadows) in [("primary", false), ("shadows", true)] {
+        for v in traced::Variant::ALL {
+            let variant = v.name();
             let start = Instant::now();
             let mut frames = 0u32;
             let elapsed = loop {
                 let mut sink = HashSink::new();
                 buffers
-                    .with_tracer(shadows, |t| traced::frame(t, Rgb565::BLACK, &mut sink))?
+                    .with_tracer(v, |t, h| traced::frame(t, h, Rgb565::BLACK, &mut sink))?
                     .map_err(|e| format!("{e:?}"))?;
                 frames += 1;
                 let elapsed = start.elapsed();
@@ -257,13 +258,13 @@ mod firmware {
             let mark = counter::start();
             buffers.fill(&scene)?;
             let build = counter::instructions(&mark);
-            for shadows in [false, true] {
+            for variant in hsr::traced::Variant::ALL {
                 let mut sink = HashSink::new();
                 let top = arch::sp();
                 measure::paint_stack();
-                let (stats, instructions) = buffers.with_tracer(shadows, |tracer| {
+                let (stats, instructions) = buffers.with_tracer(variant, |tracer, hybrid| {
                     let mark = counter::start();
-                    let stats = hsr::traced::frame(tracer, Rgb565::BLACK, &mut sink);
+                    let stats = hsr::traced::frame(tracer, hybrid, Rgb565::BLACK, &mut sink);
                     (stats, counter::instructions(&mark))
                 })?;
                 let stack = top - measure::stack_low_water();
@@ -273,12 +274,12 @@ mod firmware {
                 }
                 println!(
                     "trace variant {} polygons {} instructions {} hash {:08x} build_instructions {} scene_bytes {} render_stack {} rays {} tests {} box_tests {}",
-                    if shadows { "shadows" } else { "primary" },
+                    variant.name(),
                     hsr::LEVELS[level].polygons,
                     instructions,
                     sink.hash(),
                     build,
-                    buffers.bytes_used(),
+                    buffers.bytes_used(variant),
                     stack,
                     stats.rays(),
                     stats.intersection_tests,

@@ -18,7 +18,8 @@
 //! scene and camera set-up, every intersection test, shadows, reflection, refraction and the
 //! ray stack, with a stack too small for the depth limit so the overflow path is linked too,
 //! without and with a bounding-volume hierarchy (exported, and built at run time) and with a
-//! uniform grid built at run time. And it runs the fixed-point metaball ray caster and the
+//! uniform grid built at run time, and in hybrid mode (screen bounds, active list, their
+//! overflow). And it runs the fixed-point metaball ray caster and the
 //! metaball polygonizer with the span z-buffer drawing its mesh (`scanline3d::metaball`), and
 //! the scanline Bezier patch renderer (`scanline3d::patch`, flat and Gouraud, with and without
 //! culling, with a subdivision buffer that overflows).
@@ -165,6 +166,20 @@ mod firmware {
                 let stats =
                     Tracer::<STACK>::new(&with_bvh, &camera, options).render(&mut row, sink);
                 black_box(&stats);
+                // Hybrid mode, with room for every object and with buffers that overflow.
+                use scanline3d::trace::ScreenBound;
+                let mut bounds = [ScreenBound::default(); super::classic::OBJECTS.len()];
+                let mut active = [ScreenBound::default(); super::classic::OBJECTS.len()];
+                let n = black_box(super::classic::OBJECTS.len());
+                for (b, a) in [(n, n), (n, 3), (2, n)] {
+                    let stats = Tracer::<STACK>::new(&with_bvh, &camera, options).render_hybrid(
+                        bounds.get_mut(..b).unwrap_or(&mut []),
+                        active.get_mut(..a).unwrap_or(&mut []),
+                        &mut row,
+                        sink,
+                    );
+                    black_box(&stats);
+                }
             }
             let mut nodes = [scanline3d::trace::bvh::BvhNode {
                 min: scanline3d::trace::Vec3::ZERO,

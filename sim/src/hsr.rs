@@ -212,9 +212,37 @@ pub mod traced {
     use scanline3d::sink::{RowPixel, RowSink};
     use scanline3d::trace::bvh::{self, BvhNode};
     use scanline3d::trace::{
-        Colour, Light, Material, Object, Scene as TracedScene, Shape, TraceCamera, TraceError,
-        TraceOptions, TraceStats, Tracer, Triangle, Vec3,
+        Colour, Light, Material, Object, Scene as TracedScene, ScreenBound, Shape, TraceCamera,
+        TraceError, TraceOptions, TraceStats, Tracer, Triangle, Vec3,
     };
+
+    /// What a traced row of the table runs.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+    pub enum Variant {
+        /// Primary rays only (no light).
+        Primary,
+        /// Primary rays and a shadow ray per lit pixel.
+        Shadows,
+        /// As `Shadows`, primary visibility in hybrid mode (the objects' screen bounds).
+        Hybrid,
+    }
+
+    impl Variant {
+        /// Every variant, in table order.
+        pub const ALL: [Variant; 3] = [Variant::Primary, Variant::Shadows, Variant::Hybrid];
+
+        /// The name in the firmware's lines.
+        pub fn name(self) -> &'static str {
+            match self {
+                Variant::Primary => "primary",
+                Variant::Shadows => "shadows",
+                Variant::Hybrid => "hybrid",
+            }
+        }
+    }
+
+    /// Hybrid mode's buffers: screen bounds and active list, one entry per object each.
+    pub type HybridBuffers<'b> = Option<(&'b mut [ScreenBound], &'b mut [ScreenBound])>;
 
     /// Levels the tracer runs at: the first two. At 60,000 triangles the traced objects (60
     /// bytes each, vertices inline) and their hierarchy need about 7 MB, more than the QEMU
@@ -233,6 +261,8 @@ pub mod traced {
         materials: [Material; CAPACITY],
         nodes: [BvhNode; 2 * CAPACITY],
         items: [u32; CAPACITY],
+        bounds: [ScreenBound; CAPACITY],
+        active: [ScreenBound; CAPACITY],
         len: usize,
         bounded: usize,
         nodes_used: usize,
@@ -287,6 +317,8 @@ pub mod traced {
                     CAPACITY],
                 nodes: [node; 2 * CAPACITY],
                 items: [0; CAPACITY],
+                bounds: [ScreenBound::default(); CAPACITY],
+                active: [ScreenBound::default(); CAPACITY],
                 len: 0,
                 bounded: 0,
                 nodes_used: 0,
@@ -339,20 +371,31 @@ pub mod traced {
             Ok(())
         }
 
-        /// Bytes the filled buffers use: objects, materials, nodes and items.
-        pub fn bytes_used(&self) -> usize {
-            self.len * (core::mem::size_of::<Object<'static>>() + core::mem::size_of::<Material>())
+        /// Bytes the filled buffers use for `variant`: objects, materials, nodes and items, and
+        /// in hybrid mode the screen bounds and active list.
+        pub fn bytes_used(&self, variant: Variant) -> usize {
+            let hybrid = if variant == Variant::Hybrid {
+                2 * core::mem::size_of::<ScreenBound>()
+            } else {
+                0
+            };
+            self.len
+                * (core::mem::size_of::<Object<'static>>()
+                    + core::mem::size_of::<Material>()
+                    + hybrid)
                 + self.nodes_used * core::mem::size_of::<BvhNode>()
                 + self.items_used * core::mem::size_of::<u32>()
         }
 
         /// Calls `f` with a tracer over the filled buffers: the table's camera, ambient level
-        /// and, if `shadows`, its light (else no light: primary rays only).
+        /// and, but for [`Variant::Primary`], its light (else no light: primary rays only); for
+        /// [`Variant::Hybrid`] `f` gets the hybrid mode's buffers too.
         pub fn with_tracer<R>(
-            &self,
-            shadows: bool,
-            f: impl FnOnce(&Tracer<'_, '_, STACK>) -> R,
+            &mut self,
+            variant: Variant,
+            f: impl FnOnce(&Tracer<'_, '_, STACK>, HybridBuffers<'_>) -> R,
         ) -> Result<R, &'static str> {
+            let shadows = variant != Variant::Primary;
             let (eye, target, up, fovy, near, far) = CAMERA;
             let f64s = |v: [f32; 3]| v.map(f64::from);
             let camera = TraceCamera::new(
@@ -389,18 +432,31 @@ pub mod traced {
             )
             .map_err(|_| "hierarchy rejected")?;
             let tracer = Tracer::<STACK>::new(&scene, &camera, TraceOptions::default());
-            Ok(f(&tracer))
+            let hybrid = match (
+                self.bounds.get_mut(..self.len),
+                self.active.get_mut(..self.len),
+            ) {
+                (Some(bounds), Some(active)) if variant == Variant::Hybrid => {
+                    Some((bounds, active))
+                }
+                _ => None,
+            };
+            Ok(f(&tracer, hybrid))
         }
     }
 
     /// One traced frame into `sink` through a row of `P` (`background` only fills the row
-    /// buffer before the first row is traced).
+    /// buffer before the first row is traced), in hybrid mode when given its buffers.
     pub fn frame<P: RowPixel, K: RowSink<P>>(
         tracer: &Tracer<'_, '_, STACK>,
+        hybrid: HybridBuffers<'_>,
         background: P,
         sink: &mut K,
     ) -> Result<TraceStats, TraceError<K::Error>> {
         let mut row = [background; WIDTH];
-        tracer.render(&mut row, sink)
+        match hybrid {
+            Some((bounds, active)) => tracer.render_hybrid(bounds, active, &mut row, sink),
+            None => tracer.render(&mut row, sink),
+        }
     }
 }

@@ -79,6 +79,9 @@ enum TraceRenderer {
     Reference,
     /// The library's fixed-point tracer (`scanline3d::trace`), what the firmware runs.
     Fixed,
+    /// The library's tracer in hybrid mode: primary visibility from the objects' screen
+    /// bounds (a scanline pass, no hierarchy walk per pixel), then the same secondary rays.
+    Hybrid,
 }
 
 /// Which acceleration structure the reference tracer uses.
@@ -1013,8 +1016,9 @@ fn trace(a: TraceArgs) -> Result<(), String> {
             );
             (image.color, image.ids, image.depth, image.shadow, summary)
         }
-        TraceRenderer::Fixed => {
+        TraceRenderer::Fixed | TraceRenderer::Hybrid => {
             use scanline3d_sim::trace::fixed;
+            let hybrid = a.renderer == TraceRenderer::Hybrid;
             let scene = fixed::FixedScene::new(&traced)?;
             let f = fixed::render(
                 &scene,
@@ -1027,20 +1031,24 @@ fn trace(a: TraceArgs) -> Result<(), String> {
                     TraceAccel::Bvh | TraceAccel::Both => fixed::Accel::Bvh,
                     TraceAccel::Grid => fixed::Accel::Grid,
                 },
+                hybrid,
             )?;
             let s = &f.stats;
             let summary = format!(
-                "{} objects, {} lights; fixed-point tracer: rays: {} primary, {} secondary, {} shadow; tests per ray ({:?}): {:.2} objects, {:.2} boxes, {:.2} grid cells; {} rays dropped (stack full)",
+                "{} objects, {} lights; fixed-point tracer{}: rays: {} primary, {} secondary, {} shadow ({} answered by the shadow cache); tests per ray ({:?}): {:.2} objects, {:.2} boxes, {:.2} grid cells; {} rays dropped (stack full); {} rows fell back to the pure primary search",
                 traced.objects.len(),
                 traced.lights.len(),
+                if hybrid { " (hybrid)" } else { "" },
                 s.primary_rays,
                 s.secondary_rays,
                 s.shadow_rays,
+                s.shadow_cache_hits,
                 a.accel,
                 f64::from(s.intersection_tests) / f64::from(s.rays().max(1)),
                 f64::from(s.box_tests) / f64::from(s.rays().max(1)),
                 f64::from(s.grid_cells) / f64::from(s.rays().max(1)),
-                s.dropped_rays
+                s.dropped_rays,
+                s.fallback_rows
             );
             (f.colour, f.ids, f.depth, f.shadow, summary)
         }

@@ -230,10 +230,10 @@ pub fn build(
 }
 
 /// Heapsort of `v` by `key`: in place, O(n log n), and without the panic that core's sorts keep
-/// for a key that is not a total order (ours are `(i32, u32)` pairs).
-fn heap_sort_by_key<K: Ord>(v: &mut [u32], key: impl Fn(u32) -> K) {
-    let k = |v: &[u32], i: usize| v.get(i).map(|x| key(*x));
-    let sift_down = |v: &mut [u32], mut root: usize, end: usize| loop {
+/// for a key that is not a total order (ours are integer tuples).
+pub(crate) fn heap_sort_by_key<T: Copy, K: Ord>(v: &mut [T], key: impl Fn(T) -> K) {
+    let k = |v: &[T], i: usize| v.get(i).map(|x| key(*x));
+    let sift_down = |v: &mut [T], mut root: usize, end: usize| loop {
         let mut child = 2 * root + 1;
         if child >= end {
             break;

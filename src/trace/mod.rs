@@ -5,7 +5,8 @@
 //! [`vector`] (I16F16 vectors, integer square root) → [`shape`] (primitives, validated) →
 //! [`intersect`] (ray–primitive tests) → [`bvh`] (bounding volumes, built into caller buffers
 //! or exported as `static` data) → [`scene`] (materials, lights, camera) → [`tracer`] (the ray
-//! tree on an explicit stack, shading, rows).
+//! tree on an explicit stack, shading, rows, the shadow cache) → [`hybrid`] (primary visibility
+//! from the objects' screen bounds instead of a walk per pixel).
 //!
 //! ## Envelope and bit budget
 //!
@@ -45,14 +46,16 @@
 
 pub mod bvh;
 pub mod grid;
+pub mod hybrid;
 pub mod intersect;
 pub mod scene;
 pub mod shape;
 pub mod tracer;
 pub mod vector;
 
+pub use hybrid::ScreenBound;
 pub use intersect::Ray;
 pub use scene::{Colour, Light, LightKind, Material, Scene, TraceCamera, TraceSceneError};
 pub use shape::{Object, Plane, Polygon, Shape, ShapeError, Sphere, Triangle};
-pub use tracer::{PixelTrace, TraceError, TraceOptions, TraceStats, Tracer};
+pub use tracer::{PixelTrace, ShadowCache, TraceError, TraceOptions, TraceStats, Tracer};
 pub use vector::Vec3;

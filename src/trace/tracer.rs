@@ -4,7 +4,7 @@
 //! ## The shading model (the same as `sim`'s f64 reference)
 //!
 //! A ray's colour is the background if it hits nothing with `t ≥` [`EPSILON`] (primary rays:
-//! eye depth in `[near, far)`); otherwise the local term `KA·C·ambient + Σ KD·max(0, N·L)·C·I`
+//! eye depth in `[near, far)`; of equal `t` the smaller id wins); otherwise the local term `KA·C·ambient + Σ KD·max(0, N·L)·C·I`
 //! over the lights whose shadow ray reaches them unblocked (any object hit with
 //! `EPSILON ≤ t <` the light's distance blocks it), plus `KR·colour(R)` and `KT·colour(T)`.
 //! N faces the incoming ray; `R = d − 2(N·d)N`; `T` follows Snell's law from IOR 1 into the
@@ -27,7 +27,7 @@
 use crate::depth::DepthRow;
 use crate::sink::{Row, RowPixel, RowSink};
 use crate::trace::intersect::{reflect, Ray};
-use crate::trace::scene::{Colour, LightKind, Scene, TraceCamera};
+use crate::trace::scene::{Colour, LightKind, Scene, TraceCamera, MAX_LIGHTS};
 use crate::trace::vector::{mul, narrow_bits, sqrt, Vec3};
 use embedded_graphics::pixelcolor::Rgb888;
 use fixed::types::{I16F16, I32F32};
@@ -77,6 +77,12 @@ pub struct TraceStats {
     pub grid_cells: u32,
     /// Secondary rays not traced because the ray stack was full (0 when `STACK > max_depth`).
     pub dropped_rays: u32,
+    /// Shadow rays answered by the shadow cache: the object that blocked the previous shadow
+    /// ray towards the same light blocked this one too (one test instead of a walk).
+    pub shadow_cache_hits: u32,
+    /// Hybrid mode: rows whose primary visibility fell back to the pure tracer's search because
+    /// the screen-bound buffer or the active list was full (same image, more work).
+    pub fallback_rows: u16,
     /// Most pending rays on the stack at once.
     pub peak_stack: u16,
     /// Rows handed to the sink.
@@ -89,7 +95,8 @@ impl TraceStats {
         self.primary_rays + self.secondary_rays + self.shadow_rays
     }
 
-    fn add(&mut self, o: &TraceStats) {
+    /// Adds `o`'s counts to these (the peak stack is the larger of the two).
+    pub fn add(&mut self, o: &TraceStats) {
         self.primary_rays += o.primary_rays;
         self.secondary_rays += o.secondary_rays;
         self.shadow_rays += o.shadow_rays;
@@ -97,6 +104,8 @@ impl TraceStats {
         self.box_tests += o.box_tests;
         self.grid_cells += o.grid_cells;
         self.dropped_rays += o.dropped_rays;
+        self.shadow_cache_hits += o.shadow_cache_hits;
+        self.fallback_rows += o.fallback_rows;
         self.peak_stack = self.peak_stack.max(o.peak_stack);
     }
 }
@@ -135,9 +144,85 @@ struct Pending {
 
 /// The nearest hit along a ray.
 #[derive(Clone, Copy, Debug)]
-struct Hit {
+pub(crate) struct Hit {
     t: I16F16,
     object: u32,
+}
+
+/// The nearest-hit search over the objects a ray is offered: the smallest `t` wins and equal
+/// `t` go to the smaller id (the f64 reference's rule), so the answer does not depend on the
+/// order objects are offered in: the hierarchy's, the grid's or the hybrid mode's.
+pub(crate) struct Nearest {
+    best: Option<Hit>,
+    t_min: I16F16,
+    t_max: I16F16,
+    from: u32,
+    tests: u32,
+}
+
+impl Nearest {
+    /// A search along a ray starting on object `from` (`u32::MAX`: none) over `[t_min, t_max)`.
+    pub(crate) fn new(from: u32, t_min: I16F16, t_max: I16F16) -> Nearest {
+        Nearest {
+            best: None,
+            t_min,
+            t_max,
+            from,
+            tests: 0,
+        }
+    }
+
+    /// The exclusive bound an object's `t` must stay below to matter: `t_max`, or once
+    /// something is hit one step above its `t` (a tie may still win on its id).
+    pub(crate) fn limit(&self) -> I16F16 {
+        self.best.map_or(self.t_max, |b| {
+            b.t.saturating_add(I16F16::DELTA).min(self.t_max)
+        })
+    }
+
+    /// Tests object `id` of `scene` and keeps it if it is nearer; returns the new limit.
+    pub(crate) fn offer(&mut self, scene: &Scene<'_>, id: u32, ray: &Ray) -> I16F16 {
+        self.tests += 1;
+        let limit = self.limit();
+        let t = scene.objects.get(id as usize).and_then(|object| {
+            if id == self.from {
+                object.shape.hit_from_surface(ray, self.t_min, limit)
+            } else {
+                object.shape.hit(ray, self.t_min, limit)
+            }
+        });
+        if let Some(t) = t {
+            if self.best.is_none_or(|b| t < b.t || id < b.object) {
+                self.best = Some(Hit { t, object: id });
+            }
+        }
+        self.limit()
+    }
+
+    /// The nearest hit found; adds the tests made to `stats`.
+    pub(crate) fn finish(self, stats: &mut TraceStats) -> Option<Hit> {
+        stats.intersection_tests += self.tests;
+        self.best
+    }
+}
+
+/// Per light, the object that blocked the last shadow ray towards it (`u32::MAX`: none yet):
+/// a shadow ray tests that object first (Haines and Greenberg's shadow cache), and if it blocks
+/// the answer is the same "blocked" a full search gives, at one test. It changes no pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadowCache([u32; MAX_LIGHTS]);
+
+impl ShadowCache {
+    /// An empty cache.
+    pub const fn new() -> ShadowCache {
+        ShadowCache([u32::MAX; MAX_LIGHTS])
+    }
+}
+
+impl Default for ShadowCache {
+    fn default() -> Self {
+        ShadowCache::new()
+    }
 }
 
 /// A Whitted tracer over one scene and camera whose ray stack holds `STACK` pending rays
@@ -170,10 +255,11 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             return Err(TraceError::RowLength);
         }
         let mut stats = TraceStats::default();
+        let mut cache = ShadowCache::new();
         for y in 0..self.camera.height {
             let dropped_before = stats.dropped_rays;
             for (x, pixel) in (0..self.camera.width).zip(row.iter_mut()) {
-                let (p, s) = self.trace_pixel(x, y);
+                let (p, s) = self.trace_pixel_cached(x, y, &mut cache);
                 stats.add(&s);
                 *pixel = P::from_shade(p.colour, p.id.unwrap_or(u32::MAX));
             }
@@ -192,6 +278,41 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     /// Traces the pixel (`column`, `row`): its colour, primary id, depth and shadow mask, and
     /// what it cost.
     pub fn trace_pixel(&self, column: u16, row: u16) -> (PixelTrace, TraceStats) {
+        self.trace_pixel_cached(column, row, &mut ShadowCache::new())
+    }
+
+    /// [`trace_pixel`](Self::trace_pixel) with a shadow cache kept from pixel to pixel (what
+    /// [`render`](Self::render) does: same result, fewer tests).
+    pub fn trace_pixel_cached(
+        &self,
+        column: u16,
+        row: u16,
+        cache: &mut ShadowCache,
+    ) -> (PixelTrace, TraceStats) {
+        self.trace_with(column, row, cache, |ray, t_min, t_max, stats| {
+            self.nearest(ray, u32::MAX, t_min, t_max, stats)
+        })
+    }
+
+    /// The scene traced.
+    pub(crate) fn scene(&self) -> &'s Scene<'a> {
+        self.scene
+    }
+
+    /// The camera.
+    pub(crate) fn camera(&self) -> &'s TraceCamera {
+        self.camera
+    }
+
+    /// Traces pixel (`column`, `row`) with `first_hit` finding the primary ray's nearest hit in
+    /// `[t_min, t_max)`; everything after the primary hit is the same for every mode.
+    pub(crate) fn trace_with(
+        &self,
+        column: u16,
+        row: u16,
+        cache: &mut ShadowCache,
+        mut first_hit: impl FnMut(&Ray, I16F16, I16F16, &mut TraceStats) -> Option<Hit>,
+    ) -> (PixelTrace, TraceStats) {
         let mut stats = TraceStats {
             primary_rays: 1,
             ..TraceStats::default()
@@ -229,10 +350,15 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         ));
         while let Some((ray, (t_min, t_max))) = next.take() {
             let is_primary = ray.depth == 0;
-            match self.nearest(&ray.ray, ray.from, t_min, t_max, &mut stats) {
+            let hit = if is_primary {
+                first_hit(&ray.ray, t_min, t_max, &mut stats)
+            } else {
+                self.nearest(&ray.ray, ray.from, t_min, t_max, &mut stats)
+            };
+            match hit {
                 None => add_weighted(&mut sum, &self.scene.background, ray.weight),
                 Some(hit) => {
-                    let shadow = self.shade(&ray, hit, &mut sum, &mut stack, &mut stats);
+                    let shadow = self.shade(&ray, hit, &mut sum, &mut stack, cache, &mut stats);
                     if is_primary {
                         out.id = Some(hit.object);
                         out.depth = hit.t.checked_div(len).unwrap_or(I16F16::MAX);
@@ -257,42 +383,34 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         t_max: I16F16,
         stats: &mut TraceStats,
     ) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        let mut tests = 0;
-        let mut test = |id: u32, limit: I16F16| -> I16F16 {
-            tests += 1;
-            match self.hit(id, ray, from, t_min, limit) {
-                Some(t) => {
-                    best = Some(Hit { t, object: id });
-                    t
-                }
-                None => limit,
-            }
-        };
-        match (&self.scene.grid, &self.scene.bvh) {
+        let scene = self.scene;
+        let mut search = Nearest::new(from, t_min, t_max);
+        match (&scene.grid, &scene.bvh) {
             (Some(grid), _) => {
-                let mut limit = t_max;
                 for id in grid.unbounded() {
-                    limit = test(*id, limit);
+                    search.offer(scene, *id, ray);
                 }
-                stats.grid_cells += grid.walk(ray, t_min, limit, |id, limit| Some(test(id, limit)));
+                let limit = search.limit();
+                stats.grid_cells += grid.walk(ray, t_min, limit, |id, _| {
+                    Some(search.offer(scene, id, ray))
+                });
             }
             (None, None) => {
-                let mut limit = t_max;
-                for id in 0..self.scene.objects.len() as u32 {
-                    limit = test(id, limit);
+                for id in 0..scene.objects.len() as u32 {
+                    search.offer(scene, id, ray);
                 }
             }
             (None, Some(bvh)) => {
-                let mut limit = t_max;
                 for id in bvh.unbounded() {
-                    limit = test(*id, limit);
+                    search.offer(scene, *id, ray);
                 }
-                stats.box_tests += bvh.walk(ray, t_min, limit, |id, limit| Some(test(id, limit)));
+                let limit = search.limit();
+                stats.box_tests += bvh.walk(ray, t_min, limit, |id, _| {
+                    Some(search.offer(scene, id, ray))
+                });
             }
         }
-        stats.intersection_tests += tests;
-        best
+        search.finish(stats)
     }
 
     /// `t` of object `id` along `ray` (which starts on object `from`) in `[t_min, t_max)`.
@@ -307,38 +425,59 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     }
 
     /// Whether any object lies along `ray` (which starts on object `from`) with `t` in
-    /// `[EPSILON, t_max)`.
-    fn blocked(&self, ray: &Ray, from: u32, t_max: I16F16, stats: &mut TraceStats) -> bool {
-        let mut tests = 0;
+    /// `[EPSILON, t_max)`. `cached` is the light's entry in the shadow cache: tested first, and
+    /// set to the blocker found.
+    fn blocked(
+        &self,
+        ray: &Ray,
+        from: u32,
+        t_max: I16F16,
+        cached: &mut u32,
+        stats: &mut TraceStats,
+    ) -> bool {
+        let mut tests = 1;
+        if self.hit(*cached, ray, from, EPSILON, t_max).is_some() {
+            stats.intersection_tests += tests;
+            stats.shadow_cache_hits += 1;
+            return true;
+        }
+        let mut blocker = None;
         let mut blocks = |id: u32| {
             tests += 1;
-            self.hit(id, ray, from, EPSILON, t_max).is_some()
+            let hit = self.hit(id, ray, from, EPSILON, t_max).is_some();
+            if hit {
+                blocker = Some(id);
+            }
+            hit
         };
-        let blocked = match (&self.scene.grid, &self.scene.bvh) {
+        match (&self.scene.grid, &self.scene.bvh) {
             (Some(grid), _) => {
-                let mut found = grid.unbounded().iter().any(|id| blocks(*id));
-                if !found {
+                if !grid.unbounded().iter().any(|id| blocks(*id)) {
                     stats.grid_cells += grid.walk(ray, EPSILON, t_max, |id, limit| {
-                        found = blocks(id);
-                        (!found).then_some(limit)
+                        (!blocks(id)).then_some(limit)
                     });
                 }
-                found
             }
-            (None, None) => (0..self.scene.objects.len() as u32).any(&mut blocks),
+            (None, None) => {
+                let _ = (0..self.scene.objects.len() as u32).any(&mut blocks);
+            }
             (None, Some(bvh)) => {
-                let mut found = bvh.unbounded().iter().any(|id| blocks(*id));
-                if !found {
+                if !bvh.unbounded().iter().any(|id| blocks(*id)) {
                     stats.box_tests += bvh.walk(ray, EPSILON, t_max, |id, limit| {
-                        found = blocks(id);
-                        (!found).then_some(limit)
+                        (!blocks(id)).then_some(limit)
                     });
                 }
-                found
             }
-        };
-        stats.intersection_tests += tests;
-        blocked
+        }
+        // The cached object counts as a test only when it names one.
+        stats.intersection_tests += tests - u32::from(*cached == u32::MAX);
+        match blocker {
+            Some(id) => {
+                *cached = id;
+                true
+            }
+            None => false,
+        }
     }
 
     /// Adds the local term at `hit` times the ray's weight to `sum`, pushes the reflected and
@@ -349,6 +488,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         hit: Hit,
         sum: &mut Colour,
         stack: &mut heapless::Vec<Pending, STACK>,
+        cache: &mut ShadowCache,
         stats: &mut TraceStats,
     ) -> u8 {
         let scene = self.scene;
@@ -367,7 +507,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
 
         let mut diffuse = I16F16::ZERO; // Σ max(0, N·L)·I over unblocked lights
         let mut shadow = 0u8;
-        for (k, light) in scene.lights.iter().enumerate() {
+        for ((k, light), cached) in scene.lights.iter().enumerate().zip(cache.0.iter_mut()) {
             let (towards, distance) = match light.kind {
                 LightKind::Directional(d) => (d, I16F16::MAX),
                 LightKind::Point(p) => {
@@ -385,7 +525,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                     origin: point,
                     dir: towards,
                 };
-                !self.blocked(&shadow_ray, hit.object, distance, stats)
+                !self.blocked(&shadow_ray, hit.object, distance, cached, stats)
             };
             if lit {
                 diffuse = diffuse.saturating_add(mul(nl, light.intensity));

@@ -113,10 +113,10 @@ fn traced_on_host(run: &HsrHostRun) -> Result<Vec<TracedHost>, String> {
         let spec = &run.specs[level];
         let mut buffers = Box::new(traced::Buffers::new()?);
         spec.with_scene(|scene| buffers.fill(scene))??;
-        for (variant, shadows) in [("primary", false), ("shadows", true)] {
-            let mut sink = HashSink::new();
+        for v in traced::Variant::ALL {
+            let (variant, mut sink) = (v.name(), HashSink::new());
             buffers
-                .with_tracer(shadows, |t| traced::frame(t, Rgb565::BLACK, &mut sink))?
+                .with_tracer(v, |t, h| traced::frame(t, h, Rgb565::BLACK, &mut sink))?
                 .map_err(|e| format!("traced frame: {e:?}"))?;
             let mut image = Image {
                 width: WIDTH,
@@ -135,7 +135,7 @@ fn traced_on_host(run: &HsrHostRun) -> Result<Vec<TracedHost>, String> {
                 Ok::<(), std::convert::Infallible>(())
             });
             buffers
-                .with_tracer(shadows, |t| traced::frame(t, TriangleId::NONE, &mut ids))?
+                .with_tracer(v, |t, h| traced::frame(t, h, TriangleId::NONE, &mut ids))?
                 .map_err(|e| format!("traced id frame: {e:?}"))?;
             let (reference, ref_image) = &run.references[level];
             let bound = metrics::ErrorBound {
@@ -385,7 +385,7 @@ pub(crate) fn hsr_table() -> Result<(), String> {
             row.join(" | ")
         ));
     }
-    for variant in ["primary", "shadows"] {
+    for variant in scanline3d_sim::hsr::traced::Variant::ALL.map(|v| v.name()) {
         let mut cells = Vec::new();
         for level in hsr::LEVELS.iter() {
             let found = traced_rows
@@ -448,7 +448,7 @@ pub(crate) fn hsr_table() -> Result<(), String> {
     line(String::new());
     line("* **Instructions per frame:** the render call alone, counted on the firmware (`firmware/examples/hsr_table.rs`). **Triangles drawn:** set up for the row walk after culling and clipping. **Depth complexity:** fragments (pixel centres covered before the depth test) per pixel showing a triangle.".into());
     line("* **Workspace** is the method's `BYTES`, sized for the scene (`hsr::LEVELS`: triangles after culling, triangles per row); **render call stack** is the peak stack of the render call, measured by painting; **RAM** is their sum (the scene itself is in flash).".into());
-    line(format!("* **Ray tracing** is the library's fixed-point tracer (`scanline3d::trace`, [tracing.md](tracing.md)) over every triangle of the scene, no back faces culled, with a bounding-volume hierarchy: *ray casting* traces primary rays only (no light, so ambient colour), *with shadows* adds the light as a shadow ray per lit pixel and Lambert shading. Its **workspace** column holds the traced objects (60 B per triangle, vertices inline), a material per triangle and the hierarchy, built at run time in {} instructions at 2,500 polygons (not in the frame's count; `sim export` can build it on the host instead). At 60,000 polygons those would need about 7 MB, more than the QEMU board's 4 MiB of RAM or flash, so that level is not traced.", traced_rows.iter().find(|(t, _)| t.polygons == 2500).map_or(Ok("n/a".to_string()), |(_, f)| number(f, "build_instructions").map(thousands))?));
+    line(format!("* **Ray tracing** is the library's fixed-point tracer (`scanline3d::trace`, [tracing.md](tracing.md)) over every triangle of the scene, no back faces culled, with a bounding-volume hierarchy: *ray casting* traces primary rays only (no light, so ambient colour), *with shadows* adds the light as a shadow ray per lit pixel and Lambert shading, *hybrid mode* finds the primary hits from the triangles' screen bounds instead of a hierarchy walk per pixel (same frame hash; [tracing.md](tracing.md)). Its **workspace** column holds the traced objects (60 B per triangle, vertices inline), a material per triangle and the hierarchy (in hybrid mode also 24 B per triangle of screen bounds and active list), built at run time in {} instructions at 2,500 polygons (not in the frame's count; `sim export` can build it on the host instead). At 60,000 polygons those would need about 7 MB, more than the QEMU board's 4 MiB of RAM or flash, so that level is not traced.", traced_rows.iter().find(|(t, _)| t.polygons == 2500).map_or(Ok("n/a".to_string()), |(_, f)| number(f, "build_instructions").map(thousands))?));
     line("* **Id mismatches** are pixels whose triangle differs from the f64 ray-cast reference (`scanline3d_sim::metrics::compare`, host render through the same method); **real** ones are those not explained by the documented position error bound or a depth tie.".into());
     qualitative(
         &mut line,
@@ -510,10 +510,10 @@ fn micros(ns: Option<f64>) -> String {
 
 /// The table's name of a traced variant.
 fn traced_name(variant: &str) -> &'static str {
-    if variant == "shadows" {
-        "ray tracing with shadows"
-    } else {
-        "ray casting"
+    match variant {
+        "shadows" => "ray tracing with shadows",
+        "hybrid" => "ray tracing with shadows, hybrid mode",
+        _ => "ray casting",
     }
 }
 
@@ -610,7 +610,7 @@ pub(crate) fn qualitative<'f>(
             micros(traced_ns(t)),
             thousands(number(f, "scene_bytes")? + number(f, "render_stack")?),
             code_lines_or_err("ray tracing")?,
-            if t.variant == "shadows" { "yes: shadows here; reflection and refraction on the same code path (classic scene: [tracing.md](tracing.md))" } else { "yes, with secondary rays (not traced here)" },
+            if t.variant != "primary" { "yes: shadows here; reflection and refraction on the same code path (classic scene: [tracing.md](tracing.md))" } else { "yes, with secondary rays (not traced here)" },
         ));
     }
     line(format!(

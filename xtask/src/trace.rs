@@ -1,6 +1,6 @@
 //! `cargo xtask trace`: the fixed-point tracer's firmware (`firmware/examples/trace.rs`, the
-//! classic scene at 240×240) on QEMU for every target, with its frame hash checked against the
-//! host's fixed tracer rendering the same view.
+//! classic scene at 240×240, pure and hybrid mode) on QEMU for every target, with its frame
+//! hashes checked against the host's fixed tracer rendering the same view.
 
 use crate::*;
 
@@ -12,8 +12,9 @@ mod view;
 /// The classic scene's file (the firmware's `trace/classic.rs` is exported from it).
 const CLASSIC: &str = "sim/scenes/classic.scene";
 
-/// The hash and statistics the host's fixed tracer gives for the firmware's frame.
-fn host_frame() -> Result<(u32, scanline3d::trace::TraceStats), String> {
+/// The hash and statistics the host's fixed tracer gives for the firmware's frame, pure or in
+/// hybrid mode.
+fn host_frame(hybrid: bool) -> Result<(u32, scanline3d::trace::TraceStats), String> {
     use scanline3d_sim::trace::{fixed, scene::TracedScene};
     let scene = fixed::FixedScene::new(&TracedScene::load(&root().join(CLASSIC))?)?;
     let v = view::CLASSIC;
@@ -32,16 +33,22 @@ fn host_frame() -> Result<(u32, scanline3d::trace::TraceStats), String> {
         usize::from(v.width),
         usize::from(v.height),
         options,
+        hybrid,
     )
 }
 
 pub(crate) fn trace() -> Result<(), String> {
-    let (expected, stats) = host_frame()?;
-    println!(
-        "host fixed tracer: hash {expected:08x}, {} rays, {} intersection tests",
-        stats.rays(),
-        stats.intersection_tests
-    );
+    let mut expected = Vec::new();
+    for (hybrid, mode) in [(false, "pure"), (true, "hybrid")] {
+        let (hash, stats) = host_frame(hybrid)?;
+        println!(
+            "host fixed tracer, {mode}: hash {hash:08x}, {} rays, {} intersection tests, {} box tests",
+            stats.rays(),
+            stats.intersection_tests,
+            stats.box_tests
+        );
+        expected.push(hash);
+    }
     step("traced firmware for every target (a no-op when built)");
     build_firmware_examples("firmware", &["trace"])?;
     for (target, machine) in FIRMWARE {
@@ -49,12 +56,12 @@ pub(crate) fn trace() -> Result<(), String> {
         let out = run_example(target, "firmware", "trace")?;
         print!("{out}");
         let hashes = frame_hashes(&out);
-        if hashes != [expected] {
+        if hashes != expected {
             return Err(format!(
-                "{target}: traced frame hash {hashes:08x?} differs from the host's {expected:08x}"
+                "{target}: traced frame hashes (pure, hybrid) {hashes:08x?} differ from the host's {expected:08x?}"
             ));
         }
-        println!("traced frame hash equals the host's: {expected:08x}");
+        println!("traced frame hashes (pure, hybrid) equal the host's: {expected:08x?}");
     }
     Ok(())
 }

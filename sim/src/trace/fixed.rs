@@ -14,8 +14,8 @@ use scanline3d::trace::bvh::{self, BvhNode};
 use scanline3d::trace::grid::{self, GridShape};
 use scanline3d::trace::shape::{AaBox, Ellipsoid, Facet, Frustum};
 use scanline3d::trace::{
-    Colour, Light, LightKind, Material, Object, Plane, Polygon, Scene, Shape, Sphere, TraceCamera,
-    TraceOptions, TraceStats, Tracer, Triangle, Vec3,
+    Colour, Light, LightKind, Material, Object, PixelTrace, Plane, Polygon, Scene, ScreenBound,
+    ShadowCache, Shape, Sphere, TraceCamera, TraceOptions, TraceStats, Tracer, Triangle, Vec3,
 };
 
 /// Ray-stack capacity of the host's fixed tracer: room for `--max-depth` up to 31.
@@ -342,7 +342,9 @@ pub struct FixedFrame {
     pub stats: TraceStats,
 }
 
-/// Traces every pixel of `scene` from `cam` at `w × h`.
+/// Traces every pixel of `scene` from `cam` at `w × h`: the pure tracer, or with `hybrid` the
+/// hybrid mode (primary visibility from the objects' screen bounds, see
+/// [`scanline3d::trace::hybrid`]); secondary rays use `accel` either way.
 pub fn render(
     scene: &FixedScene,
     cam: &CameraSpec,
@@ -350,8 +352,10 @@ pub fn render(
     h: usize,
     options: TraceOptions,
     accel: Accel,
+    hybrid: bool,
 ) -> Result<FixedFrame, String> {
     let camera = camera(cam, w, h)?;
+    let count = scene.entries.len();
     scene.with_scene(accel, |scene| {
         let tracer = Tracer::<STACK>::new(scene, &camera, options);
         let mut frame = FixedFrame {
@@ -363,26 +367,39 @@ pub fn render(
             shadow: Vec::with_capacity(w * h),
             stats: TraceStats::default(),
         };
+        let push = |frame: &mut FixedFrame, p: &PixelTrace| {
+            frame
+                .colour
+                .push([p.colour.r(), p.colour.g(), p.colour.b()]);
+            frame.ids.push(p.id.map_or(-1, |i| i as i32));
+            frame
+                .depth
+                .push(p.id.map_or(f32::INFINITY, |_| p.depth.to_num::<f32>()));
+            frame.shadow.push(p.shadow);
+        };
+        if hybrid {
+            let mut bounds = vec![ScreenBound::default(); count];
+            let mut active = vec![ScreenBound::default(); count];
+            let stats = tracer.hybrid_frame(
+                &mut bounds,
+                &mut active,
+                &mut frame,
+                |frame, _, p| push(frame, p),
+                |_, _, _| Ok::<(), std::convert::Infallible>(()),
+            );
+            frame.stats = match stats {
+                Ok(stats) => stats,
+                Err(never) => match never {},
+            };
+            return frame;
+        }
+        let mut cache = ShadowCache::new();
         let mut total = TraceStats::default();
         for y in 0..h as u16 {
             for x in 0..w as u16 {
-                let (p, s) = tracer.trace_pixel(x, y);
-                total.primary_rays += s.primary_rays;
-                total.secondary_rays += s.secondary_rays;
-                total.shadow_rays += s.shadow_rays;
-                total.intersection_tests += s.intersection_tests;
-                total.box_tests += s.box_tests;
-                total.grid_cells += s.grid_cells;
-                total.dropped_rays += s.dropped_rays;
-                total.peak_stack = total.peak_stack.max(s.peak_stack);
-                frame
-                    .colour
-                    .push([p.colour.r(), p.colour.g(), p.colour.b()]);
-                frame.ids.push(p.id.map_or(-1, |i| i as i32));
-                frame
-                    .depth
-                    .push(p.id.map_or(f32::INFINITY, |_| p.depth.to_num::<f32>()));
-                frame.shadow.push(p.shadow);
+                let (p, s) = tracer.trace_pixel_cached(x, y, &mut cache);
+                total.add(&s);
+                push(&mut frame, &p);
             }
         }
         total.rows = h as u16;
@@ -392,20 +409,30 @@ pub fn render(
 }
 
 /// The frame hash the firmware prints: the tracer's rows in [`Rgb565`] through a
-/// [`HashSink`], and the frame's statistics (with the hierarchy, as the firmware).
+/// [`HashSink`], and the frame's statistics (with the hierarchy, as the firmware), by the pure
+/// tracer or with `hybrid` in hybrid mode.
 pub fn frame_hash(
     scene: &FixedScene,
     cam: &CameraSpec,
     w: usize,
     h: usize,
     options: TraceOptions,
+    hybrid: bool,
 ) -> Result<(u32, TraceStats), String> {
     let camera = camera(cam, w, h)?;
+    let count = scene.entries.len();
     scene.with_scene(Accel::Bvh, |scene| {
         let mut row = vec![Rgb565::new(0, 0, 0); w];
         let mut sink = HashSink::new();
-        Tracer::<STACK>::new(scene, &camera, options)
-            .render(&mut row, &mut sink)
+        let tracer = Tracer::<STACK>::new(scene, &camera, options);
+        let stats = if hybrid {
+            let mut bounds = vec![ScreenBound::default(); count];
+            let mut active = vec![ScreenBound::default(); count];
+            tracer.render_hybrid(&mut bounds, &mut active, &mut row, &mut sink)
+        } else {
+            tracer.render(&mut row, &mut sink)
+        };
+        stats
             .map(|stats| (sink.hash(), stats))
             .map_err(|e| format!("{e:?}"))
     })?

@@ -21,4 +21,5 @@ mod realworld_cli;
 mod run;
 mod trace;
 mod trace_fixed;
+mod trace_hybrid;
 mod vertex_cache;

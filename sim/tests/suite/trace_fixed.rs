@@ -49,7 +49,16 @@ fn compare(
     let fixed_scene =
         fixed::FixedScene::new(&traced).unwrap_or_else(|e| panic!("{} {label}: {e}", scene.name));
     let options = fixed::options(limits.max_depth, limits.threshold).unwrap();
-    let ours = fixed::render(&fixed_scene, cam, SIZE, SIZE, options, fixed::Accel::Bvh).unwrap();
+    let ours = fixed::render(
+        &fixed_scene,
+        cam,
+        SIZE,
+        SIZE,
+        options,
+        fixed::Accel::Bvh,
+        false,
+    )
+    .unwrap();
     assert_eq!(ours.stats.dropped_rays, 0);
     let n = SIZE * SIZE;
     let mut c = Comparison {
@@ -121,7 +130,7 @@ fn the_accelerations_give_the_same_image_with_fewer_tests() {
     let (_, cam) = &scene.cameras[0];
     let fixed_scene = fixed::FixedScene::new(&scene.load().unwrap()).unwrap();
     let options = scanline3d::trace::TraceOptions::default();
-    let render = |accel| fixed::render(&fixed_scene, cam, 64, 64, options, accel).unwrap();
+    let render = |accel| fixed::render(&fixed_scene, cam, 64, 64, options, accel, false).unwrap();
     let plain = render(fixed::Accel::None);
     let per_ray =
         |s: &scanline3d::trace::TraceStats| f64::from(s.intersection_tests) / f64::from(s.rays());
@@ -154,7 +163,7 @@ fn each_structure_cuts_tests_on_the_mesh_tenfold() {
     let (_, cam) = &scene.cameras[0];
     let fixed_scene = fixed::FixedScene::new(&scene.load().unwrap()).unwrap();
     let options = scanline3d::trace::TraceOptions::default();
-    let render = |accel| fixed::render(&fixed_scene, cam, 24, 24, options, accel).unwrap();
+    let render = |accel| fixed::render(&fixed_scene, cam, 24, 24, options, accel, false).unwrap();
     let plain = render(fixed::Accel::None);
     let brute = f64::from(plain.stats.intersection_tests) / f64::from(plain.stats.rays());
     for accel in [fixed::Accel::Bvh, fixed::Accel::Grid] {

@@ -1,0 +1,214 @@
+//! The fixed tracer's hybrid mode (primary visibility from the objects' screen bounds) against
+//! the pure tracer on every traced corpus scene: the same pixels, with less work; its buffers'
+//! overflow is reported and still gives the same image; `sim trace --renderer hybrid`.
+
+use crate::run::{scratch, sim};
+use embedded_graphics::pixelcolor::Rgb565;
+use scanline3d::sink::HashSink;
+use scanline3d::trace::{ScreenBound, TraceOptions, Tracer};
+use scanline3d_sim::trace::{corpus, fixed};
+
+const SIZE: usize = 64;
+
+/// Hybrid and pure (with the hierarchy) give identical colour, id, depth and shadow images on
+/// every corpus camera, except where the hierarchy's search and the search over every object
+/// disagree: the hybrid mode finds exactly the latter's first hit (same intersection code, same
+/// order-free tie rule), the hierarchy can prune a root an intersection test reports outside
+/// the object's box (one pixel of `diamond` at 64×64, a frustum's). Each such pixel is checked
+/// against the search over every object.
+#[test]
+fn hybrid_mode_gives_the_pure_tracers_images_on_every_corpus_scene() {
+    for scene in corpus::all() {
+        let fixed_scene = fixed::FixedScene::new(&scene.load().unwrap()).unwrap();
+        for (label, cam) in &scene.cameras {
+            let options = TraceOptions::default();
+            let render = |hybrid| {
+                fixed::render(
+                    &fixed_scene,
+                    cam,
+                    SIZE,
+                    SIZE,
+                    options,
+                    fixed::Accel::Bvh,
+                    hybrid,
+                )
+                .unwrap()
+            };
+            let (pure, hybrid) = (render(false), render(true));
+            let what = format!("{} {label}", scene.name);
+            let camera = fixed::camera(cam, SIZE, SIZE).unwrap();
+            let differ: Vec<usize> = (0..SIZE * SIZE)
+                .filter(|i| {
+                    (pure.ids[*i], pure.colour[*i], pure.shadow[*i])
+                        != (hybrid.ids[*i], hybrid.colour[*i], hybrid.shadow[*i])
+                        || pure.depth[*i].to_bits() != hybrid.depth[*i].to_bits()
+                })
+                .collect();
+            fixed_scene
+                .with_scene(fixed::Accel::None, |every| {
+                    let tracer = Tracer::<32>::new(every, &camera, options);
+                    for i in &differ {
+                        let (x, y) = ((i % SIZE) as u16, (i / SIZE) as u16);
+                        let (p, _) = tracer.trace_pixel(x, y);
+                        let id = p.id.map_or(-1, |id| id as i32);
+                        assert_eq!(id, hybrid.ids[*i], "{what} ({x}, {y})");
+                        assert_ne!(id, pure.ids[*i], "{what} ({x}, {y}): unexplained");
+                    }
+                })
+                .unwrap();
+            assert!(differ.len() <= 2, "{what}: {} pixels differ", differ.len());
+            let (p, h) = (&pure.stats, &hybrid.stats);
+            assert_eq!(
+                (h.primary_rays, h.fallback_rows),
+                (p.primary_rays, 0),
+                "{what}"
+            );
+            let work = |s: &scanline3d::trace::TraceStats| s.intersection_tests + s.box_tests;
+            eprintln!(
+                "{what}: {} pixels differ; tests + box tests per frame {} pure, {} hybrid",
+                differ.len(),
+                work(p),
+                work(h)
+            );
+            // On a dense mesh the screen rectangles of the far side overlap the near side's,
+            // which the hierarchy's front-to-back walk skips: fewer tests is asserted for the
+            // scenes of few, large objects the hybrid mode is for (the firmware's classic).
+            if scene.name != "mesh" {
+                assert!(work(h) < work(p), "{what}");
+            }
+        }
+    }
+}
+
+/// The shadow cache changes no pixel: each pixel traced with a cache of its own equals the
+/// frame traced with one cache kept from pixel to pixel, which answers some shadow rays with
+/// one test.
+#[test]
+fn the_shadow_cache_changes_no_pixel() {
+    let scene = corpus::by_name("classic").unwrap();
+    let (_, cam) = &scene.cameras[0];
+    let fixed_scene = fixed::FixedScene::new(&scene.load().unwrap()).unwrap();
+    let camera = fixed::camera(cam, 40, 40).unwrap();
+    fixed_scene
+        .with_scene(fixed::Accel::Bvh, |scene| {
+            let tracer = Tracer::<8>::new(scene, &camera, TraceOptions::default());
+            let mut cache = scanline3d::trace::ShadowCache::new();
+            let mut hits = 0;
+            for y in 0..40 {
+                for x in 0..40 {
+                    let (kept, s) = tracer.trace_pixel_cached(x, y, &mut cache);
+                    hits += s.shadow_cache_hits;
+                    assert_eq!(kept, tracer.trace_pixel(x, y).0, "pixel ({x}, {y})");
+                }
+            }
+            assert!(hits > 0, "the classic floor's shadows hit the cache");
+        })
+        .unwrap();
+}
+
+/// Buffers too small for the frame: every row (no room for the bounds) or some rows (a short
+/// active list) fall back to the pure search, are counted, and the frame hash is unchanged.
+#[test]
+fn full_hybrid_buffers_are_reported_and_change_no_pixel() {
+    let scene = corpus::by_name("classic").unwrap();
+    let (_, cam) = &scene.cameras[0];
+    let fixed_scene = fixed::FixedScene::new(&scene.load().unwrap()).unwrap();
+    let (w, h) = (48u16, 40u16);
+    let camera = fixed::camera(cam, w.into(), h.into()).unwrap();
+    fixed_scene
+        .with_scene(fixed::Accel::Bvh, |scene| {
+            let tracer = Tracer::<8>::new(scene, &camera, TraceOptions::default());
+            let hash = |bounds: usize, active: usize| {
+                let mut row = vec![Rgb565::new(0, 0, 0); w.into()];
+                let mut sink = HashSink::new();
+                let mut b = vec![ScreenBound::default(); bounds];
+                let mut a = vec![ScreenBound::default(); active];
+                let stats = tracer
+                    .render_hybrid(&mut b, &mut a, &mut row, &mut sink)
+                    .unwrap();
+                (sink.hash(), stats.fallback_rows)
+            };
+            let mut pure = HashSink::new();
+            let mut row = vec![Rgb565::new(0, 0, 0); w.into()];
+            tracer.render(&mut row, &mut pure).unwrap();
+            let n = scene.objects.len();
+            assert_eq!(hash(n, n), (pure.hash(), 0));
+            assert_eq!(hash(1, n), (pure.hash(), h), "no room for every bound");
+            let (same, fallback) = hash(n, 4);
+            assert_eq!(same, pure.hash());
+            assert!(fallback > 0 && fallback < h, "{fallback} rows fell back");
+            let mut short = vec![Rgb565::new(0, 0, 0); usize::from(w) - 1];
+            assert!(tracer
+                .render_hybrid(&mut [], &mut [], &mut short, &mut HashSink::new())
+                .is_err());
+        })
+        .unwrap();
+}
+
+/// `sim trace --renderer hybrid` writes the same id and shadow images as `--renderer fixed`
+/// and says which mode ran.
+#[test]
+fn sim_trace_renders_in_hybrid_mode() {
+    let dir = scratch("trace-hybrid");
+    let scene = corpus::by_name("classic").unwrap().path();
+    let run = |renderer: &str| {
+        let args = [
+            "trace",
+            scene.to_str().unwrap(),
+            "--eye",
+            "0,3,7",
+            "--target",
+            "0,0.8,0",
+            "--size",
+            "32x24",
+            "--renderer",
+            renderer,
+            "--out",
+            "t.png",
+            "--ids",
+            "ids.bin",
+            "--shadow",
+            "shadow.bin",
+        ];
+        let (status, stdout, stderr) = sim(&args, &dir);
+        assert_eq!(status, 0, "{stderr}");
+        let read = |f: &str| std::fs::read(dir.join(f)).unwrap();
+        (stdout, read("ids.bin"), read("shadow.bin"), read("t.png"))
+    };
+    let (said, ids, shadow, png) = run("hybrid");
+    assert!(said.contains("fixed-point tracer (hybrid)"), "{said}");
+    assert!(said.contains("0 rows fell back"), "{said}");
+    assert_eq!(ids.len(), 32 * 24 * 4);
+    let (_, pure_ids, pure_shadow, pure_png) = run("fixed");
+    assert_eq!((ids, shadow, png), (pure_ids, pure_shadow, pure_png));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The method table's traced scene (100 triangles, 240×240: about 7 s in debug): the hybrid
+/// variant gives the frame of the variant with shadows, as `cargo xtask hsr-table` and its
+/// firmware run them.
+#[test]
+fn the_method_tables_hybrid_frame_is_the_shadow_frame() {
+    use scanline3d_sim::hsr::traced::{self, Variant};
+    use scanline3d_sim::scene::SceneSpec;
+    let mut buffers = Box::new(traced::Buffers::new().unwrap());
+    SceneSpec::hsr(0)
+        .unwrap()
+        .with_scene(|scene| buffers.fill(scene))
+        .unwrap()
+        .unwrap();
+    let mut frame = |variant| {
+        let mut sink = HashSink::new();
+        let stats = buffers
+            .with_tracer(variant, |t, h| {
+                traced::frame(t, h, Rgb565::new(0, 0, 0), &mut sink)
+            })
+            .unwrap()
+            .unwrap();
+        (sink.hash(), stats)
+    };
+    let (shadows, s) = frame(Variant::Shadows);
+    let (hybrid, h) = frame(Variant::Hybrid);
+    assert_eq!(shadows, hybrid);
+    assert_eq!((s.rays(), h.fallback_rows), (h.rays(), 0));
+}

@@ -1,0 +1,339 @@
+//! Hybrid mode: primary visibility by a scanline pass over the objects' screen bounds instead of
+//! a hierarchy walk per pixel, then the same ray tree as the pure tracer from each pixel's first
+//! hit, row by row into the same [`RowSink`]s.
+//!
+//! Once per frame every object's box ([`bvh::bounds`] padded by [`bvh::PAD`]) is projected onto
+//! the screen: the pixel rectangle its eight corners span, widened by [`MARGIN`] pixels (planes,
+//! and boxes reaching behind `near / 2`, cover the whole screen; boxes wholly behind it or off
+//! screen are dropped). The rectangles are sorted by first row into the caller's `bounds`
+//! buffer. Per row an active list (the caller's `active` buffer) holds the rectangles spanning
+//! the row; per pixel only the active objects whose columns cover it are intersected, with the
+//! pure tracer's intersection code and its order-free tie rule (nearest `t`, then smaller id).
+//! A ray through a pixel that hits an object meets it inside the object's padded box, whose
+//! projection contains the pixel centre up to the direction's rounding (below 2^-14 radians,
+//! far below the margin's pixels), so the candidates include every object the pure tracer
+//! could find: the first hit, and so the pixel, is the pure tracer's.
+//!
+//! Memory: `bounds` needs one [`ScreenBound`] (12 bytes) per visible object, `active` one per
+//! object spanning a row. When either is too small the rows concerned fall back to the pure
+//! tracer's primary search (same image, more work) and [`TraceStats::fallback_rows`] counts
+//! them; nothing is dropped silently.
+
+use crate::depth::DepthRow;
+use crate::sink::{Row, RowPixel, RowSink};
+use crate::trace::bvh::{self, heap_sort_by_key, PAD};
+use crate::trace::tracer::{Nearest, PixelTrace, ShadowCache, TraceError, TraceStats, Tracer};
+use crate::trace::vector::Vec3;
+use fixed::types::I8F24;
+
+/// Pixels added on each side of a projected box: covers the truncation to whole pixels and the
+/// rounding of ray directions and of the projection (f32, relative error near 2^-20).
+pub const MARGIN: i32 = 2;
+
+/// The pixel rectangle an object may be seen in (inclusive bounds).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ScreenBound {
+    /// The object's id.
+    pub object: u32,
+    /// First column.
+    pub x0: u16,
+    /// Last column.
+    pub x1: u16,
+    /// First row.
+    pub y0: u16,
+    /// Last row.
+    pub y1: u16,
+}
+
+/// A frame in progress: the sorted bounds, the next one to activate and the active list.
+struct Scan<'b> {
+    bounds: &'b [ScreenBound],
+    /// Every visible object found room in `bounds`.
+    complete: bool,
+    next: usize,
+    active: &'b mut [ScreenBound],
+    live: usize,
+}
+
+impl Scan<'_> {
+    /// Brings the active list to row `y`; false when it overflowed (the row must fall back).
+    fn advance(&mut self, y: u16) -> bool {
+        // Drop the rectangles that ended above this row, keeping the rest packed.
+        let mut kept = 0;
+        for i in 0..self.live {
+            if let Some(b) = self.active.get(i).copied() {
+                if b.y1 >= y {
+                    if let Some(slot) = self.active.get_mut(kept) {
+                        *slot = b;
+                    }
+                    kept += 1;
+                }
+            }
+        }
+        self.live = kept;
+        while let Some(b) = self.bounds.get(self.next) {
+            if b.y0 > y {
+                break;
+            }
+            match self.active.get_mut(self.live) {
+                Some(slot) => *slot = *b,
+                // Left for a later row; this one falls back.
+                None => return false,
+            }
+            self.live += 1;
+            self.next += 1;
+        }
+        self.complete
+    }
+}
+
+impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
+    /// Writes the screen bounds of the visible objects into `bounds`, sorted by first row;
+    /// returns how many were written and whether all fitted.
+    pub fn screen_bounds(&self, bounds: &mut [ScreenBound]) -> (usize, bool) {
+        let camera = self.camera();
+        let (w, h) = (camera.width, camera.height);
+        let f = |v: [I8F24; 3]| v.map(|c| c.to_num::<f32>());
+        let (corner, right, down) = (f(camera.corner), f(camera.right), f(camera.down));
+        let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        // The view direction: the direction through the image centre.
+        let (hw, hh) = (f32::from(w - 1) / 2.0, f32::from(h - 1) / 2.0);
+        let forward: [f32; 3] = core::array::from_fn(|i| corner[i] + hw * right[i] + hh * down[i]);
+        let (rr, dd) = (dot(right, right), dot(down, down));
+        let (cr, cd) = (dot(corner, right), dot(corner, down));
+        let near = camera.near.to_num::<f32>() / 2.0;
+        let eye = camera.eye.bits().map(|c| c as f32 / 65536.0);
+        let full = (0, w - 1, 0, h - 1);
+        let mut used = 0;
+        let mut complete = true;
+        for (id, object) in self.scene().objects.iter().enumerate() {
+            let rect = match bvh::bounds(&object.shape) {
+                None => Some(full),
+                Some((lo, hi)) => {
+                    let pad = Vec3 {
+                        x: PAD,
+                        y: PAD,
+                        z: PAD,
+                    };
+                    let (lo, hi) = (lo.sub(pad).bits(), hi.add(pad).bits());
+                    let (mut x, mut y) = ((f32::MAX, f32::MIN), (f32::MAX, f32::MIN));
+                    let (mut nearest, mut farthest) = (f32::MAX, f32::MIN);
+                    for k in 0..8 {
+                        let p: [f32; 3] = core::array::from_fn(|i| {
+                            let c = if k & (1 << i) == 0 { lo[i] } else { hi[i] };
+                            c as f32 / 65536.0 - eye[i]
+                        });
+                        let z = dot(p, forward);
+                        (nearest, farthest) = (nearest.min(z), farthest.max(z));
+                        if z > 0.0 {
+                            let (c, r) =
+                                ((dot(p, right) / z - cr) / rr, (dot(p, down) / z - cd) / dd);
+                            (x, y) = ((x.0.min(c), x.1.max(c)), (y.0.min(r), y.1.max(r)));
+                        }
+                    }
+                    if farthest < near {
+                        None
+                    } else if nearest < near {
+                        Some(full)
+                    } else {
+                        // `as` saturates; truncation towards zero is inside the margin.
+                        let (x0, x1) = (
+                            (x.0 as i32).saturating_sub(MARGIN),
+                            (x.1 as i32).saturating_add(MARGIN),
+                        );
+                        let (y0, y1) = (
+                            (y.0 as i32).saturating_sub(MARGIN),
+                            (y.1 as i32).saturating_add(MARGIN),
+                        );
+                        let (wi, hi) = (i32::from(w), i32::from(h));
+                        (x1 >= 0 && y1 >= 0 && x0 < wi && y0 < hi).then(|| {
+                            // max/min, not clamp: clamp's check for an empty range would link a panic.
+                            let clamp = |v: i32, n: i32| v.max(0).min(n - 1) as u16;
+                            (clamp(x0, wi), clamp(x1, wi), clamp(y0, hi), clamp(y1, hi))
+                        })
+                    }
+                }
+            };
+            if let Some((x0, x1, y0, y1)) = rect {
+                match bounds.get_mut(used) {
+                    Some(slot) => {
+                        *slot = ScreenBound {
+                            object: id as u32,
+                            x0,
+                            x1,
+                            y0,
+                            y1,
+                        };
+                        used += 1;
+                    }
+                    None => complete = false,
+                }
+            }
+        }
+        if let Some(written) = bounds.get_mut(..used) {
+            heap_sort_by_key(written, |b| (b.y0, b.object));
+        }
+        (used, complete)
+    }
+
+    /// Renders the frame in hybrid mode into `row` (length = the camera's width), handing each
+    /// row to `sink`: the same rows as [`render`](Self::render). `bounds` holds the screen
+    /// bounds (one per visible object), `active` the rectangles spanning a row; rows they cannot
+    /// serve fall back to the pure search ([`TraceStats::fallback_rows`]).
+    pub fn render_hybrid<P: RowPixel, S: RowSink<P>>(
+        &self,
+        bounds: &mut [ScreenBound],
+        active: &mut [ScreenBound],
+        row: &mut [P],
+        sink: &mut S,
+    ) -> Result<TraceStats, TraceError<S::Error>> {
+        if row.len() != usize::from(self.camera().width) {
+            return Err(TraceError::RowLength);
+        }
+        self.hybrid_frame(
+            bounds,
+            active,
+            &mut (row, sink),
+            |(row, _), x, p| {
+                if let Some(pixel) = row.get_mut(usize::from(x)) {
+                    *pixel = P::from_shade(p.colour, p.id.unwrap_or(u32::MAX));
+                }
+            },
+            |(row, sink), y, complete| {
+                sink.write_row(Row {
+                    y,
+                    pixels: row,
+                    depth: DepthRow::NONE,
+                    complete,
+                })
+                .map_err(TraceError::Sink)
+            },
+        )
+    }
+
+    /// The hybrid frame, pixel by pixel: `pixel(context, column, trace)` for each pixel of a
+    /// row, then `row_done(context, row, complete)` (`complete`: no ray was dropped on the row).
+    /// See [`render_hybrid`](Self::render_hybrid) for the buffers.
+    pub fn hybrid_frame<C, E>(
+        &self,
+        bounds: &mut [ScreenBound],
+        active: &mut [ScreenBound],
+        context: &mut C,
+        mut pixel: impl FnMut(&mut C, u16, &PixelTrace),
+        mut row_done: impl FnMut(&mut C, u16, bool) -> Result<(), E>,
+    ) -> Result<TraceStats, E> {
+        let (used, complete) = self.screen_bounds(bounds);
+        let mut scan = Scan {
+            bounds: bounds.get(..used).unwrap_or(&[]),
+            complete,
+            next: 0,
+            active,
+            live: 0,
+        };
+        let scene = self.scene();
+        let mut cache = ShadowCache::new();
+        let mut stats = TraceStats::default();
+        for y in 0..self.camera().height {
+            let dropped_before = stats.dropped_rays;
+            let scanned = scan.advance(y);
+            if !scanned {
+                stats.fallback_rows += 1;
+            }
+            let live = scan.active.get(..scan.live).unwrap_or(&[]);
+            for x in 0..self.camera().width {
+                let (p, s) = if scanned {
+                    self.trace_with(x, y, &mut cache, |ray, t_min, t_max, stats| {
+                        let mut search = Nearest::new(u32::MAX, t_min, t_max);
+                        for b in live {
+                            if b.x0 <= x && x <= b.x1 {
+                                search.offer(scene, b.object, ray);
+                            }
+                        }
+                        search.finish(stats)
+                    })
+                } else {
+                    self.trace_pixel_cached(x, y, &mut cache)
+                };
+                stats.add(&s);
+                pixel(context, x, &p);
+            }
+            row_done(context, y, stats.dropped_rays == dropped_before)?;
+            stats.rows += 1;
+        }
+        Ok(stats)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trace::scene::{Colour, Material, Scene, TraceCamera};
+    use crate::trace::shape::{Object, Plane, Shape, Sphere};
+    use crate::trace::tracer::TraceOptions;
+    use fixed::types::I16F16;
+
+    fn v(x: f64, y: f64, z: f64) -> Vec3 {
+        let f = I16F16::from_num;
+        Vec3 {
+            x: f(x),
+            y: f(y),
+            z: f(z),
+        }
+    }
+
+    #[test]
+    fn screen_bounds_cover_what_is_seen_and_drop_what_is_behind() {
+        let sphere = |c: Vec3| Object {
+            shape: Shape::Sphere(Sphere::new(c, I16F16::ONE).unwrap()),
+            material: 0,
+        };
+        let objects = [
+            sphere(v(0.0, 0.0, 0.0)),  // in front, centred
+            sphere(v(0.0, 0.0, 20.0)), // behind the eye
+            sphere(v(40.0, 0.0, 0.0)), // off screen to the right
+            Object {
+                shape: Shape::Plane(Plane::new(v(0.0, 1.0, 0.0), I16F16::from_num(2)).unwrap()),
+                material: 0,
+            },
+        ];
+        let grey = Colour::new([I16F16::from_num(0.5); 3]).unwrap();
+        let materials = [Material::new(grey, [I16F16::ONE; 4], I16F16::ONE).unwrap()];
+        let scene = Scene::new(&objects, &materials, &[], Colour::BLACK, I16F16::ZERO).unwrap();
+        let camera = TraceCamera::new(
+            [0.0, 0.0, 5.0],
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            60.0,
+            0.1,
+            100.0,
+            40,
+            30,
+        )
+        .unwrap();
+        let tracer = Tracer::<4>::new(&scene, &camera, TraceOptions::default());
+        let mut bounds = [ScreenBound::default(); 4];
+        let (used, complete) = tracer.screen_bounds(&mut bounds);
+        assert!(complete);
+        assert_eq!(used, 2, "{bounds:?}");
+        let ball = bounds.iter().find(|b| b.object == 0).unwrap();
+        // The unit sphere at distance 5 under a 60° view 30 pixels high spans about 6 rows
+        // around the centre (radius · 15 / (5 · tan 30°) ≈ 5.2 pixels each way).
+        assert!(
+            ball.x0 <= 14 && ball.x1 >= 25 && ball.y0 <= 9 && ball.y1 >= 20,
+            "{ball:?}"
+        );
+        assert!(ball.x0 >= 8 && ball.x1 <= 31, "{ball:?}");
+        let plane = bounds.iter().find(|b| b.object == 3).unwrap();
+        assert_eq!((plane.x0, plane.x1, plane.y0, plane.y1), (0, 39, 0, 29));
+        // Each pixel the pure tracer sees the sphere in lies inside its rectangle.
+        for y in 0..30u16 {
+            for x in 0..40u16 {
+                if tracer.trace_pixel(x, y).0.id == Some(0) {
+                    assert!((ball.x0..=ball.x1).contains(&x) && (ball.y0..=ball.y1).contains(&y));
+                }
+            }
+        }
+        let mut small = [ScreenBound::default(); 1];
+        assert_eq!(tracer.screen_bounds(&mut small), (1, false));
+    }
+}
