@@ -176,17 +176,21 @@ fn reference_and_fixed_renderer_share_the_base_colour() {
 
 #[test]
 fn fixed_renderer_against_the_reference_at_half_a_pixel() {
+    // Least colour PSNR (dB) where ids agree, Gouraud and flat: the measured figures (sphere
+    // 38.5 and 37.6 dB, teapot 42.9 and 42.0 dB) rounded down to whole dB, less 1 dB.
     let cases = [
         (
             "sphere.bpt",
             camera([2.0, 1.5, 2.5], [0.0; 3], [0.0, 1.0, 0.0]),
+            (37.0, 36.0),
         ),
         (
             "teapot.bpt",
             camera([4.0, -7.0, 3.0], [0.2, 0.0, 1.3], [0.0, 0.0, 1.0]),
+            (41.0, 41.0),
         ),
     ];
-    for (name, cam) in cases {
+    for (name, cam, (gouraud_min, flat_min)) in cases {
         let f = compare(&load(name), &cam);
         let share = f.coverage as f64 / (W * H) as f64;
         println!(
@@ -209,16 +213,11 @@ fn fixed_renderer_against_the_reference_at_half_a_pixel() {
         // Gouraud from exactly lit vertices: a fraction of a level on average.
         assert!(f.color_mean < 1.0, "{name}: {}", f.color_mean);
         // Shading against the exact normals, every pixel whose id agrees (patch edges and
-        // the teapot's creases included): the thresholds are the measured PSNRs rounded
-        // down to whole dB, less 1 dB (docs/patches.md has the figures).
-        let (gouraud_min, flat_min) = PSNR_MIN;
+        // the teapot's creases included).
         assert!(f.psnr_gouraud >= gouraud_min, "{name}: {}", f.psnr_gouraud);
         assert!(f.psnr_flat >= flat_min, "{name}: {}", f.psnr_flat);
     }
 }
-
-/// Least colour PSNR (dB) where ids agree, Gouraud and flat, at `TOLERANCE`.
-const PSNR_MIN: (f64, f64) = (0.0, 0.0);
 
 /// A small deterministic generator for views.
 fn lcg(state: &mut u64) -> f64 {
@@ -294,8 +293,8 @@ fn trimmed_holes_appear_where_the_trim_says() {
             );
             assert!(far <= tolerance + 1.0 / 16.0, "view {view}, {tolerance}: {far}");
             assert!(share <= 0.005, "view {view}, {tolerance}: {share}");
-            worst = worst.max(far - tolerance);
+            worst = worst.max(far);
         }
     }
-    println!("farthest beyond the tolerance: {worst:.3} px");
+    println!("farthest of all: {worst:.3} px");
 }
