@@ -285,9 +285,9 @@ mod firmware {
             16,
         >::new(Rgb565::new(0, 0, 0));
         let mut cramped_patches =
-            scanline3d::patch::PatchWorkspace::<Rgb565, Flat, 64, 48, 40, 64, 4>::new(
-                Rgb565::new(0, 0, 0),
-            );
+            scanline3d::patch::PatchWorkspace::<Rgb565, Flat, 64, 48, 40, 64, 4>::new(Rgb565::new(
+                0, 0, 0,
+            ));
         let instances = demo::instances();
         let mut frame = 0;
         loop {

@@ -291,7 +291,10 @@ fn trimmed_holes_appear_where_the_trim_says() {
                 "trimmed sheet, view {view} eye {eye:.2?}, tolerance {tolerance} px: {} triangles ({} cut by trims), coverage mismatches {mismatches} ({:.3} %), farthest {far:.3} px from a trim curve or the silhouette",
                 s.frame.triangles_in, s.trim_cut, 100.0 * share
             );
-            assert!(far <= tolerance + 1.0 / 16.0, "view {view}, {tolerance}: {far}");
+            assert!(
+                far <= tolerance + 1.0 / 16.0,
+                "view {view}, {tolerance}: {far}"
+            );
             assert!(share <= 0.005, "view {view}, {tolerance}: {share}");
             worst = worst.max(far);
         }

@@ -82,7 +82,10 @@ fn export_writes_trim_loops_and_render_draws_them() {
     assert_eq!(code, 0, "{stderr}");
     assert!(stdout.contains("1 patches, 2 trim loops"), "{stdout}");
     let source = std::fs::read_to_string(dir.join("trimmed.rs")).unwrap();
-    assert!(source.contains("pub static TRIM_LOOPS: [TrimLoop; 2]"), "{source}");
+    assert!(
+        source.contains("pub static TRIM_LOOPS: [TrimLoop; 2]"),
+        "{source}"
+    );
     assert!(source.contains("pub static TRIM_POINTS: [TrimPoint; 35]"));
     assert!(source.contains("m.with_trims(&TRIM_LOOPS, &TRIM_POINTS)"));
     let (code, stdout, stderr) = sim(
