@@ -438,7 +438,7 @@ fn faces<const TRIM: usize>(trims: &Trims<'_>, t: &[P; 3], emit: &mut dyn FnMut(
         *o = k;
     }
     let key = |k: usize| points.get(k).map(|b| (b.side, b.along));
-    order.sort_unstable_by_key(|&k| key(k));
+    sort_by_key(order, |&k| key(k));
     let mut rank = [0usize; TRIM];
     let mut distinct = 0;
     for (pos, &k) in order.iter().enumerate() {
@@ -465,7 +465,7 @@ fn faces<const TRIM: usize>(trims: &Trims<'_>, t: &[P; 3], emit: &mut dyn FnMut(
         *c = (i.min(j), i.max(j));
     }
     // Chords ending at j, innermost (largest i) first.
-    chords.sort_unstable_by_key(|&(i, j)| (j, core::cmp::Reverse(i)));
+    sort_by_key(chords, |&(i, j)| (j, core::cmp::Reverse(i)));
     let ring = ring.get(..distinct).unwrap_or_default();
     let mut face = [[0u32; 2]; TRIM];
     let mut emit_face = |indices: &[usize]| {
@@ -516,6 +516,26 @@ fn faces<const TRIM: usize>(trims: &Trims<'_>, t: &[P; 3], emit: &mut dyn FnMut(
     }
     emit_face(stack.get(..top).unwrap_or_default());
     true
+}
+
+/// Sorts a short slice by `key`: insertion sort, which (unlike `core`'s sorts) has no panic
+/// path for a key that is not a total order.
+fn sort_by_key<T: Copy, K: Ord>(s: &mut [T], key: impl Fn(&T) -> K) {
+    for i in 1..s.len() {
+        let mut j = i;
+        while let (Some(&a), Some(&b)) = (s.get(j.wrapping_sub(1)), s.get(j)) {
+            if key(&a) <= key(&b) {
+                break;
+            }
+            if let Some(x) = s.get_mut(j - 1) {
+                *x = b;
+            }
+            if let Some(y) = s.get_mut(j) {
+                *y = a;
+            }
+            j -= 1;
+        }
+    }
 }
 
 /// The chord that trim edge `s` makes across `t` (no trim vertex inside `t` or inside one of

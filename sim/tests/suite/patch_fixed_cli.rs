@@ -130,3 +130,26 @@ fn the_firmware_teapot_is_what_export_writes() {
         "regenerate demo/src/patches/teapot.rs with sim export"
     );
 }
+
+#[test]
+fn the_library_s_trimmed_sheet_is_what_export_writes() {
+    let dir = scratch("trimmed-data");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let out = dir.join("trimmed_sheet.rs");
+    let (code, _, stderr) = sim(
+        &[
+            "export",
+            "sim/scenes/patches/trimmed.bpt",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &root,
+    );
+    assert_eq!(code, 0, "{stderr}");
+    let fresh = std::fs::read_to_string(&out).unwrap();
+    let committed = std::fs::read_to_string(root.join("tests/data/trimmed_sheet.rs")).unwrap();
+    assert_eq!(
+        fresh, committed,
+        "regenerate tests/data/trimmed_sheet.rs with sim export"
+    );
+}
