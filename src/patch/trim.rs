@@ -650,7 +650,10 @@ mod tests {
     }
 
     /// A hole (a 12-gon) with an island (a triangle) inside it.
-    fn model() -> (Vec<TrimLoop>, Vec<TrimPoint>, Vec<Vec<(f64, f64)>>) {
+    /// Loops as f64 polylines.
+    type Polylines = Vec<Vec<(f64, f64)>>;
+
+    fn model() -> (Vec<TrimLoop>, Vec<TrimPoint>, Polylines) {
         let mut hole: Vec<(f64, f64)> = (0..12)
             .map(|k| {
                 let a = k as f64 * std::f64::consts::TAU / 12.0;
