@@ -109,8 +109,9 @@ const LEAF_CELLS: u32 = 4;
 ///   reported, as for meshes);
 /// * `TRIM`: room to cut one tessellation triangle by trim loops (boundary points: its corners
 ///   and two per trim edge crossing it; triangles waiting after splits at trim vertices), on
-///   the stack while a trimmed triangle is cut, about `60·TRIM` bytes. A triangle that needs
-///   more is kept or dropped whole and [`PatchStats::trim_overflows`] counts it.
+///   the stack while a trimmed triangle is cut: about `125·TRIM` bytes on a 32-bit target.
+///   A triangle that needs more is kept or dropped whole and [`PatchStats::trim_overflows`]
+///   counts it.
 pub struct PatchWorkspace<
     P: RowPixel,
     S: Shading,
