@@ -22,7 +22,8 @@
 //! overflow). And it runs the fixed-point metaball ray caster and the
 //! metaball polygonizer with the span z-buffer drawing its mesh (`scanline3d::metaball`), and
 //! the scanline Bezier patch renderer (`scanline3d::patch`, flat and Gouraud, with and without
-//! culling, with a subdivision buffer that overflows).
+//! culling, with a subdivision buffer that overflows, and with trim loops cut into two
+//! patches, once with room to cut them and once with too little).
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -227,6 +228,53 @@ mod firmware {
         }
     }
 
+    use fixed::types::I16F16;
+    use scanline3d::patch::{PatchModel, TrimLoop, TrimPoint};
+
+    const fn q(u: f64, v: f64) -> TrimPoint {
+        [
+            I16F16::from_bits((u * 65536.0) as i32),
+            I16F16::from_bits((v * 65536.0) as i32),
+        ]
+    }
+
+    /// A square hole with a triangular island in patch 0 of the teapot, a triangle cut from
+    /// patch 5.
+    static TRIM_POINTS: [TrimPoint; 10] = [
+        q(0.2, 0.2),
+        q(0.8, 0.2),
+        q(0.8, 0.8),
+        q(0.2, 0.8),
+        q(0.4, 0.4),
+        q(0.6, 0.4),
+        q(0.5, 0.6),
+        q(0.1, 0.1),
+        q(0.9, 0.3),
+        q(0.3, 0.9),
+    ];
+    static TRIM_LOOPS: [TrimLoop; 3] = [
+        TrimLoop {
+            patch: 0,
+            start: 0,
+            len: 4,
+        },
+        TrimLoop {
+            patch: 0,
+            start: 4,
+            len: 3,
+        },
+        TrimLoop {
+            patch: 5,
+            start: 7,
+            len: 3,
+        },
+    ];
+    static TRIMMED_TEAPOT: PatchModel<'static> =
+        match demo::patches::MODEL.with_trims(&TRIM_LOOPS, &TRIM_POINTS) {
+            Ok(m) => m,
+            Err(_) => panic!("invalid trim loops"),
+        };
+
     #[cfg_attr(target_arch = "arm", cortex_m_rt::entry)]
     #[cfg_attr(target_arch = "riscv32", riscv_rt::entry)]
     fn main() -> ! {
@@ -242,6 +290,19 @@ mod firmware {
                 Rgb565::new(0, 0, 0),
             );
         let mut polygonized = demo::metaballs::Poly8::new(Rgb565::new(0, 0, 0));
+        let mut trimmed_patches = scanline3d::patch::PatchWorkspace::<
+            Rgb565,
+            Gouraud<PerPixel>,
+            64,
+            48,
+            40,
+            64,
+            16,
+        >::new(Rgb565::new(0, 0, 0));
+        let mut cramped_patches =
+            scanline3d::patch::PatchWorkspace::<Rgb565, Flat, 64, 48, 40, 64, 4>::new(Rgb565::new(
+                0, 0, 0,
+            ));
         let instances = demo::instances();
         let mut frame = 0;
         loop {
@@ -289,6 +350,15 @@ mod firmware {
                 let tolerance = black_box(scanline3d::patch::Tolerance::ONE);
                 let small = small_patches.render(&scene, &options, tolerance, &mut sink);
                 core::hint::black_box((&small, sink.hash()));
+                // Trimmed, with room to cut and with too little.
+                let trimmed = scanline3d::patch::PatchScene {
+                    model: black_box(&TRIMMED_TEAPOT),
+                    ..scene
+                };
+                let options = RenderOptions::default();
+                let cut = trimmed_patches.render(&trimmed, &options, tolerance, &mut sink);
+                let cramped = cramped_patches.render(&trimmed, &options, tolerance, &mut sink);
+                core::hint::black_box((&cut, &cramped, sink.hash()));
             }
             // The fixed-point tracer, with room for its ray tree and with too little.
             let options = black_box(scanline3d::trace::TraceOptions::default());

@@ -656,10 +656,10 @@ fn export_patches(scene: &std::path::Path, out: &std::path::Path) -> Result<(), 
         } else {
             ""
         },
-        if fixed.trimmed > 0 {
-            ", trims dropped: the scanline renderer does not trim"
+        if fixed.trim_loops.is_empty() {
+            String::new()
         } else {
-            ""
+            format!(", {} trim loops", fixed.trim_loops.len())
         }
     );
     Ok(())
@@ -890,18 +890,11 @@ fn render_patches(a: RenderArgs) -> Result<(), String> {
                 v.faces.cull,
                 shading,
             )?;
-            let trimmed = fixed::FixedPatches::new(&model)?.trimmed;
-            if trimmed > 0 {
-                let _ = writeln!(
-                    std::io::stderr(),
-                    "sim: {trimmed} trimmed patches drawn untrimmed: the scanline patch renderer does not trim"
-                );
-            }
             let s = r.stats;
             let f = s.frame;
             let json = format!(
-                "{{\"renderer\": \"fixed\", \"patches\": {}, \"tolerance\": {}, \"width\": {w}, \"height\": {h}, \"triangles\": {}, \"patches_culled\": {}, \"pieces\": {}, \"pieces_culled\": {}, \"overflows\": {}, \"capped\": {}, \"late\": {}, \"culled\": {}, \"clipped\": {}, \"drawn\": {}, \"fragments\": {}, \"peak_active\": {}, \"dropped\": {}}}\n",
-                model.patches.len(), a.tolerance, f.triangles_in, s.patches_culled, s.pieces, s.pieces_culled, s.overflows, s.capped, s.late, f.culled, f.clipped, f.activated, f.fragments, f.peak_active, f.dropped
+                "{{\"renderer\": \"fixed\", \"patches\": {}, \"tolerance\": {}, \"width\": {w}, \"height\": {h}, \"triangles\": {}, \"patches_culled\": {}, \"pieces\": {}, \"pieces_culled\": {}, \"overflows\": {}, \"capped\": {}, \"late\": {}, \"trim_cut\": {}, \"trim_overflows\": {}, \"culled\": {}, \"clipped\": {}, \"drawn\": {}, \"fragments\": {}, \"peak_active\": {}, \"dropped\": {}}}\n",
+                model.patches.len(), a.tolerance, f.triangles_in, s.patches_culled, s.pieces, s.pieces_culled, s.overflows, s.capped, s.late, s.trim_cut, s.trim_overflows, f.culled, f.clipped, f.activated, f.fragments, f.peak_active, f.dropped
             );
             (r.image, json)
         }

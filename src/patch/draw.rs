@@ -9,6 +9,7 @@
 
 use super::eval::{dehomogenize, Net};
 use super::tessellate::{self, Levels, ScreenNet, Uv};
+use super::trim::{self, Cut};
 use super::{PatchModel, Tolerance};
 use crate::arithmetic::Arithmetic;
 use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping};
@@ -64,6 +65,11 @@ pub struct PatchStats {
     /// Triangles that began above the row that made them (the rows above were lost). The
     /// control-hull bound makes this 0; it is counted so a test can hold it to that.
     pub late: u32,
+    /// Tessellation triangles that trim edges touch, cut in parameter space.
+    pub trim_cut: u32,
+    /// Triangles (or parts of one) that needed more than `TRIM` boundary points or waiting
+    /// triangles to cut: kept or dropped whole by the parity of their centroid instead.
+    pub trim_overflows: u32,
 }
 
 /// A patch or a piece of its interior waiting in a row bucket.
@@ -100,7 +106,12 @@ const LEAF_CELLS: u32 = 4;
 ///   more room lets pieces be split finer so their triangles are made nearer their rows.
 ///   When full, a piece is tessellated whole and [`PatchStats::overflows`] counts it;
 /// * `ACTIVE`: triangles that may be on the active list at once (more are dropped and
-///   reported, as for meshes).
+///   reported, as for meshes);
+/// * `TRIM`: room to cut one tessellation triangle by trim loops (boundary points: its corners
+///   and two per trim edge crossing it; triangles waiting after splits at trim vertices), on
+///   the stack while a trimmed triangle is cut: about `125·TRIM` bytes on a 32-bit target.
+///   A triangle that needs more is kept or dropped whole and [`PatchStats::trim_overflows`]
+///   counts it.
 pub struct PatchWorkspace<
     P: RowPixel,
     S: Shading,
@@ -108,6 +119,7 @@ pub struct PatchWorkspace<
     const H: usize,
     const SUBS: usize = 256,
     const ACTIVE: usize = 256,
+    const TRIM: usize = 64,
 > {
     depth: [Depth; W],
     pixels: [P; W],
@@ -125,7 +137,8 @@ impl<
         const H: usize,
         const SUBS: usize,
         const ACTIVE: usize,
-    > PatchWorkspace<P, S, W, H, SUBS, ACTIVE>
+        const TRIM: usize,
+    > PatchWorkspace<P, S, W, H, SUBS, ACTIVE, TRIM>
 {
     /// Size of this workspace in bytes.
     pub const BYTES: usize = core::mem::size_of::<Self>();
@@ -194,7 +207,7 @@ impl<
         let bits = model.max_abs_bits();
         let mv = ModelView::new(&scene.transform, &camera.view().world_to_eye, bits)
             .map_err(|error| RenderError::Transform { instance: 0, error })?;
-        let mut rows = PatchRows::<SUB, C, A> {
+        let mut rows = PatchRows::<SUB, C, A, TRIM> {
             model,
             mv: A::Transform::prepare(mv, bits),
             lighting: Lighting::new(&scene.light, &scene.transform),
@@ -244,7 +257,7 @@ enum Hull {
 }
 
 /// The frame's patch state: what pass 2 activates row by row.
-struct PatchRows<'a, 'm, const SUB: u32, C, A: Arithmetic> {
+struct PatchRows<'a, 'm, const SUB: u32, C, A: Arithmetic, const TRIM: usize> {
     model: &'m PatchModel<'m>,
     mv: <A::Transform as TransformPrecision>::Matrix,
     lighting: Lighting,
@@ -262,7 +275,9 @@ struct PatchRows<'a, 'm, const SUB: u32, C, A: Arithmetic> {
     clipping: core::marker::PhantomData<C>,
 }
 
-impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
+impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
+    PatchRows<'_, '_, SUB, C, A, TRIM>
+{
     /// Pass 1: every patch whose control hull is on screen goes into the bucket of the hull's
     /// first row, in reverse order so each bucket lists patches in ascending order.
     fn file_patches<E>(&mut self) -> Result<(), RenderError<E>> {
@@ -447,8 +462,8 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
         }
     }
 
-    /// Tessellates triangle `uv` of `patch` (control net `net`) and draws it ([`Self::draw`]),
-    /// flat-shaded with the normal at its parameter centroid.
+    /// Tessellates triangle `uv` of `patch` (control net `net`) and draws what its trims keep
+    /// of it ([`Self::draw`]), flat-shaded with the normal at its parameter centroid.
     fn triangle<S: Shading>(
         &mut self,
         patch: u16,
@@ -457,10 +472,54 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
         row: usize,
         f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
+        let trims = self.model.trims(patch as usize);
+        let cut = trim::classify(&trims, uv);
+        if cut == Cut::Drop {
+            return;
+        }
         let mid = |k: usize| uv.iter().map(|p| p[k]).sum::<u32>() / 3;
         let face = self.face::<S>(patch, net, [mid(0), mid(1)]);
+        if cut == Cut::Pieces {
+            self.trimmed::<S>(patch, net, uv, face, row, f);
+            return;
+        }
         let cv = uv.map(|p| self.vertex::<S>(patch, net, p));
         self.draw(patch, cv, face, row, f);
+    }
+
+    /// Draws the parts of triangle `uv` of `patch` that its trims keep: faces cut in
+    /// parameter space ([`trim::clip`]), their vertices evaluated on the surface, each face
+    /// a fan of triangles with the whole triangle's flat colours `face`.
+    #[inline(never)]
+    fn trimmed<S: Shading>(
+        &mut self,
+        patch: u16,
+        net: &Net,
+        uv: [Uv; 3],
+        face: Sides<Rgb888>,
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        self.stats.trim_cut += 1;
+        let trims = self.model.trims(patch as usize);
+        let overflows = trim::clip::<TRIM>(&trims, uv, |polygon| {
+            let Some((&first, rest)) = polygon.split_first() else {
+                return;
+            };
+            let apex = self.vertex::<S>(patch, net, first);
+            let mut previous: Option<(Uv, Vertex)> = None;
+            for &p in rest {
+                let v = self.vertex::<S>(patch, net, p);
+                if let Some((q, w)) = previous {
+                    // Collinear in (u, v): no area to draw.
+                    if tessellate::area2(first, q, p) != 0 {
+                        self.draw(patch, [apex, w, v], face, row, f);
+                    }
+                }
+                previous = Some((p, v));
+            }
+        });
+        self.stats.trim_overflows += overflows;
     }
 
     /// Draws interior cells `is × js`, each grid point evaluated once (two rows of points at a
@@ -498,6 +557,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
                 *slot = this.vertex::<S>(patch, net, at(i, j));
             }
         };
+        let trims = self.model.trims(patch as usize);
         let (mut below, mut above) = ([empty; SIDE], [empty; SIDE]);
         points(self, js[0], &mut below);
         for j in js[0]..js[1] {
@@ -514,9 +574,17 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
                 let corners = [a, b, c, d];
                 let centre = |p: [u32; 2], q: [u32; 2]| [(p[0] + q[0]) / 2, (p[1] + q[1]) / 2];
                 let face = self.face::<S>(patch, net, centre(at(i, j), at(i + 1, j + 1)));
+                let corner_uv = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
                 for t in tessellate::CELL_TRIANGLES {
-                    let cv = t.map(|k| corners.get(k).copied().unwrap_or(a));
-                    self.draw(patch, cv, face, row, f);
+                    let uv = t.map(|k| corner_uv.get(k).copied().unwrap_or([0; 2]));
+                    match trim::classify(&trims, uv) {
+                        Cut::Keep => {
+                            let cv = t.map(|k| corners.get(k).copied().unwrap_or(a));
+                            self.draw(patch, cv, face, row, f);
+                        }
+                        Cut::Drop => {}
+                        Cut::Pieces => self.trimmed::<S>(patch, net, uv, face, row, f),
+                    }
                 }
             }
             below = above;
@@ -658,7 +726,9 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> PatchRows<'_, '_, SUB, C, A> {
     }
 }
 
-impl<const SUB: u32, C: Clipping, A: Arithmetic> RowPieces<SUB> for PatchRows<'_, '_, SUB, C, A> {
+impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize> RowPieces<SUB>
+    for PatchRows<'_, '_, SUB, C, A, TRIM>
+{
     fn each_row_piece<S: Shading>(
         &mut self,
         row: usize,

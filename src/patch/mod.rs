@@ -29,13 +29,26 @@
 //! | tolerance | [`Tolerance`] (U8F8 pixels) | ≥ 1 sub-pixel (smaller is raised to it) | levels below 2^[`MAX_LEVEL`] segments |
 //! | segments per edge or grid side | | 2^[`MAX_LEVEL`] = 64 | 8-bit grid indices; a patch that needs more is drawn at 64 and counted in [`PatchStats::capped`] |
 //!
+//! | trim points | [`TrimPoint`] (I16F16) | `[0, 1]` | the parameters' bits; see `trim` for the cut's budget |
+//!
 //! Parameters `(u, v)` are I16F16 bits in `[0, 2^16]` (exact at grid points `i/2^k`).
+//!
+//! # Trims
+//!
+//! Patches may be trimmed by closed polylines in `(u, v)` ([`PatchModel::with_trims`]): a
+//! point is drawn when it lies inside an even number of its patch's loops. Tessellation
+//! triangles that a trim edge touches are cut in parameter space at the trim's vertices and
+//! edges, the new vertices evaluated on the surface, so the hole's edge is as accurate as
+//! the tessellation and neighbours stay crack-free; see [`PatchStats::trim_cut`] and
+//! [`PatchStats::trim_overflows`].
 
 mod draw;
 mod eval;
 mod tessellate;
+mod trim;
 
 pub use draw::{PatchScene, PatchStats, PatchWorkspace};
+pub use trim::{TrimLoop, TrimPoint};
 
 use embedded_graphics::pixelcolor::Rgb888;
 use fixed::types::{I16F16, U8F8};
@@ -90,6 +103,18 @@ pub enum PatchError {
     },
     /// The weights (or per-patch colours) are not one set per patch.
     Length,
+    /// A trim loop of patch `patch` has fewer than 3 points, a point outside `[0, 1]²`, a
+    /// zero-length edge or points beyond the trim points, or names a patch the model does not
+    /// have, or the loops are not in patch order.
+    TrimLoop {
+        /// Patch index.
+        patch: usize,
+    },
+    /// Two edges of patch `patch`'s trim loops meet (a loop crosses itself or another).
+    TrimCrossing {
+        /// Patch index.
+        patch: usize,
+    },
 }
 
 impl core::fmt::Display for PatchError {
@@ -105,6 +130,13 @@ impl core::fmt::Display for PatchError {
                 "patch {patch}: a weight is outside {MIN_WEIGHT}..={MAX_WEIGHT}"
             ),
             Self::Length => write!(f, "weights and colours must be given once per patch"),
+            Self::TrimLoop { patch } => write!(
+                f,
+                "patch {patch}: a trim loop needs 3 or more distinct points in [0, 1]², on a patch of the model, loops in patch order"
+            ),
+            Self::TrimCrossing { patch } => {
+                write!(f, "patch {patch}: trim loop edges cross or meet")
+            }
         }
     }
 }
@@ -135,6 +167,8 @@ pub struct PatchModel<'a> {
     weights: Option<&'a [[Weight; 16]]>,
     colors: PatchColors<'a>,
     max_abs_bits: i32,
+    trim_loops: &'a [TrimLoop],
+    trim_points: &'a [TrimPoint],
 }
 
 impl<'a> PatchModel<'a> {
@@ -199,7 +233,68 @@ impl<'a> PatchModel<'a> {
             // Evaluated points are convex combinations of control points, rounded: a few
             // units of the last bit beyond the largest coordinate at most.
             max_abs_bits: max_abs_bits + 16,
+            trim_loops: &[],
+            trim_points: &[],
         })
+    }
+
+    /// The model with trim loops: `loops` (in patch order) index `points`. A point `(u, v)` of
+    /// a patch is drawn when it lies inside an even number of that patch's loops. Loops must
+    /// be simple and must not meet (checked: O(n²) in the points of a patch).
+    ///
+    /// ```
+    /// # use embedded_graphics::pixelcolor::Rgb888;
+    /// # use fixed::types::I16F16;
+    /// use scanline3d::patch::{PatchColors, PatchModel, TrimLoop, TrimPoint};
+    /// # let mut p = [[I16F16::ZERO; 3]; 16];
+    /// # for i in 0..4 {
+    /// #     for j in 0..4 {
+    /// #         p[4 * i + j] = [I16F16::from_num(i), I16F16::from_num(j), I16F16::ZERO];
+    /// #     }
+    /// # }
+    /// # let points = [p];
+    /// let q = |u: f64, v: f64| -> TrimPoint { [I16F16::from_num(u), I16F16::from_num(v)] };
+    /// // A square hole in patch 0.
+    /// let hole = [q(0.25, 0.25), q(0.75, 0.25), q(0.75, 0.75), q(0.25, 0.75)];
+    /// let loops = [TrimLoop { patch: 0, start: 0, len: 4 }];
+    /// let model = PatchModel::new(&points, None, PatchColors::Uniform(Rgb888::new(200, 100, 0)))?
+    ///     .with_trims(&loops, &hole)?;
+    /// # Ok::<(), scanline3d::patch::PatchError>(())
+    /// ```
+    pub const fn with_trims(
+        self,
+        loops: &'a [TrimLoop],
+        points: &'a [TrimPoint],
+    ) -> Result<Self, PatchError> {
+        if let Err(e) = trim::check(loops, points, self.points.len()) {
+            return Err(e);
+        }
+        Ok(PatchModel {
+            trim_loops: loops,
+            trim_points: points,
+            ..self
+        })
+    }
+
+    /// The trim loops, in patch order.
+    pub const fn trim_loops(&self) -> &'a [TrimLoop] {
+        self.trim_loops
+    }
+
+    /// The trim points the loops index.
+    pub const fn trim_points(&self) -> &'a [TrimPoint] {
+        self.trim_points
+    }
+
+    /// The trim loops of patch `index`.
+    pub(crate) fn trims(&self, index: usize) -> trim::Trims<'a> {
+        let loops = self.trim_loops;
+        let first = loops.partition_point(|l| (l.patch as usize) < index);
+        let end = loops.partition_point(|l| (l.patch as usize) <= index);
+        trim::Trims {
+            loops: loops.get(first..end).unwrap_or_default(),
+            points: self.trim_points,
+        }
     }
 
     /// The control points, one set of 16 per patch.

@@ -162,12 +162,16 @@ pub(crate) fn grid(index: u32, level: u8) -> u32 {
     index << (16 - level as u32)
 }
 
+/// Twice the signed area of `a b c` in the `(u, v)` plane (positive: counter-clockwise).
+pub(crate) fn area2(a: Uv, b: Uv, c: Uv) -> i64 {
+    let d = |a: Uv, b: Uv, k: usize| b[k] as i64 - a[k] as i64;
+    d(a, b, 0) * d(a, c, 1) - d(a, c, 0) * d(a, b, 1)
+}
+
 /// `t` with its vertices in counter-clockwise order in the `(u, v)` plane (`u` right, `v`
 /// up), so screen winding follows the surface's orientation; `None` for zero area.
 fn oriented(t: [Uv; 3]) -> Option<[Uv; 3]> {
-    let d = |a: Uv, b: Uv, k: usize| b[k] as i64 - a[k] as i64;
-    let area = d(t[0], t[1], 0) * d(t[0], t[2], 1) - d(t[0], t[2], 0) * d(t[0], t[1], 1);
-    match area {
+    match area2(t[0], t[1], t[2]) {
         0 => None,
         a if a > 0 => Some(t),
         _ => Some([t[0], t[2], t[1]]),

@@ -14,6 +14,7 @@ mod module_graph;
 mod newell;
 mod patch_cover;
 mod patch_firmware;
+mod patch_trim;
 mod patterns;
 mod render;
 mod resolve;

@@ -1,6 +1,7 @@
 //! Patch cover tests: a closed patch model drawn by the fixed-point patch renderer covers every
 //! pixel centre well inside its silhouette (no cracks, no T-junction holes) over random views
-//! and tolerances, and a full subdivision buffer degrades deterministically and is reported.
+//! and tolerances, and a full subdivision buffer degrades deterministically and is reported, as
+//! does too little room to cut trimmed triangles.
 
 use crate::common;
 
@@ -8,7 +9,7 @@ use embedded_graphics::pixelcolor::Rgb888;
 use fixed::types::I16F16;
 use scanline3d::patch::{
     ControlPoints, PatchColors, PatchModel, PatchScene, PatchStats, PatchWorkspace, Tolerance,
-    Weight,
+    TrimLoop, TrimPoint, Weight,
 };
 use scanline3d::scene::Transform;
 use scanline3d::sink::{FnSink, Row, TriangleId};
@@ -149,7 +150,7 @@ fn fill(cover: &mut [bool], a: [f64; 2], b: [f64; 2], c: [f64; 2]) {
     }
 }
 
-fn render<const SUBS: usize>(
+fn render<const SUBS: usize, const TRIM: usize>(
     model: &PatchModel<'_>,
     cam: &CameraSpec,
     tolerance: f64,
@@ -160,7 +161,7 @@ fn render<const SUBS: usize>(
         camera: cam.fixed().unwrap(),
         light: common::light(),
     };
-    let mut ws: Box<PatchWorkspace<TriangleId, Flat, W, H, SUBS, 2048>> =
+    let mut ws: Box<PatchWorkspace<TriangleId, Flat, W, H, SUBS, 2048, TRIM>> =
         Box::new(PatchWorkspace::new(TriangleId::NONE));
     let mut ids = vec![-1i32; W * H];
     let mut next_row = 0u16;
@@ -240,7 +241,7 @@ fn closed_patch_models_have_no_holes_over_random_views_and_tolerances() {
         for view in 0..10 {
             let cam = random_view(&mut rng);
             let tolerance = [0.25, 0.5, 1.0, 2.0, 4.0][view % 5];
-            let (ids, stats) = render::<512>(&model, &cam, tolerance);
+            let (ids, stats) = render::<512, 64>(&model, &cam, tolerance);
             let what = format!(
                 "{n}×{n} per face, rational {rational}, view {view}, tolerance {tolerance}"
             );
@@ -273,7 +274,7 @@ fn the_exact_sphere_has_no_holes_at_its_poles_or_seams() {
         // The unit sphere: come closer than for the cube.
         cam.eye = cam.eye.map(|c| c * 0.7);
         let tolerance = [0.25, 0.5, 1.0, 2.0, 4.0][view % 5];
-        let (ids, stats) = render::<512>(&model, &cam, tolerance);
+        let (ids, stats) = render::<512, 64>(&model, &cam, tolerance);
         let what = format!("sphere, view {view}, tolerance {tolerance}");
         assert_eq!(
             (stats.late, stats.overflows, stats.frame.dropped),
@@ -303,10 +304,10 @@ fn a_full_subdivision_buffer_is_reported_and_changes_nothing_else() {
         near: 0.1,
         far: 100.0,
     };
-    let (roomy, roomy_stats) = render::<512>(&model, &cam, 0.25);
+    let (roomy, roomy_stats) = render::<512, 64>(&model, &cam, 0.25);
     assert_eq!(roomy_stats.overflows, 0);
     // 6 entries: one per patch, none left for splitting pieces.
-    let (tight, tight_stats) = render::<6>(&model, &cam, 0.25);
+    let (tight, tight_stats) = render::<6, 64>(&model, &cam, 0.25);
     assert!(tight_stats.overflows > 0);
     // The same triangles are made, only earlier, so the image is the same.
     assert_eq!(tight, roomy);
@@ -316,7 +317,7 @@ fn a_full_subdivision_buffer_is_reported_and_changes_nothing_else() {
     );
     assert!(tight_stats.frame.peak_active > roomy_stats.frame.peak_active);
     // Deterministic: the same frame again gives the same statistics.
-    assert_eq!(render::<6>(&model, &cam, 0.25).1, tight_stats);
+    assert_eq!(render::<6, 64>(&model, &cam, 0.25).1, tight_stats);
     // Fewer entries than patches on screen: an error before any row.
     let scene = PatchScene {
         model: &model,
@@ -341,4 +342,58 @@ fn a_full_subdivision_buffer_is_reported_and_changes_nothing_else() {
         })
     ));
     assert_eq!(rows, 0);
+}
+
+#[test]
+fn too_little_room_to_cut_trims_is_reported_and_deterministic() {
+    let (points, _) = puffy_cube(1, false);
+    // A 16-gon hole in every face, an island inside it.
+    let q = |u: f64, v: f64| -> TrimPoint { [I16F16::from_num(u), I16F16::from_num(v)] };
+    let mut trim_points = Vec::new();
+    let mut loops = Vec::new();
+    for patch in 0..points.len() as u16 {
+        let start = trim_points.len() as u32;
+        for k in 0..16 {
+            let a = k as f64 * std::f64::consts::TAU / 16.0;
+            trim_points.push(q(0.5 + 0.35 * a.cos(), 0.5 + 0.3 * a.sin()));
+        }
+        trim_points.extend([q(0.4, 0.4), q(0.6, 0.45), q(0.45, 0.6)]);
+        loops.push(TrimLoop {
+            patch,
+            start,
+            len: 16,
+        });
+        loops.push(TrimLoop {
+            patch,
+            start: start + 16,
+            len: 3,
+        });
+    }
+    let whole = PatchModel::new(
+        &points,
+        None,
+        PatchColors::Uniform(Rgb888::new(255, 255, 255)),
+    )
+    .unwrap();
+    let model = whole.with_trims(&loops, &trim_points).unwrap();
+    let cam = CameraSpec {
+        eye: [2.5, 1.8, 3.0],
+        target: [0.0; 3],
+        up: [0.0, 1.0, 0.0],
+        fovy: 50.0,
+        near: 0.1,
+        far: 100.0,
+    };
+    let (untrimmed, _) = render::<512, 64>(&whole, &cam, 2.0);
+    let (roomy, roomy_stats) = render::<512, 64>(&model, &cam, 2.0);
+    assert!(roomy_stats.trim_cut > 0);
+    assert_eq!(roomy_stats.trim_overflows, 0);
+    // The holes show the inside of the cube (other patches) or nothing.
+    let changed = roomy.iter().zip(&untrimmed).filter(|(a, b)| a != b).count();
+    assert!(changed > W * H / 20, "{changed}");
+    // Room for 4 boundary points: every cut triangle overflows and is kept or dropped whole.
+    let (tight, tight_stats) = render::<512, 4>(&model, &cam, 2.0);
+    assert!(tight_stats.trim_overflows > 0);
+    assert_eq!(tight_stats.trim_cut, roomy_stats.trim_cut);
+    assert_eq!(render::<512, 4>(&model, &cam, 2.0), (tight, tight_stats));
 }

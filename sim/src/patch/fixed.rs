@@ -7,7 +7,8 @@ use crate::scene::{CameraSpec, LightSpec};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::I16F16;
 use scanline3d::patch::{
-    self, ControlPoints, PatchColors, PatchScene, PatchStats, PatchWorkspace, Tolerance, Weight,
+    self, ControlPoints, PatchColors, PatchScene, PatchStats, PatchWorkspace, Tolerance, TrimLoop,
+    TrimPoint, Weight,
 };
 use scanline3d::scene::{Light, Transform};
 use scanline3d::sink::{FnSink, Row, TriangleId};
@@ -22,15 +23,17 @@ const SUBS: usize = 16384;
 const ACTIVE: usize = 16384;
 
 /// A patch model in the library's formats: I16F16 control points and weights (`None` when
-/// every weight is 1), one colour per patch.
+/// every weight is 1), trim loops as I16F16 `(u, v)` points.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FixedPatches {
     /// Control points, one set of 16 per patch.
     pub points: Vec<ControlPoints>,
     /// Weights, if any patch is rational.
     pub weights: Option<Vec<[Weight; 16]>>,
-    /// Patches with trim loops (the scanline renderer draws them untrimmed).
-    pub trimmed: usize,
+    /// Trim loops in patch order, indexing `trim_points`.
+    pub trim_loops: Vec<TrimLoop>,
+    /// The trim loops' points.
+    pub trim_points: Vec<TrimPoint>,
 }
 
 impl FixedPatches {
@@ -63,17 +66,42 @@ impl FixedPatches {
             weights.push(p.weights.map(Weight::from_num));
         }
         let rational = weights.iter().flatten().any(|&w| w != Weight::ONE);
+        let mut trim_loops = Vec::new();
+        let mut trim_points = Vec::new();
+        for (k, p) in model.patches.iter().enumerate() {
+            for t in &p.trims {
+                let (patch, start, len) = (
+                    u16::try_from(k),
+                    u32::try_from(trim_points.len()),
+                    u32::try_from(t.points.len()),
+                );
+                let (Ok(patch), Ok(start), Ok(len)) = (patch, start, len) else {
+                    return Err(format!("patch {k}: too many patches or trim points"));
+                };
+                trim_loops.push(TrimLoop { patch, start, len });
+                trim_points.extend(t.points.iter().map(|p| p.map(I16F16::from_num)));
+            }
+        }
         Ok(FixedPatches {
             points,
             weights: rational.then_some(weights),
-            trimmed: model.patches.iter().filter(|p| !p.trims.is_empty()).count(),
+            trim_loops,
+            trim_points,
         })
+    }
+
+    /// Patches with trim loops.
+    pub fn trimmed(&self) -> usize {
+        let mut patches: Vec<u16> = self.trim_loops.iter().map(|l| l.patch).collect();
+        patches.dedup();
+        patches.len()
     }
 
     /// The library's checked model, with `colors` (one per patch, or one for all).
     pub fn model<'a>(&'a self, colors: PatchColors<'a>) -> Result<patch::PatchModel<'a>, String> {
         patch::PatchModel::new(&self.points, self.weights.as_deref(), colors)
-            .map_err(|e| e.to_string())
+            .and_then(|m| m.with_trims(&self.trim_loops, &self.trim_points))
+            .map_err(|e| format!("{e} (in I16F16)"))
     }
 }
 
@@ -194,8 +222,8 @@ fn two_passes<S: Shading>(
 }
 
 /// `fixed` as Rust source: `static` I16F16 control points (`POINTS`), weights (`WEIGHTS`, for
-/// rational models) and the checked `MODEL` (checked at compile time), for firmware. `command`
-/// goes into the header.
+/// rational models), trim loops (`TRIM_LOOPS`, `TRIM_POINTS`, for trimmed models) and the
+/// checked `MODEL` (checked at compile time), for firmware. `command` goes into the header.
 pub fn export_source(fixed: &FixedPatches, color: Rgb888, command: &str) -> String {
     use std::fmt::Write as _;
     let n = fixed.points.len();
@@ -206,7 +234,11 @@ pub fn export_source(fixed: &FixedPatches, color: Rgb888, command: &str) -> Stri
          //! control points, `points[4·i + j]` = `P_ij`; ids are patch indices). Do not edit.\n"
     );
     s += "use embedded_graphics::pixelcolor::Rgb888;\nuse fixed::types::I16F16;\n";
-    s += "use scanline3d::patch::{ControlPoints, PatchColors, PatchModel};\n\n";
+    s += if fixed.trim_loops.is_empty() {
+        "use scanline3d::patch::{ControlPoints, PatchColors, PatchModel};\n\n"
+    } else {
+        "use scanline3d::patch::{ControlPoints, PatchColors, PatchModel, TrimLoop, TrimPoint};\n\n"
+    };
     s += "const fn c(bits: i32) -> I16F16 {\n    I16F16::from_bits(bits)\n}\n\n";
     let _ = writeln!(
         s,
@@ -241,11 +273,40 @@ pub fn export_source(fixed: &FixedPatches, color: Rgb888, command: &str) -> Stri
         }
         None => "None",
     };
+    let checked = if fixed.trim_loops.is_empty() {
+        "Ok(m) => m"
+    } else {
+        let _ = writeln!(
+            s,
+            "/// Trim loops (patch, first point, point count), in patch order.\n\
+             pub static TRIM_LOOPS: [TrimLoop; {}] = [",
+            fixed.trim_loops.len()
+        );
+        for l in &fixed.trim_loops {
+            let _ = writeln!(
+                s,
+                "    TrimLoop {{ patch: {}, start: {}, len: {} }},",
+                l.patch, l.start, l.len
+            );
+        }
+        let _ = writeln!(
+            s,
+            "];\n\n/// Trim points `(u, v)`, the loops' vertices.\n\
+             pub static TRIM_POINTS: [TrimPoint; {}] = [",
+            fixed.trim_points.len()
+        );
+        for p in &fixed.trim_points {
+            let _ = writeln!(s, "    [c({}), c({})],", p[0].to_bits(), p[1].to_bits());
+        }
+        s += "];\n\n";
+        "Ok(m) => match m.with_trims(&TRIM_LOOPS, &TRIM_POINTS) {\n        Ok(m) => m,\n        \
+         Err(_) => panic!(\"the exported trim loops are invalid\"),\n    }"
+    };
     let _ = writeln!(
         s,
         "/// The model, checked when this file is compiled.\n\
          pub static MODEL: PatchModel<'static> = match PatchModel::new(\n    &POINTS,\n    {weights},\n    \
-         PatchColors::Uniform(Rgb888::new({}, {}, {})),\n) {{\n    Ok(m) => m,\n    \
+         PatchColors::Uniform(Rgb888::new({}, {}, {})),\n) {{\n    {checked},\n    \
          Err(_) => panic!(\"the exported patches are outside the library's envelope\"),\n}};",
         color.r(),
         color.g(),
@@ -262,11 +323,12 @@ mod tests {
     #[test]
     fn the_shipped_models_convert() {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/patches");
-        for name in ["teapot.bpt", "sphere.bpt"] {
+        for name in ["teapot.bpt", "sphere.bpt", "trimmed.bpt"] {
             let model = parse::load(&dir.join(name)).unwrap();
             let fixed = FixedPatches::new(&model).unwrap();
             assert_eq!(fixed.points.len(), model.patches.len());
             assert_eq!(fixed.weights.is_some(), name == "sphere.bpt");
+            assert_eq!(fixed.trimmed(), usize::from(name == "trimmed.bpt"));
             fixed.model(PatchColors::Uniform(PATCH_COLOR)).unwrap();
         }
     }

@@ -76,6 +76,38 @@ fn export_writes_the_model_as_static_data() {
 }
 
 #[test]
+fn export_writes_trim_loops_and_render_draws_them() {
+    let dir = scratch("trimmed");
+    let (code, stdout, stderr) = sim(&["export", &model("trimmed"), "--out", "trimmed.rs"], &dir);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("1 patches, 2 trim loops"), "{stdout}");
+    let source = std::fs::read_to_string(dir.join("trimmed.rs")).unwrap();
+    assert!(
+        source.contains("pub static TRIM_LOOPS: [TrimLoop; 2]"),
+        "{source}"
+    );
+    assert!(source.contains("pub static TRIM_POINTS: [TrimPoint; 35]"));
+    assert!(source.contains("m.with_trims(&TRIM_LOOPS, &TRIM_POINTS)"));
+    let (code, stdout, stderr) = sim(
+        &[
+            "render",
+            &model("trimmed"),
+            "--size",
+            "64x64",
+            "--tolerance",
+            "1",
+            "--stats",
+            "-",
+        ],
+        &dir,
+    );
+    assert_eq!(code, 0, "{stderr}");
+    assert!(!stderr.contains("trim"), "{stderr}");
+    assert!(stdout.contains("\"trim_overflows\": 0"), "{stdout}");
+    assert!(!stdout.contains("\"trim_cut\": 0"), "{stdout}");
+}
+
+#[test]
 fn the_firmware_teapot_is_what_export_writes() {
     let dir = scratch("teapot");
     // Run from the repository root so the header's command line is the one in the file.
@@ -96,5 +128,28 @@ fn the_firmware_teapot_is_what_export_writes() {
     assert_eq!(
         fresh, committed,
         "regenerate demo/src/patches/teapot.rs with sim export"
+    );
+}
+
+#[test]
+fn the_library_s_trimmed_sheet_is_what_export_writes() {
+    let dir = scratch("trimmed-data");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let out = dir.join("trimmed_sheet.rs");
+    let (code, _, stderr) = sim(
+        &[
+            "export",
+            "sim/scenes/patches/trimmed.bpt",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &root,
+    );
+    assert_eq!(code, 0, "{stderr}");
+    let fresh = std::fs::read_to_string(&out).unwrap();
+    let committed = std::fs::read_to_string(root.join("tests/data/trimmed_sheet.rs")).unwrap();
+    assert_eq!(
+        fresh, committed,
+        "regenerate tests/data/trimmed_sheet.rs with sim export"
     );
 }
