@@ -136,6 +136,95 @@ pub(crate) fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i64; 3]> {
     })
 }
 
+/// Exact floor division of many numerators by one divisor, through one reciprocal: the
+/// division of a triangle's attribute planes by its area. On cores without a 64-bit divider
+/// (Cortex-M0: `__aeabi_uldivmod`, several hundred instructions; Cortex-M4 and RV32IM: a
+/// library call too) one 64-bit division makes the reciprocal and each quotient then takes a
+/// few 32×32-bit multiplies, a multiply-back and a comparison or two.
+///
+/// Bit budget: the divisor is normalised to its top 32 bits rounded up, `top ∈ [2^31, 2^32]`
+/// (`den <= top · 2^sd`, equal when `den` has at most 32 bits) and `inv = ⌊(2^63 − 1) / top⌋ <
+/// 2^32`, so `u · inv / 2^(63 + sd)` never exceeds `u / den` and falls short of it by at most
+/// `2^-30 · u / den + 2`. For `u < 2^63` and `den < 2^60` the remainder after one estimate is
+/// below `2^62` (exact in wrapping `u64` arithmetic); a second estimate on the remainder
+/// leaves a quotient at most a few units short, which comparisons settle. The quotient is
+/// `u / den` exactly, every time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Reciprocal {
+    den: u64,
+    /// `⌊(2^63 − 1) / top⌋`, below 2^32.
+    inv: u64,
+    /// `31 + sd`, in `0..=63`: the estimate's shift after the 32-bit high product.
+    shift: u32,
+}
+
+/// Largest divisor [`Reciprocal`] takes (exclusive).
+const RECIPROCAL_MAX_DEN: u64 = 1 << 60;
+
+impl Reciprocal {
+    /// The reciprocal of `den`; `None` for 0 or `den >= 2^60`.
+    #[inline]
+    pub(crate) fn new(den: u64) -> Option<Self> {
+        if den == 0 || den >= RECIPROCAL_MAX_DEN {
+            return None;
+        }
+        let bits = 64 - den.leading_zeros();
+        let (top, sd) = if bits > 32 {
+            ((den >> (bits - 32)) + 1, (bits - 32) as i32)
+        } else {
+            (den << (32 - bits), bits as i32 - 32)
+        };
+        // top >= 2^31 > 0: no division by zero, and the quotient is below 2^32.
+        let inv = ((1u64 << 63) - 1) / top.max(1);
+        Some(Reciprocal {
+            den,
+            inv,
+            shift: (31 + sd) as u32,
+        })
+    }
+
+    /// A lower estimate of `u / den` (`u < 2^63`): `⌊⌊u · inv / 2^32⌋ / 2^shift⌋`, the 96-bit
+    /// product taken in two 32×32-bit halves.
+    #[inline]
+    fn estimate(&self, u: u64) -> u64 {
+        let (hi, lo) = (u >> 32, u & 0xFFFF_FFFF);
+        // hi < 2^31 and inv < 2^32: the first product is below 2^63, the second below 2^64.
+        let high = hi * self.inv + ((lo * self.inv) >> 32);
+        high >> self.shift
+    }
+
+    /// `⌊u / den⌋` for `u < 2^63`, exactly.
+    #[inline]
+    pub(crate) fn floor_div(&self, u: u64) -> u64 {
+        let u = u & (u64::MAX >> 1);
+        let mut q = self.estimate(u);
+        let mut r = u.wrapping_sub(q.wrapping_mul(self.den));
+        if r >= self.den << 2 {
+            // A large quotient: the first estimate may be short by 2^-30 of it.
+            let q2 = self.estimate(r);
+            q += q2;
+            r = r.wrapping_sub(q2.wrapping_mul(self.den));
+        }
+        // At most a few steps (the bound above); `r` falls every step.
+        while r >= self.den {
+            q += 1;
+            r -= self.den;
+        }
+        q
+    }
+
+    /// `⌊n / den⌋` (rounded towards −∞) for any `i64` `n`, exactly.
+    #[inline]
+    pub(crate) fn floor_div_signed(&self, n: i64) -> i64 {
+        if n >= 0 {
+            self.floor_div(n as u64) as i64
+        } else {
+            // ⌊n / d⌋ = −1 − ⌊(−n − 1) / d⌋, and −n − 1 = !n fits 63 bits.
+            -1 - self.floor_div(!n as u64) as i64
+        }
+    }
+}
+
 /// How precisely lighting takes the cosine between a normal and the light, chosen at compile
 /// time (see [`crate::arithmetic::Arithmetic`]).
 pub trait NormalPrecision:
@@ -269,6 +358,66 @@ mod tests {
         assert_eq!(
             cosine_i32([i64::MIN + 1, 0, 0], [1 << 30, 0, 0]),
             Some(-(1 << 30))
+        );
+    }
+
+    /// The reciprocal's quotients are exact: every divisor size from 1 to just below 2^60,
+    /// powers of two and their neighbours, numerators from 0 to 2^63 − 1, both signs.
+    #[test]
+    fn reciprocal_division_is_exact() {
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut dens = std::vec![1u64, 2, 3, 5, 7, (1 << 60) - 1, (1 << 59) + 1];
+        for k in 0..60 {
+            dens.extend([1u64 << k, (1u64 << k) + 1, (1u64 << (k + 1)) - 1]);
+        }
+        for _ in 0..3000 {
+            dens.push((next() >> 4) >> (next() % 60));
+        }
+        assert_eq!(Reciprocal::new(0), None);
+        assert_eq!(Reciprocal::new(1 << 60), None);
+        for &d in &dens {
+            let Some(r) = Reciprocal::new(d) else {
+                assert_eq!(d, 0);
+                continue;
+            };
+            let check = |u: u64| {
+                assert_eq!(r.floor_div(u), u / d, "{u} / {d}");
+                let n = u as i64;
+                assert_eq!(r.floor_div_signed(n), n.div_euclid(d as i64), "{n} / {d}");
+                assert_eq!(
+                    r.floor_div_signed(-n),
+                    (-n).div_euclid(d as i64),
+                    "-{n} / {d}"
+                );
+            };
+            for u in [
+                0,
+                1,
+                d - 1,
+                d,
+                d + 1,
+                (i64::MAX as u64) - 1,
+                i64::MAX as u64,
+            ] {
+                check(u.min(i64::MAX as u64));
+            }
+            for _ in 0..40 {
+                check((next() >> 1) >> (next() % 63));
+                // Numerators a multiple of d, and one below.
+                let m = ((next() >> 1) >> (next() % 63)) / d.max(1) * d;
+                check(m);
+                check(m.saturating_sub(1));
+            }
+        }
+        assert_eq!(
+            Reciprocal::new(7).unwrap().floor_div_signed(i64::MIN),
+            i64::MIN.div_euclid(7)
         );
     }
 
