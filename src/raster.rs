@@ -223,28 +223,6 @@ impl TriangleWalk {
         }
         true
     }
-
-    /// The left edge of the current row.
-    #[inline]
-    fn left_edge(&self) -> &EdgeWalk {
-        if self.long_is_left {
-            &self.long
-        } else {
-            &self.short
-        }
-    }
-
-    /// [`Self::advance`], moving `depth` along with the walk's left end.
-    #[inline]
-    pub fn advance_depth<const S: u32>(&mut self, depth: &mut DepthWalk) -> bool {
-        let (before, step) = (self.left_edge().x, self.left_edge().step);
-        if !self.advance::<S>() {
-            return false;
-        }
-        let left = self.left_edge();
-        depth.next_row(left.x.wrapping_sub(before), step, left.step);
-        true
-    }
 }
 
 /// Calls `f(row, x0, x1)` for every non-empty span of triangle `v` inside a `width × height`
@@ -503,7 +481,12 @@ impl DepthPlane {
     /// for triangles too thin to hold two centres in a row, where the step is never used.
     #[inline]
     pub fn span_start(&self, c: i32, r: i32) -> (i32, i32) {
-        clamped_span_start(self.origin.at(&self.q, c, r), self.q.dx)
+        let q = self.origin.at(&self.q, c, r) >> DEPTH_PLANE_EXTRA_BITS;
+        let dq = self.q.dx >> DEPTH_PLANE_EXTRA_BITS;
+        (
+            q.clamp(0, i32::MAX as i64) as i32,
+            dq.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
+        )
     }
 
     /// The reference pixel, shared with the triangle's colour planes.
@@ -517,86 +500,6 @@ impl DepthPlane {
         let q = self.origin.at(&self.q, c, r) >> DEPTH_PLANE_EXTRA_BITS;
         Depth::from_bits(q.clamp(i32::MIN as i64, i32::MAX as i64) as i32)
     }
-}
-
-/// A triangle's depth plane stepped down its walk: the plane's value (I24F40) at the left end of
-/// the walk's current row, moved to the next row with one addition (two where the left edge
-/// steps one column more), so a span's start depth takes no multiply unless the span is clipped
-/// at the screen's left. Integer sums are exact, so every value equals
-/// [`DepthPlane::span_start`]'s for the same pixel, bit for bit.
-#[derive(Clone, Copy, Debug)]
-pub struct DepthWalk {
-    origin: PixelOrigin,
-    /// The plane at the left end of the current row.
-    q: i64,
-    /// Per-pixel step.
-    dx: i64,
-    /// From one row's left end to the next one's when the left edge steps its quotient:
-    /// `dy + dx · step`.
-    row_step: i64,
-}
-
-impl DepthWalk {
-    /// The depth of `walk`'s triangle (plane `plane`) at the left end of its first row.
-    pub fn new(plane: &DepthPlane, walk: &TriangleWalk) -> Self {
-        let (left, row) = (walk.left_edge().x, walk.row());
-        DepthWalk {
-            origin: plane.origin,
-            q: plane.origin.at(&plane.q, left, row),
-            dx: plane.q.dx,
-            row_step: plane
-                .q
-                .dy
-                .wrapping_add(plane.q.dx.wrapping_mul(walk.left_edge().step as i64)),
-        }
-    }
-
-    /// The next row: the left end moved by `cols` columns, where the left edge stepped by
-    /// `step` columns (and one more on a carry) and steps by `next_step` from now on (they
-    /// differ where the walk turns the corner at its middle vertex on the left).
-    #[inline]
-    fn next_row(&mut self, cols: i32, step: i32, next_step: i32) {
-        self.q = self.q.wrapping_add(self.row_step);
-        match cols.wrapping_sub(step) {
-            0 => {}
-            1 => self.q = self.q.wrapping_add(self.dx),
-            extra => self.q = self.q.wrapping_add(self.dx.wrapping_mul(extra as i64)),
-        }
-        if next_step != step {
-            let turn = self.dx.wrapping_mul(next_step.wrapping_sub(step) as i64);
-            self.row_step = self.row_step.wrapping_add(turn);
-        }
-    }
-
-    /// Start value and per-pixel step, in [`Depth`] bits, of the span starting at column `l`
-    /// of the walk's current row, whose left end is column `left` (`l > left` only where the
-    /// span is clipped at the screen's left). Clamped as [`DepthPlane::span_start`] clamps.
-    #[inline]
-    pub fn span_start(&self, left: i32, l: i32) -> (i32, i32) {
-        let q = match l.wrapping_sub(left) {
-            0 => self.q,
-            n => self.q.wrapping_add(self.dx.wrapping_mul(n as i64)),
-        };
-        clamped_span_start(q, self.dx)
-    }
-
-    /// The reference pixel of the triangle's colour planes.
-    pub fn origin(&self) -> &PixelOrigin {
-        &self.origin
-    }
-}
-
-/// `(q, dq)` of a span from its I24F40 start and step: the start clamped to `[0, i32::MAX]`,
-/// the step saturated at ±2^31 (only for triangles too thin to hold two centres in a row,
-/// where the step is never used).
-#[inline]
-fn clamped_span_start(q: i64, dx: i64) -> (i32, i32) {
-    let q = q >> DEPTH_PLANE_EXTRA_BITS;
-    let dq = dx >> DEPTH_PLANE_EXTRA_BITS;
-    (
-        q.clamp(0, i32::MAX as i64) as i32,
-        dq.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
-    )
 }
 
 /// Three colour-channel planes for Gouraud shading, in I16F16 (channel 0–255 plus fraction).
@@ -1037,55 +940,6 @@ mod tests {
                 );
             }
         }
-    }
-
-    /// The stepped depth equals the plane's at every span start, clipped or not, on triangles
-    /// whose middle vertex is on either side, from tiny to guard-band sized.
-    #[test]
-    fn depth_walk_equals_the_plane() {
-        use crate::project::SubPx;
-        let mut x = 0x1B87_3593_94D0_49BBu64;
-        let mut next = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
-        let h = 240;
-        let mut rows = 0;
-        for _ in 0..4000 {
-            let span = 16i64 << (next() % 14);
-            let v: [ScreenVertex<4>; 3] = core::array::from_fn(|_| ScreenVertex {
-                x: SubPx(((next() % (2 * span as u64)) as i64 - span + 1920) as i32),
-                y: SubPx(((next() % (2 * span as u64)) as i64 - span + 1920) as i32),
-                q: Depth::from_bits((next() >> 34) as i32),
-                color: [I16F16::ZERO; 3],
-            });
-            let (Some(solver), Some(mut walk)) = (
-                PlaneSolver::new(&v),
-                TriangleWalk::new::<4>(v.each_ref().map(xy), 0, h),
-            ) else {
-                continue;
-            };
-            let plane = DepthPlane::new(&solver, &v);
-            let mut depth = DepthWalk::new(&plane, &walk);
-            loop {
-                let (left, right) = walk.span();
-                let y = walk.row();
-                for l in [left, left.max(0), left + 1, (left + right) / 2] {
-                    assert_eq!(
-                        depth.span_start(left, l),
-                        plane.span_start(l, y),
-                        "{v:?} row {y} column {l}"
-                    );
-                }
-                rows += 1;
-                if !walk.advance_depth::<4>(&mut depth) {
-                    break;
-                }
-            }
-        }
-        assert!(rows > 10_000, "{rows}");
     }
 
     #[test]

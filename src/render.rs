@@ -21,7 +21,7 @@ use crate::math::NormalPrecision;
 use crate::options::RenderOptions;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{
-    color_channels, first_row, signed_area, xy, DepthPlane, DepthWalk, PlaneSolver, TriangleWalk,
+    color_channels, first_row, signed_area, xy, DepthPlane, PlaneSolver, TriangleWalk,
 };
 use crate::scene::{Instance, MeshColors, Scene, MAX_SCENE_TRIANGLES};
 use crate::shading::{Shading, SpanDepth};
@@ -37,24 +37,9 @@ use heapless::{Vec, VecView};
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct ActiveTri<T, K = ()> {
     pub(crate) walk: TriangleWalk,
-    pub(crate) depth: DepthWalk,
+    pub(crate) depth: DepthPlane,
     pub(crate) payload: T,
     pub(crate) key: K,
-}
-
-impl<T, K> ActiveTri<T, K> {
-    /// Start depth and per-pixel step (I2F30 bits) of the span starting at column `l` of the
-    /// walk's current row.
-    #[inline]
-    pub(crate) fn span_depth(&self, l: i32) -> (i32, i32) {
-        self.depth.span_start(self.walk.span().0, l)
-    }
-
-    /// Moves the walk, and its depth, to the next row; `false` when the triangle is finished.
-    #[inline]
-    pub(crate) fn advance<const S: u32>(&mut self) -> bool {
-        self.walk.advance_depth::<S>(&mut self.depth)
-    }
 }
 
 /// A per-triangle sort key: `u32` for depth sorting, `()` where the order is activation order.
@@ -121,8 +106,7 @@ pub(crate) fn fill_span<P: RowPixel, S: Shading, Z: DepthFormat, K>(
     depth: &mut [Z],
     pixels: &mut [P],
 ) -> u32 {
-    debug_assert_eq!(y, t.walk.row(), "internal error: a span off the walk's row");
-    let (q, dq) = t.span_depth(l);
+    let (q, dq) = t.depth.span_start(l, y);
     let span = SpanDepth { x0: l, y, q, dq };
     let cols = l as usize..r as usize;
     match (depth.get_mut(cols.clone()), pixels.get_mut(cols)) {
@@ -753,7 +737,7 @@ pub(crate) fn walk_rows<
                     };
                     let mut tri_state = ActiveTri {
                         walk,
-                        depth: DepthWalk::new(&DepthPlane::new(&solver, &s), &walk),
+                        depth: DepthPlane::new(&solver, &s),
                         payload: S::payload::<P, SUB>(face, id, &solver, &s),
                         key: R::Key::from_raw(key),
                     };
@@ -875,7 +859,7 @@ fn walk_band<P: RowPixel, S: Shading, const SUB: u32, R: Resolve<P, S>>(
             stats.fragments += (r - l) as u32;
             stats.pixels_written += resolve.span(t, order, y, l, r);
         }
-        if !t.advance::<SUB>() {
+        if !t.walk.advance::<SUB>() {
             return false;
         }
     }

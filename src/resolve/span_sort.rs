@@ -94,8 +94,7 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanSort<'_, P, S::Payload<P>> {
     }
     #[inline]
     fn span(&mut self, t: &ActiveTri<S::Payload<P>>, order: usize, y: i32, l: i32, r: i32) -> u32 {
-        debug_assert_eq!(y, t.walk.row(), "internal error: a span off the walk's row");
-        let (q, dq) = t.span_depth(l);
+        let (q, dq) = t.depth.span_start(l, y);
         // At most one span per active triangle, and the list holds as many as the active list.
         let pushed = self.spans.push(SortSpan {
             l,
