@@ -27,7 +27,6 @@
 //! solved in i128 once per triangle and stepped in i64 (depth) or i32 (colour).
 
 use crate::depth::Depth;
-use crate::math::Reciprocal;
 use crate::project::ScreenVertex;
 use core::cmp::Ordering;
 use fixed::types::I16F16;
@@ -309,9 +308,6 @@ pub struct PlaneSolver {
     e2: (i64, i64),
     /// Twice the doubled-unit area, made positive (`flip` remembers the sign).
     area: i64,
-    /// The reciprocal of `2 · area`, the denominator of every rounded quotient of the 64-bit
-    /// path (one division per triangle instead of one per plane coefficient).
-    recip: Option<Reciprocal>,
     flip: bool,
     sub_bits: u32,
 }
@@ -336,7 +332,6 @@ impl PlaneSolver {
             e1,
             e2,
             area: area.abs(),
-            recip: Reciprocal::new(area.unsigned_abs().saturating_mul(2)),
             flip: area < 0,
             sub_bits: S,
         })
@@ -397,15 +392,13 @@ impl PlaneSolver {
             .checked_mul(self.to_ref.0)?
             .checked_add(num_y.checked_mul(self.to_ref.1)?)?;
         let scale = 1i64.checked_shl(extra)?;
-        let recip = self.recip.as_ref()?;
-        let div = |n: i64| round_div_i64(recip, n, area);
         let value = f0
             .checked_mul(scale)?
-            .checked_add(div(to_ref.checked_mul(scale)?)?)?;
+            .checked_add(round_div_i64(to_ref.checked_mul(scale)?, area)?)?;
         Some(Plane {
             value,
-            dx: div(num_x.checked_mul(px)?)?,
-            dy: div(num_y.checked_mul(px)?)?,
+            dx: round_div_i64(num_x.checked_mul(px)?, area)?,
+            dy: round_div_i64(num_y.checked_mul(px)?, area)?,
         })
     }
 }
@@ -418,11 +411,13 @@ fn cross_diff_i64(a: i64, b: i64, c: i64, d: i64) -> Option<i64> {
     (small(a) && small(b) && small(c) && small(d)).then(|| a * b - c * d)
 }
 
-/// [`round_div`] in 64 bits, `None` if `2·n + d` does not fit (`d >= 1`); `recip` is the
-/// reciprocal of `2·d`, which makes the division exact multiplies.
+/// [`round_div`] in 64 bits, `None` if `2·n + d` does not fit (`d >= 1`).
 #[inline]
-fn round_div_i64(recip: &Reciprocal, n: i64, d: i64) -> Option<i64> {
-    Some(recip.floor_div_signed(n.checked_mul(2)?.checked_add(d)?))
+fn round_div_i64(n: i64, d: i64) -> Option<i64> {
+    let d = d.max(1);
+    n.checked_mul(2)?
+        .checked_add(d)?
+        .checked_div_euclid(d.checked_mul(2)?)
 }
 
 /// `a·b − c·d`, exactly. When every factor fits 31 bits the products and their difference fit
