@@ -18,7 +18,11 @@ fn main() -> Result<(), String> {
     for v in VARIANTS {
         let of: Vec<_> = all.iter().filter(|a| a.variant == v.name).collect();
         let views = of.len().max(1) as f64;
-        let mean = of.iter().map(|a| a.metrics.id_mismatch_percent()).sum::<f64>() / views;
+        let mean = of
+            .iter()
+            .map(|a| a.metrics.id_mismatch_percent())
+            .sum::<f64>()
+            / views;
         let worst = of
             .iter()
             .map(|a| a.metrics.id_mismatch_percent())
@@ -26,7 +30,10 @@ fn main() -> Result<(), String> {
         let sum = |f: fn(&scanline3d_sim::metrics::Metrics) -> usize| {
             of.iter().map(|a| f(&a.metrics)).sum::<usize>()
         };
-        let psnr = of.iter().map(|a| a.metrics.psnr).fold(f64::INFINITY, f64::min);
+        let psnr = of
+            .iter()
+            .map(|a| a.metrics.psnr)
+            .fold(f64::INFINITY, f64::min);
         let colour = of.iter().map(|a| a.metrics.color_max).max().unwrap_or(0);
         println!(
             "| {} | {} | {} | {mean:.4} % / {worst:.3} % | {} | {} | {psnr:.2} dB | {colour} |",
