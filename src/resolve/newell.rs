@@ -31,15 +31,22 @@
 //! # Splitting and tolerances
 //!
 //! A piece is cut where its edges cross the other's plane. The new vertices are rounded to
-//! the sub-pixel grid (and `q` to an I2F30 step) and shared by the pieces on both sides, so
-//! the cut is watertight (the outer edges move by at most half a sub-pixel where a cut meets
-//! them). Rounded vertices are no longer exactly on the cutting plane, so tests 3 and 4 count
+//! the sub-pixel grid (and `q` to an I2F30 step) and shared by the pieces on both sides.
+//! Rounded vertices are no longer exactly on the cutting plane, so tests 3 and 4 count
 //! a vertex as on a plane when the plane passes through its rounding cell (`±½` in `x`, `y`
 //! and `q`): `2·|n·(v − a)| ≤ |n_x| + |n_y| + |n_q|`. The pieces of a split then always pass
 //! against the plane that cut them, so no cut is repeated. The price is that a piece may stick
 //! out of another's plane by less than that cell and still be drawn behind it: the pixels
 //! affected lie within about half a sub-pixel of where the two planes meet, where the depth
 //! gap is below the renderer's error bound.
+//!
+//! The rounded parts are only used to find the order. What is painted is the original
+//! piece, cut by a *split tree*: each split records the screen lines between its parts (the
+//! line through the two rounded cut points, and the diagonal of a four-sided part), and every
+//! pixel centre of the original goes to exactly one side of each line. So the parts tile the
+//! original exactly, whatever the rounding: no crack where a rounded cut point falls inside
+//! an outer edge, no T-junction where a later cut meets an earlier one, and the original's
+//! coverage is the span z-buffer's.
 //!
 //! # Ties
 //!
@@ -68,20 +75,24 @@
 //!
 //! # Painting
 //!
-//! The final order is handed to the shared row walker as a key per piece (its position), and
-//! spans are painted far to near into one row of pixels with the depth sort's painter, so rows
-//! reach the sink one at a time and [`Row::depth`](crate::sink::Row::depth) is empty. Pieces
-//! carry their vertex colours rounded to 8 bits a channel (split vertices interpolate them),
-//! so Gouraud colours may differ from the span z-buffer's by rounding.
+//! The original pieces go to the shared row walker, each with its split tree as key. On each
+//! row the painter divides an original's span at the tree's lines (exact integer arithmetic
+//! at the pixel centres) and gives each run the position of its part in the final order.
+//! A pixel takes the colour of the latest part in the order that covers it, which is what
+//! painting the parts far to near gives, kept as one position per pixel of the row; rows
+//! reach the sink one at a time and [`Row::depth`](crate::sink::Row::depth) is empty. A part
+//! whose pixels a later part already holds is not written, so `pixels_written` is at most
+//! `fragments`. Colours are the original's (its vertex colours rounded to 8 bits a channel).
 //!
 //! # Memory
 //!
 //! A [`NewellWorkspace`] holds, in bytes:
 //!
-//! * `PIECES · 61`: the kept pieces ([`StoredTriangle`], 52), the list (2), a key per piece
-//!   (4: its activation rank while sorting, then its position), a mark (1) and a bucket link (2);
-//! * `2·H` bucket heads, `size_of::<P>()·W` for one row of pixels and `ACTIVE` active
-//!   triangles (about 104 bytes each for flat shading).
+//! * `PIECES · 89`: the kept pieces ([`StoredTriangle`], 52), the list (2), a key per piece
+//!   (4: its activation rank while sorting, then its position), a mark (1), a bucket link (2),
+//!   a split-tree link (4) and a split-tree cut (24: two points and two links);
+//! * `2·H` bucket heads, `size_of::<P>()·W + 4·W` for one row of pixels and their positions,
+//!   and `ACTIVE` active triangles (about 104 bytes each for flat shading).
 //!
 //! [`NewellWorkspace::BYTES`] gives the total.
 
@@ -119,6 +130,9 @@ pub struct SortStats {
     pub pieces_in: u32,
     /// Pieces painted (after splitting).
     pub pieces_out: u32,
+    /// Workspace entries the frame used: the kept pieces and every part made by splitting
+    /// (an original that is split keeps its entry). `PIECES` must be at least this.
+    pub entries: u32,
     /// Pairs compared.
     pub comparisons: u32,
     /// Pieces moved to the head of the list.
@@ -144,7 +158,8 @@ pub struct SortStats {
 /// wherever two pieces overlap (see the [module docs](self) for the tests, the splitting, the
 /// work bound and the memory).
 ///
-/// * `PIECES`: screen pieces per frame, including those made by splitting (≤ 65535);
+/// * `PIECES`: screen pieces per frame, including those made by splitting (≤ 65535; an
+///   original that is split keeps its entry, its parts take new ones);
 /// * `ACTIVE`: pieces that may cross one row (more are dropped and reported, as for the
 ///   other row walkers).
 ///
@@ -158,8 +173,8 @@ pub struct SortStats {
 /// let scene = demo::scene(&instances, 0, demo::ORBIT_FRAMES)?;
 /// let stats = ws.render(&scene, &RenderOptions::default(), &mut HashSink::new()).unwrap();
 /// assert!(stats.is_complete());
-/// // Every covered pixel is painted, hidden ones too.
-/// assert_eq!(stats.pixels_written, stats.fragments);
+/// // A part is not written where a part later in the order already is.
+/// assert!(stats.pixels_written <= stats.fragments);
 /// assert!(ws.sort_stats().pieces_out >= ws.sort_stats().pieces_in);
 /// # Ok::<(), scanline3d::scene::SceneError>(())
 /// ```
@@ -229,6 +244,7 @@ impl<
             last: SortStats {
                 pieces_in: 0,
                 pieces_out: 0,
+                entries: 0,
                 comparisons: 0,
                 moves: 0,
                 re_moves: 0,
@@ -295,6 +311,7 @@ impl<
         let result = sort.run();
         let (n, len, cuts) = (sort.n, sort.len, sort.cuts);
         sort.stats.pieces_out = len as u32;
+        sort.stats.entries = n as u32;
         self.last = sort.stats;
         result?;
 
@@ -925,7 +942,7 @@ impl Cut {
             (true, (slope < 0).then(|| at0.div_euclid(-slope) + 1))
         } else {
             // First column with slope·c + at0 ≥ 0.
-            (false, (slope > 0).then(|| -((-at0).div_euclid(slope))))
+            (false, (slope > 0).then(|| -(at0.div_euclid(slope))))
         }
     }
 }
@@ -1168,6 +1185,38 @@ mod tests {
         assert!((total - area(&t)).abs() <= 200, "{total} vs {}", area(&t));
         for p in parts.iter().flatten() {
             assert!(!plane.straddled_by(p), "{p:?}");
+        }
+    }
+
+    #[test]
+    fn a_cut_sends_each_pixel_centre_to_one_side_and_finds_where_it_changes() {
+        // Lines at various slopes through sub-pixel points (4 bits), against the sign of the
+        // cross product at each centre of a row.
+        for (a, b) in [
+            ([3, 5], [200, 90]),
+            ([40, 0], [41, 300]),
+            ([0, 17], [150, 17]),
+            ([100, 8], [20, 250]),
+            ([64, 0], [64, 99]),
+        ] {
+            let cut = Cut { a, b, ..Cut::EMPTY };
+            let side = |c: i32, y: i32| {
+                let line = Line { a, b, inside: a };
+                line.side([c * 16 + 8, y * 16 + 8]) >= 0
+            };
+            for y in 0..16 {
+                for x in 0..20 {
+                    let (pos, change) = cut.side_and_end::<4>(x, y);
+                    assert_eq!(pos, side(x, y), "{a:?} {b:?} at {x}, {y}");
+                    let first = (x + 1..200).find(|&c| side(c, y) != pos);
+                    let change = change.map(|c| c.max(x as i128 + 1) as i32);
+                    assert_eq!(
+                        change.filter(|&c| c < 200),
+                        first,
+                        "{a:?} {b:?} at {x}, {y}"
+                    );
+                }
+            }
         }
     }
 
