@@ -937,12 +937,15 @@ impl Cut {
         let slope = -(dy << (SUB + 1));
         let at0 = dx * cy - dy * cx(0);
         let here = slope * x as i128 + at0;
+        // (Checked divisions: the divisor is positive, so `None` only stands for no change.)
         if here >= 0 {
             // First column with slope·c + at0 < 0.
-            (true, (slope < 0).then(|| at0.div_euclid(-slope) + 1))
+            let first = at0.checked_div_euclid(-slope).map(|c| c + 1);
+            (true, first.filter(|_| slope < 0))
         } else {
             // First column with slope·c + at0 ≥ 0.
-            (false, (slope > 0).then(|| -(at0.div_euclid(slope))))
+            let first = at0.checked_div_euclid(slope).map(|c| -c);
+            (false, first.filter(|_| slope > 0))
         }
     }
 }
@@ -976,7 +979,8 @@ impl<P: RowPixel, const SUB: u32> OrderPainter<'_, P, SUB> {
             };
             let (pos, change) = cut.side_and_end::<SUB>(x, y);
             if let Some(c) = change {
-                end = end.min(c.clamp(x as i128 + 1, i32::MAX as i128) as i32);
+                // (`max`/`min` rather than `clamp`, which keeps a panic path.)
+                end = end.min(c.max(x as i128 + 1).min(i32::MAX as i128) as i32);
             }
             r = if pos { cut.pos } else { cut.neg };
         }
