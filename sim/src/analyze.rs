@@ -191,6 +191,71 @@ pub struct Analysis {
     pub depth_bits_at_far: f64,
     /// Accuracy and coordinate headroom per sub-pixel setting.
     pub settings: Vec<SettingAccuracy>,
+    /// What Newell's depth sort needs over the views (4 sub-pixel bits).
+    pub newell: NewellNeeds,
+    /// Why Newell's needs could not be measured, if they could not (`newell` is then the
+    /// views before).
+    pub newell_error: Option<String>,
+}
+
+/// What Newell's depth sort (`scanline3d::resolve::NewellWorkspace`) needs, the most over
+/// the analysed views.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NewellNeeds {
+    /// Workspace entries (kept pieces and the parts of splits): `PIECES`.
+    pub entries: u32,
+    /// Search steps; the workspace allows `step_limit(PIECES)`.
+    pub steps: u32,
+    /// Pieces painted.
+    pub pieces_out: u32,
+    /// Splits.
+    pub splits: u32,
+}
+
+impl NewellNeeds {
+    /// `PIECES` with the margin: room for the entries and for the steps
+    /// (`step_limit(PIECES) = 8 · PIECES + 64`), at most 65535.
+    pub fn pieces_capacity(&self, margin_percent: u32) -> usize {
+        let entries = with_margin(self.entries as usize, margin_percent);
+        let steps = with_margin(self.steps as usize, margin_percent);
+        let for_steps = steps.saturating_sub(64).div_ceil(8);
+        entries
+            .max(for_steps)
+            .clamp(1, scanline3d::scene::MAX_SCENE_TRIANGLES)
+    }
+}
+
+/// What Newell's sort needs for `spec` seen by its camera at `w × h` and 4 sub-pixel bits,
+/// measured with the largest workspace (`PIECES` = 65535).
+pub fn newell_needs(spec: &SceneSpec, w: usize, h: usize) -> Result<NewellNeeds, String> {
+    use crate::scene::MAX_SIZE;
+    use scanline3d::resolve::NewellWorkspace;
+    use scanline3d::sink::{FnSink, Row, TriangleId};
+    type Ws = NewellWorkspace<TriangleId, Flat, MAX_SIZE, MAX_SIZE, 65535, 4096>;
+    let options = scanline3d::RenderOptions::default().with_back_face_culling(spec.cull_back_faces);
+    // The workspace is built by value (megabytes): on a thread with room for it.
+    std::thread::scope(|scope| {
+        std::thread::Builder::new()
+            .stack_size(256 << 20)
+            .spawn_scoped(scope, || {
+                let mut ws: Box<Ws> = Box::new(Ws::new(TriangleId::NONE));
+                spec.with_scene(|scene| {
+                    let mut rows = FnSink(|_: Row<'_, TriangleId>| -> Result<(), ()> { Ok(()) });
+                    ws.render_sized(w, h, scene, &options, &mut rows)
+                        .map_err(|e| format!("newell: {e:?}"))
+                })??;
+                let s = ws.sort_stats();
+                Ok(NewellNeeds {
+                    entries: s.entries,
+                    steps: s.steps,
+                    pieces_out: s.pieces_out,
+                    splits: s.splits,
+                })
+            })
+            .map_err(|e| format!("cannot start render thread: {e}"))?
+            .join()
+            .map_err(|_| "render thread panicked".to_string())?
+    })
 }
 
 /// Capacities with a safety margin in percent (rounded up; at least the measured value).
@@ -281,6 +346,18 @@ pub fn analyze(
             ..spec.clone()
         };
         let reference = view.reference()?;
+        if a.newell_error.is_none() {
+            match newell_needs(&view, w, h) {
+                Ok(n) => {
+                    let needs = &mut a.newell;
+                    needs.entries = needs.entries.max(n.entries);
+                    needs.steps = needs.steps.max(n.steps);
+                    needs.pieces_out = needs.pieces_out.max(n.pieces_out);
+                    needs.splits = needs.splits.max(n.splits);
+                }
+                Err(e) => a.newell_error = Some(e),
+            }
+        }
         // Numeric headroom from the vertices themselves.
         let mut eye_max: f64 = 0.0;
         let mut screen_max: f64 = 0.0;
@@ -349,6 +426,14 @@ impl fmt::Display for Analysis {
             "per row: at most {} active triangles, {} spans",
             self.peak_active, self.peak_spans
         )?;
+        match (&self.newell_error, &self.newell) {
+            (None, n) => writeln!(
+                f,
+                "newell (4 sub-pixel bits): at most {} workspace entries, {} sort steps, {} splits, {} pieces painted per view",
+                n.entries, n.steps, n.splits, n.pieces_out
+            )?,
+            (Some(e), _) => writeln!(f, "newell: not measured ({e})")?,
+        }
         if self.views_clipping == 0 {
             writeln!(
                 f,

@@ -284,6 +284,23 @@ impl Export<'_> {
             a.peak_active
         );
         let _ = writeln!(s, "pub const MAX_ACTIVE: usize = {active};");
+        match &a.newell_error {
+            None => {
+                let _ = writeln!(
+                    s,
+                    "/// Newell's depth sort (`PIECES`): {} workspace entries and {} sort steps measured, plus the margin.",
+                    a.newell.entries, a.newell.steps
+                );
+                let _ = writeln!(
+                    s,
+                    "pub const NEWELL_PIECES: usize = {};",
+                    a.newell.pieces_capacity(self.margin_percent)
+                );
+            }
+            Some(e) => {
+                let _ = writeln!(s, "// Newell's depth sort was not measured: {e}");
+            }
+        }
         let _ = writeln!(
             s,
             "/// Whether any analysed view needed clipping (if not, `NoClip` is safe for these views)."

@@ -577,6 +577,12 @@ fn analyze_command(a: AnalyzeArgs) -> Result<(), String> {
     for (name, bytes) in analysis.buffers(margin) {
         say!("  {bytes:>7} B  {name}");
     }
+    if analysis.newell_error.is_none() {
+        say!(
+            "newell (margin {margin} %): PIECES = {}",
+            analysis.newell.pieces_capacity(margin)
+        );
+    }
     match analysis.recommended(a.goal) {
         Some(s) => say!(
             "recommended for ≤ {} % id mismatches and no real ones: {} sub-pixel bits",

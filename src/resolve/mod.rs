@@ -11,7 +11,7 @@
 //! | [`ZBufferWorkspace`] | full-frame z-buffer: a band of `H` rows | `H·W` depth + `H·W` pixels | same |
 //! | [`SpanSortWorkspace`] | span sorting (Watkins): visible segments from depths at span ends | one row of pixels, a span list; no depth | each pixel once |
 //! | [`DepthSortWorkspace`] | depth sort / painter's: far to near by mean depth, overwriting | one row of pixels, a key per triangle; no depth | every covered pixel (overdraw) |
-//! | [`NewellWorkspace`] | depth sort (Newell, Newell and Sancha): far to near, overlaps resolved by plane and projection tests, splitting cycles and interpenetration | every kept piece and its order, one row of pixels; no depth | every covered pixel (overdraw) |
+//! | [`NewellWorkspace`] | depth sort (Newell, Newell and Sancha): far to near, overlaps resolved by plane and projection tests, splitting cycles and interpenetration | every kept piece, its order and split tree, one row of pixels and of positions; no depth | every covered pixel not yet held by a later piece |
 //! | [`bsp::BspWorkspace`] | BSP tree order (Fuchs, Kedem, Naylor): far to near for any eye position, the tree built ahead of time | one row of pixels, a key per triangle, a traversal stack; no depth | every covered pixel (overdraw) |
 //! | [`WarnockWorkspace`] | area subdivision (Warnock): windows split until simple | every kept piece, a frame of pixels, a window stack and index buffer; no depth | each pixel once |
 //!

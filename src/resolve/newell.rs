@@ -31,15 +31,22 @@
 //! # Splitting and tolerances
 //!
 //! A piece is cut where its edges cross the other's plane. The new vertices are rounded to
-//! the sub-pixel grid (and `q` to an I2F30 step) and shared by the pieces on both sides, so
-//! the cut is watertight (the outer edges move by at most half a sub-pixel where a cut meets
-//! them). Rounded vertices are no longer exactly on the cutting plane, so tests 3 and 4 count
+//! the sub-pixel grid (and `q` to an I2F30 step) and shared by the pieces on both sides.
+//! Rounded vertices are no longer exactly on the cutting plane, so tests 3 and 4 count
 //! a vertex as on a plane when the plane passes through its rounding cell (`±½` in `x`, `y`
 //! and `q`): `2·|n·(v − a)| ≤ |n_x| + |n_y| + |n_q|`. The pieces of a split then always pass
 //! against the plane that cut them, so no cut is repeated. The price is that a piece may stick
 //! out of another's plane by less than that cell and still be drawn behind it: the pixels
 //! affected lie within about half a sub-pixel of where the two planes meet, where the depth
 //! gap is below the renderer's error bound.
+//!
+//! The rounded parts are only used to find the order. What is painted is the original
+//! piece, cut by a *split tree*: each split records the screen lines between its parts (the
+//! line through the two rounded cut points, and the diagonal of a four-sided part), and every
+//! pixel centre of the original goes to exactly one side of each line. So the parts tile the
+//! original exactly, whatever the rounding: no crack where a rounded cut point falls inside
+//! an outer edge, no T-junction where a later cut meets an earlier one, and the original's
+//! coverage is the span z-buffer's.
 //!
 //! # Ties
 //!
@@ -68,29 +75,35 @@
 //!
 //! # Painting
 //!
-//! The final order is handed to the shared row walker as a key per piece (its position), and
-//! spans are painted far to near into one row of pixels with the depth sort's painter, so rows
-//! reach the sink one at a time and [`Row::depth`](crate::sink::Row::depth) is empty. Pieces
-//! carry their vertex colours rounded to 8 bits a channel (split vertices interpolate them),
-//! so Gouraud colours may differ from the span z-buffer's by rounding.
+//! The original pieces go to the shared row walker, each with its split tree as key. On each
+//! row the painter divides an original's span at the tree's lines (exact integer arithmetic
+//! at the pixel centres) and gives each run the position of its part in the final order.
+//! A pixel takes the colour of the latest part in the order that covers it, which is what
+//! painting the parts far to near gives, kept as one position per pixel of the row; rows
+//! reach the sink one at a time and [`Row::depth`](crate::sink::Row::depth) is empty. A part
+//! whose pixels a later part already holds is not written, so `pixels_written` is at most
+//! `fragments`. Colours are the original's (its vertex colours rounded to 8 bits a channel).
 //!
 //! # Memory
 //!
 //! A [`NewellWorkspace`] holds, in bytes:
 //!
-//! * `PIECES · 61`: the kept pieces ([`StoredTriangle`], 52), the list (2), a key per piece
-//!   (4: its activation rank while sorting, then its position), a mark (1) and a bucket link (2);
-//! * `2·H` bucket heads, `size_of::<P>()·W` for one row of pixels and `ACTIVE` active
-//!   triangles (about 104 bytes each for flat shading).
+//! * `PIECES · 89`: the kept pieces ([`StoredTriangle`], 52), the list (2), a key per piece
+//!   (4: its activation rank while sorting, then its position), a mark (1), a bucket link (2),
+//!   a split-tree link (4) and a split-tree cut (24: two points and two links);
+//! * `2·H` bucket heads, `size_of::<P>()·W + 4·W` for one row of pixels and their positions,
+//!   and `ACTIVE` active triangles (about 104 bytes each for flat shading).
 //!
 //! [`NewellWorkspace::BYTES`] gives the total.
 
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
+use crate::depth::DepthRow;
 use crate::options::{RenderOptions, MAX_INSTANCES};
-use crate::render::{internal, viewport, walk_rows, ActiveTri, Buckets, NO_ENTRY};
+use crate::render::{
+    internal, viewport, walk_rows, ActiveTri, Buckets, FinishedRow, Resolve, NO_ENTRY,
+};
 use crate::resolve::common::{check_sizes, render_whole_target, sort_by_key};
-use crate::resolve::depth_sort::Painter;
 use crate::resolve::store::{self, StoredPieces, StoredTriangle};
 use crate::scene::Scene;
 use crate::shading::Shading;
@@ -117,6 +130,9 @@ pub struct SortStats {
     pub pieces_in: u32,
     /// Pieces painted (after splitting).
     pub pieces_out: u32,
+    /// Workspace entries the frame used: the kept pieces and every part made by splitting
+    /// (an original that is split keeps its entry). `PIECES` must be at least this.
+    pub entries: u32,
     /// Pairs compared.
     pub comparisons: u32,
     /// Pieces moved to the head of the list.
@@ -142,7 +158,8 @@ pub struct SortStats {
 /// wherever two pieces overlap (see the [module docs](self) for the tests, the splitting, the
 /// work bound and the memory).
 ///
-/// * `PIECES`: screen pieces per frame, including those made by splitting (≤ 65535);
+/// * `PIECES`: screen pieces per frame, including those made by splitting (≤ 65535; an
+///   original that is split keeps its entry, its parts take new ones);
 /// * `ACTIVE`: pieces that may cross one row (more are dropped and reported, as for the
 ///   other row walkers).
 ///
@@ -156,8 +173,8 @@ pub struct SortStats {
 /// let scene = demo::scene(&instances, 0, demo::ORBIT_FRAMES)?;
 /// let stats = ws.render(&scene, &RenderOptions::default(), &mut HashSink::new()).unwrap();
 /// assert!(stats.is_complete());
-/// // Every covered pixel is painted, hidden ones too.
-/// assert_eq!(stats.pixels_written, stats.fragments);
+/// // A part is not written where a part later in the order already is.
+/// assert!(stats.pixels_written <= stats.fragments);
 /// assert!(ws.sort_stats().pieces_out >= ws.sort_stats().pieces_in);
 /// # Ok::<(), scanline3d::scene::SceneError>(())
 /// ```
@@ -175,8 +192,11 @@ pub struct NewellWorkspace<
     keys: [u32; PIECES],
     marked: [bool; PIECES],
     next: [u16; PIECES],
+    tree: [u32; PIECES],
+    nodes: [Cut; PIECES],
     heads: [u16; H],
     pixels: [P; W],
+    order: [u32; W],
     background: P,
     active: Vec<ActiveTri<S::Payload<P>, u32>, ACTIVE>,
     last: SortStats,
@@ -214,13 +234,17 @@ impl<
             keys: [0; PIECES],
             marked: [false; PIECES],
             next: [NO_ENTRY; PIECES],
+            tree: [0; PIECES],
+            nodes: [Cut::EMPTY; PIECES],
             heads: [NO_ENTRY; H],
             pixels: [background; W],
+            order: [0; W],
             background,
             active: Vec::new(),
             last: SortStats {
                 pieces_in: 0,
                 pieces_out: 0,
+                entries: 0,
                 comparisons: 0,
                 moves: 0,
                 re_moves: 0,
@@ -252,9 +276,11 @@ impl<
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
         let vp = viewport::<SUB_BITS, K::Error>(width, height, W, H, scene)?;
-        let (Some(pixels), Some(heads)) =
-            (self.pixels.get_mut(..width), self.heads.get_mut(..height))
-        else {
+        let (Some(pixels), Some(order), Some(heads)) = (
+            self.pixels.get_mut(..width),
+            self.order.get_mut(..width),
+            self.heads.get_mut(..height),
+        ) else {
             return Err(RenderError::InvalidTarget);
         };
         let (n, stats) = store::collect::<S, SUB_BITS, C, A, K::Error, INSTANCES>(
@@ -263,40 +289,56 @@ impl<
             &vp,
             &mut self.store,
         )?;
+        let collected = n;
+        // Each original is a whole tree of one piece until it is split.
+        for (i, t) in self.tree.iter_mut().take(n).enumerate() {
+            *t = LEAF | i as u32;
+        }
         let mut sort = Sort {
             store: &mut self.store,
             keys: &mut self.keys,
             marked: &mut self.marked,
             list: &mut self.list,
+            tree: &mut self.tree,
+            nodes: &mut self.nodes,
+            originals: n,
             n,
             len: 0,
+            cuts: 0,
             stats: SortStats::default(),
         };
         sort.ranks::<SUB_BITS>(vp.width as i32, vp.height as i32);
         let result = sort.run();
-        let (n, len) = (sort.n, sort.len);
+        let (n, len, cuts) = (sort.n, sort.len, sort.cuts);
         sort.stats.pieces_out = len as u32;
+        sort.stats.entries = n as u32;
         self.last = sort.stats;
         result?;
 
-        // Key = position in the final order: the row walker's painter draws ascending keys.
-        // (List entries index the store's first `n` pieces, `n <= PIECES`.)
+        // Key = position in the final order, from 1 (0: nothing painted yet). (List entries
+        // index the store's first `n` pieces, `n <= PIECES`.)
+        self.keys.fill(0);
         for (k, &i) in self.list.iter().take(len).enumerate() {
             if let Some(key) = self.keys.get_mut(i as usize) {
-                *key = k as u32;
+                *key = k as u32 + 1;
             } else {
                 debug_assert!(false, "internal error: list entry {i} out of the store");
             }
         }
-        let store = internal(self.store.get(..n), &[]);
-        store::bucket(store, &vp, heads, &mut self.next);
+        // The original pieces are walked, with their split trees as keys: the painter finds
+        // each pixel's piece in the tree, so split pieces tile their original exactly.
+        let originals = internal(self.store.get(..collected), &[]);
+        store::bucket(originals, &vp, heads, &mut self.next);
         let pieces = StoredPieces {
-            store,
-            keys: internal(self.keys.get(..n), &[]),
+            store: originals,
+            keys: internal(self.tree.get(..originals.len()), &[]),
         };
-        let mut painter = Painter {
+        let mut painter = OrderPainter::<P, SUB_BITS> {
             pixels,
+            order,
             background: self.background,
+            cuts: internal(self.nodes.get(..cuts), &[]),
+            positions: internal(self.keys.get(..n), &[]),
             spans: 0,
         };
         let height = heads.len();
@@ -444,6 +486,16 @@ struct Sort<'a> {
     keys: &'a mut [u32],
     marked: &'a mut [bool],
     list: &'a mut [u16],
+    /// Per original piece (the first `originals`): its split tree ([`LEAF`]` | piece`, a cut,
+    /// or [`NOTHING`]). Per piece made by a split: where it hangs ([`ROOT`]` | original`, or
+    /// `cut << 1 | side`, side 0 for the cut's `pos`).
+    tree: &'a mut [u32],
+    /// The cuts made so far are `nodes[..cuts]`.
+    nodes: &'a mut [Cut],
+    cuts: usize,
+    /// The pieces the pipeline kept: they stay in the store unchanged (they are what the
+    /// painter walks), their parts go after them.
+    originals: usize,
     /// Pieces in the store.
     n: usize,
     /// Pieces in the list.
@@ -669,7 +721,8 @@ impl Sort<'_> {
         Ok(())
     }
 
-    /// Splits list entry `at` by `plane` and files its pieces in the sorted part of the list.
+    /// Splits list entry `at` by `plane`, files its parts in the sorted part of the list and
+    /// puts the cut into the split tree in the piece's place.
     fn split<E>(
         &mut self,
         at: usize,
@@ -681,18 +734,28 @@ impl Sort<'_> {
             return Ok(());
         };
         let t = *self.piece(x);
-        let (parts, made) = cut(&t, &plane);
-        let count = parts.iter().flatten().count();
-        let extra = count.saturating_sub(1);
-        if self.n + extra > self.store.len() {
+        let parts = cut(&t, &plane);
+        let count = parts.parts.iter().flatten().count();
+        // An original keeps its entry (the painter walks it); a part's entry goes to its
+        // first part.
+        let reuse = x as usize >= self.originals;
+        let extra = count.saturating_sub(reuse as usize);
+        let cuts = count.saturating_sub(1);
+        if self.n + extra > self.store.len() || self.cuts + cuts > self.nodes.len() {
             return Err(RenderError::Capacity {
                 what: CapacityKind::Pieces,
-                needed: self.n + extra,
+                needed: (self.n + extra).max(self.store.len() + 1),
                 capacity: self.store.len(),
             });
         }
         self.stats.splits += 1;
-        self.stats.dropped_slivers += (made - count) as u32;
+        self.stats.dropped_slivers += (parts.made - count) as u32;
+        // Where the piece hangs in its tree (read before its entry is reused).
+        let place = if reuse {
+            internal(self.tree.get(x as usize).copied(), NOTHING)
+        } else {
+            ROOT | x as u32
+        };
         // Take the piece out of the list.
         if let Some(rest @ [_, ..]) = self.list.get_mut(at..self.len) {
             rest.rotate_left(1);
@@ -704,12 +767,15 @@ impl Sort<'_> {
             *front -= 1;
         }
         let rank = self.rank(x);
-        let mut slot = Some(x as usize);
-        for part in parts.into_iter().flatten() {
+        let mut slot = reuse.then_some(x as usize);
+        let mut refs = [None; 3];
+        for (r, part) in refs.iter_mut().zip(parts.parts) {
+            let Some(part) = part else { continue };
             let i = slot.take().unwrap_or_else(|| {
                 self.n += 1;
                 self.n - 1
             });
+            *r = Some(LEAF | i as u32);
             if let (Some(s), Some(k), Some(m)) = (
                 self.store.get_mut(i),
                 self.keys.get_mut(i),
@@ -748,7 +814,234 @@ impl Sort<'_> {
             // Every part was a sliver: the piece is gone.
             *s = StoredTriangle::EMPTY;
         }
+        // The parts' tree: part 0 | (part 1 | part 2), leaving out cuts with nothing on a side.
+        let [r0, r1, r2] = refs;
+        let [l0, l1] = parts.lines;
+        let rest = self.join(l1, r1, r2);
+        let whole = self.join(l0, r0, rest);
+        self.hang(whole.unwrap_or(NOTHING), place);
         Ok(())
+    }
+
+    /// The tree of `first` and `rest` split by `line` (whose `inside` point is on `first`'s
+    /// side): a new cut if both are there, else whichever is.
+    fn join(&mut self, line: Line, first: Option<u32>, rest: Option<u32>) -> Option<u32> {
+        let (Some(first), Some(rest)) = (first, rest) else {
+            return first.or(rest);
+        };
+        let (pos, neg) = if line.side(line.inside) >= 0 {
+            (first, rest)
+        } else {
+            (rest, first)
+        };
+        let k = self.cuts;
+        let Some(node) = self.nodes.get_mut(k) else {
+            // Room for every cut was checked before the split.
+            debug_assert!(false, "internal error: no room for cut {k}");
+            return Some(first);
+        };
+        *node = Cut {
+            a: line.a,
+            b: line.b,
+            pos,
+            neg,
+        };
+        self.cuts += 1;
+        self.hang(pos, (k as u32) << 1);
+        self.hang(neg, (k as u32) << 1 | 1);
+        Some(k as u32)
+    }
+
+    /// Hangs tree `r` at `place` (see [`Sort::tree`]); a piece remembers where it hangs.
+    fn hang(&mut self, r: u32, place: u32) {
+        let slot = if place == NOTHING {
+            None
+        } else if place & ROOT != 0 {
+            self.tree.get_mut((place & !ROOT) as usize)
+        } else {
+            self.nodes.get_mut((place >> 1) as usize).map(|c| {
+                if place & 1 == 0 {
+                    &mut c.pos
+                } else {
+                    &mut c.neg
+                }
+            })
+        };
+        match slot {
+            Some(s) => *s = r,
+            None => debug_assert!(false, "internal error: no place {place:#x} for {r:#x}"),
+        }
+        if r != NOTHING && r & LEAF != 0 {
+            if let Some(p) = self.tree.get_mut((r & !LEAF) as usize) {
+                *p = place;
+            }
+        }
+    }
+}
+
+/// A split-tree reference to a piece: `LEAF | index` (else the index of a [`Cut`]).
+const LEAF: u32 = 1 << 31;
+/// A split-tree reference to nothing: parts that all rounded to no area.
+const NOTHING: u32 = u32::MAX;
+/// Where a piece hangs when it is a whole tree: `ROOT | original`.
+const ROOT: u32 = 1 << 31;
+
+/// A line through two points of the sub-pixel grid, and a point off it.
+#[derive(Clone, Copy, Debug)]
+struct Line {
+    a: [i32; 2],
+    b: [i32; 2],
+    inside: [i32; 2],
+}
+
+impl Line {
+    /// `(b − a) × (p − a)`: its sign says on which side of the line `p` is.
+    fn side(&self, p: [i32; 2]) -> i64 {
+        let d = |k: usize| self.b[k] as i64 - self.a[k] as i64;
+        d(0) * (p[1] as i64 - self.a[1] as i64) - d(1) * (p[0] as i64 - self.a[0] as i64)
+    }
+}
+
+/// A node of a split tree: the original piece's region is cut by the line through `a` and `b`
+/// (sub-pixel points); pixel centres `p` where `(b − a) × (p − a) ≥ 0` go to `pos`, the
+/// others to `neg` (each a [`LEAF`] piece, another cut or [`NOTHING`]). Every pixel centre of
+/// the original goes to exactly one leaf, whatever the rounding of the cut points, so the
+/// parts of a split tile the original without cracks or overlap.
+#[derive(Clone, Copy, Debug)]
+struct Cut {
+    a: [i32; 2],
+    b: [i32; 2],
+    pos: u32,
+    neg: u32,
+}
+
+impl Cut {
+    const EMPTY: Cut = Cut {
+        a: [0; 2],
+        b: [0; 2],
+        pos: NOTHING,
+        neg: NOTHING,
+    };
+
+    /// On row `y`, the side of column `x`'s centre (`true`: `pos`) and the first column after
+    /// `x` where the side changes, if any (sub-pixel bits `SUB`). Exact: the side is a linear
+    /// function `A·x + B` of the column, in `i128` (`|A| < 2^33`, `|B| < 2^80`).
+    fn side_and_end<const SUB: u32>(&self, x: i32, y: i32) -> (bool, Option<i128>) {
+        let (dx, dy) = (
+            self.b[0] as i128 - self.a[0] as i128,
+            self.b[1] as i128 - self.a[1] as i128,
+        );
+        // Doubled coordinates: a centre is at (2c + 1) · 2^SUB halves.
+        let cx = |c: i128| ((2 * c + 1) << SUB) - 2 * self.a[0] as i128;
+        let cy = ((2 * y as i128 + 1) << SUB) - 2 * self.a[1] as i128;
+        let slope = -(dy << (SUB + 1));
+        let at0 = dx * cy - dy * cx(0);
+        let here = slope * x as i128 + at0;
+        // (Checked divisions: the divisor is positive, so `None` only stands for no change.)
+        if here >= 0 {
+            // First column with slope·c + at0 < 0.
+            let first = at0.checked_div_euclid(-slope).map(|c| c + 1);
+            (true, first.filter(|_| slope < 0))
+        } else {
+            // First column with slope·c + at0 ≥ 0.
+            let first = at0.checked_div_euclid(slope).map(|c| -c);
+            (false, first.filter(|_| slope > 0))
+        }
+    }
+}
+
+/// Newell's painter: the walked pieces are the originals, each with its split tree; each
+/// pixel gets the colour of the piece latest in the order that covers it. That is what
+/// painting the pieces far to near gives, row by row, without walking the pieces themselves.
+struct OrderPainter<'a, P, const SUB: u32> {
+    pixels: &'a mut [P],
+    /// Per pixel: the position (from 1) of the piece painted there, 0 for none.
+    order: &'a mut [u32],
+    background: P,
+    cuts: &'a [Cut],
+    /// Per piece: its position in the order, from 1.
+    positions: &'a [u32],
+    spans: u16,
+}
+
+impl<P: RowPixel, const SUB: u32> OrderPainter<'_, P, SUB> {
+    /// The piece of `tree` whose region holds column `x` of row `y`, and the first column
+    /// (at most `end`) where the leaf changes.
+    fn leaf(&self, tree: u32, x: i32, y: i32, end: i32) -> (u32, i32) {
+        let (mut r, mut end) = (tree, end);
+        // A tree has at most one cut per node: a walk longer than that is an internal error.
+        for _ in 0..=self.cuts.len() {
+            if r == NOTHING || r & LEAF != 0 {
+                return (r, end);
+            }
+            let Some(cut) = self.cuts.get(r as usize) else {
+                break;
+            };
+            let (pos, change) = cut.side_and_end::<SUB>(x, y);
+            if let Some(c) = change {
+                // (`max`/`min` rather than `clamp`, which keeps a panic path.)
+                end = end.min(c.max(x as i128 + 1).min(i32::MAX as i128) as i32);
+            }
+            r = if pos { cut.pos } else { cut.neg };
+        }
+        debug_assert!(false, "internal error: split tree {tree:#x} has no leaf");
+        (NOTHING, end)
+    }
+}
+
+impl<P: RowPixel, S: Shading, const SUB: u32> Resolve<P, S> for OrderPainter<'_, P, SUB> {
+    type Key = u32;
+    fn begin_band(&mut self, _: i32, _: usize) {
+        self.pixels.fill(self.background);
+        self.order.fill(0);
+        self.spans = 0;
+    }
+    fn span(&mut self, t: &ActiveTri<S::Payload<P>, u32>, _: usize, y: i32, l: i32, r: i32) -> u32 {
+        self.spans += 1;
+        let mut written = 0;
+        let mut x = l;
+        while x < r {
+            let (leaf, end) = self.leaf(t.key, x, y, r);
+            let key = if leaf == NOTHING {
+                0
+            } else {
+                internal(self.positions.get((leaf & !LEAF) as usize).copied(), 0)
+            };
+            // Paint the runs of `x..end` not yet painted by a later piece.
+            let (Some(pixels), Some(order)) = (
+                self.pixels.get_mut(x as usize..end as usize),
+                self.order.get_mut(x as usize..end as usize),
+            ) else {
+                // walk_band clamps spans to the row, and `x < end <= r`.
+                debug_assert!(false, "internal error: span {x}..{end} out of the row");
+                return written;
+            };
+            let mut i = 0;
+            while i < order.len() {
+                let start = i;
+                while order.get(i).is_some_and(|&o| o < key) {
+                    i += 1;
+                }
+                if let (Some(run), Some(o)) = (pixels.get_mut(start..i), order.get_mut(start..i)) {
+                    if !run.is_empty() {
+                        o.fill(key);
+                        S::paint(&t.payload, t.depth.origin(), x + start as i32, y, run);
+                        written += run.len() as u32;
+                    }
+                }
+                i += 1;
+            }
+            x = end;
+        }
+        written
+    }
+    fn finish_row(&mut self, _: i32) -> FinishedRow<'_, P> {
+        FinishedRow {
+            pixels: self.pixels,
+            depth: DepthRow::NONE,
+            spans: self.spans,
+            written: 0,
+        }
     }
 }
 
@@ -759,10 +1052,20 @@ fn sort_key(store: &[StoredTriangle], keys: &[u32], i: u16) -> (i32, Reverse<u32
     (q, Reverse(internal(keys.get(i as usize).copied(), 0)))
 }
 
-/// Cuts `t` by `plane` into up to three triangles of the same orientation, each on one side
-/// of it (within the rounding tolerance), and how many parts the cut made (2 or 3). Parts of
-/// zero screen area are left out (`None`).
-fn cut(t: &StoredTriangle, plane: &PlaneEq) -> ([Option<StoredTriangle>; 3], usize) {
+/// What [`cut`] makes of a piece.
+struct Parts {
+    /// Up to three triangles of the piece's orientation, each on one side of the plane
+    /// (within the rounding tolerance); parts of zero screen area are left out (`None`).
+    parts: [Option<StoredTriangle>; 3],
+    /// How many parts the cut made (2 or 3).
+    made: usize,
+    /// The lines between them: `lines[0]` has part 0 on its `inside` and parts 1 and 2 on the
+    /// other side, `lines[1]` (if any) separates part 1 (inside) from part 2.
+    lines: [Line; 2],
+}
+
+/// Cuts `t` by `plane` (see [`Parts`]).
+fn cut(t: &StoredTriangle, plane: &PlaneEq) -> Parts {
     let s = [0, 1, 2].map(|k| plane.at(t, k).signum());
     // Rotate so that vertex 0 is the odd one out: the vertex on the plane when one is, else
     // the one alone on its side.
@@ -780,13 +1083,27 @@ fn cut(t: &StoredTriangle, plane: &PlaneEq) -> ([Option<StoredTriangle>; 3], usi
         u.toward(w, su, su - sw)
     };
     let tri = |p: [Vertex; 3]| make(t, p);
+    let line = |a: &Vertex, b: &Vertex, inside: &Vertex| Line {
+        a: [a.x, a.y],
+        b: [b.x, b.y],
+        inside: [inside.x, inside.y],
+    };
     if s[v(0)] == 0 {
         // b and c lie on opposite sides.
         let i = at(&b, &c);
-        ([tri([a, b, i]), tri([a, i, c]), None], 2)
+        let l = line(&a, &i, &b);
+        Parts {
+            parts: [tri([a, b, i]), tri([a, i, c]), None],
+            made: 2,
+            lines: [l, l],
+        }
     } else {
         let (i1, i2) = (at(&a, &b), at(&a, &c));
-        ([tri([a, i1, i2]), tri([i1, b, c]), tri([i1, c, i2])], 3)
+        Parts {
+            parts: [tri([a, i1, i2]), tri([i1, b, c]), tri([i1, c, i2])],
+            made: 3,
+            lines: [line(&i1, &i2, &a), line(&i1, &c, &b)],
+        }
     }
 }
 
@@ -864,7 +1181,7 @@ mod tests {
         let cutter = tri([50, 51, 50], [0, 50, 100], [0, 5000, 10]);
         let plane = PlaneEq::of(&cutter).unwrap();
         assert!(plane.straddled_by(&t));
-        let (parts, made) = cut(&t, &plane);
+        let Parts { parts, made, .. } = cut(&t, &plane);
         assert_eq!((parts.iter().flatten().count(), made), (3, 3));
         let area = |p: &StoredTriangle| PlaneEq::of(p).unwrap().n[2];
         let total: i128 = parts.iter().flatten().map(area).sum();
@@ -872,6 +1189,38 @@ mod tests {
         assert!((total - area(&t)).abs() <= 200, "{total} vs {}", area(&t));
         for p in parts.iter().flatten() {
             assert!(!plane.straddled_by(p), "{p:?}");
+        }
+    }
+
+    #[test]
+    fn a_cut_sends_each_pixel_centre_to_one_side_and_finds_where_it_changes() {
+        // Lines at various slopes through sub-pixel points (4 bits), against the sign of the
+        // cross product at each centre of a row.
+        for (a, b) in [
+            ([3, 5], [200, 90]),
+            ([40, 0], [41, 300]),
+            ([0, 17], [150, 17]),
+            ([100, 8], [20, 250]),
+            ([64, 0], [64, 99]),
+        ] {
+            let cut = Cut { a, b, ..Cut::EMPTY };
+            let side = |c: i32, y: i32| {
+                let line = Line { a, b, inside: a };
+                line.side([c * 16 + 8, y * 16 + 8]) >= 0
+            };
+            for y in 0..16 {
+                for x in 0..20 {
+                    let (pos, change) = cut.side_and_end::<4>(x, y);
+                    assert_eq!(pos, side(x, y), "{a:?} {b:?} at {x}, {y}");
+                    let first = (x + 1..200).find(|&c| side(c, y) != pos);
+                    let change = change.map(|c| c.max(x as i128 + 1) as i32);
+                    assert_eq!(
+                        change.filter(|&c| c < 200),
+                        first,
+                        "{a:?} {b:?} at {x}, {y}"
+                    );
+                }
+            }
         }
     }
 

@@ -56,8 +56,10 @@ fn both(
     assert!(stats.is_complete());
     assert_eq!(stats.rows as usize, H);
     assert_eq!(stats.bucketed, zstats.bucketed);
-    // Every covered pixel is painted (far to near).
-    assert_eq!(stats.pixels_written, stats.fragments);
+    // Every covered pixel is painted once at least; a pixel a later piece already holds is
+    // not painted again.
+    assert!(stats.pixels_written <= stats.fragments);
+    assert!(stats.pixels_written as usize >= n.iter().filter(|p| **p != bg).count());
     (z, n, ws.sort_stats())
 }
 
@@ -172,7 +174,7 @@ fn no_room_for_split_pieces_is_reported() {
 #[test]
 fn workspace_memory_is_as_documented() {
     type Ws = NewellWorkspace<Rgb565, Flat, 240, 240, 1280, 64>;
-    let active = Ws::BYTES - (1280 * 61 + 240 * 2 + 240 * 2);
+    let active = Ws::BYTES - (1280 * 89 + 240 * 2 + 240 * 2 + 240 * 4);
     println!("{} bytes, {} for 64 active", Ws::BYTES, active);
     assert!(active > 64 * 90 && active < 64 * 120, "{}", Ws::BYTES);
 }

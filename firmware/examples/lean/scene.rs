@@ -170,6 +170,8 @@ pub const HEIGHT: usize = 240;
 pub const MAX_TRIANGLES: usize = 29;
 /// Triangles crossing one row: 11 measured, plus the margin.
 pub const MAX_ACTIVE: usize = 11;
+/// Newell's depth sort (`PIECES`): 29 workspace entries and 29 sort steps measured, plus the margin.
+pub const NEWELL_PIECES: usize = 29;
 /// Whether any analysed view needed clipping (if not, `NoClip` is safe for these views).
 pub const NEEDS_CLIPPING: bool = false;
 /// Back-face culling, as analysed.
