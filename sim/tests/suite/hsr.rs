@@ -127,3 +127,46 @@ fn every_method_against_the_reference() {
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// The capacities of the lecture's table (`hsr::LEVELS`) hold for every method at every
+/// level: `cargo xtask hsr-table` runs these frames on the firmware, where a capacity that no
+/// longer fits (Newell's pieces, say, after a change to how it splits) would end the run.
+#[test]
+fn every_method_fits_the_table_capacities() {
+    use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
+    use scanline3d::sink::HashSink;
+    use scanline3d_sim::hsr::{self, Method, Resolve, Visit};
+
+    struct Fits(Vec<scanline3d_sim::scene::SceneSpec>);
+    impl Visit for Fits {
+        type Error = String;
+        fn visit<M: Method, const T: usize, const A: usize, const K: usize>(
+            &mut self,
+            level: usize,
+        ) -> Result<(), String> {
+            let mut ws = Box::new(M::Ws::<Rgb565, T, A, K>::new(Rgb565::BLACK));
+            let stats = self.0[level].with_scene(|scene| {
+                ws.frame(scene, &mut HashSink::new())
+                    .map_err(|e| format!("{} at level {level}: {e}", M::NAME))
+            })??;
+            if stats.is_complete() {
+                Ok(())
+            } else {
+                Err(format!("{} at level {level}: incomplete frame", M::NAME))
+            }
+        }
+    }
+    let specs = (0..hsr::LEVELS.len())
+        .map(scanline3d_sim::scene::SceneSpec::hsr)
+        .collect::<Result<Vec<_>, String>>()
+        .unwrap();
+    // The workspaces are built by value (megabytes at the largest level): on a thread with
+    // room for them.
+    std::thread::Builder::new()
+        .stack_size(256 << 20)
+        .spawn(move || hsr::for_each(&mut Fits(specs)))
+        .unwrap()
+        .join()
+        .unwrap()
+        .unwrap();
+}
