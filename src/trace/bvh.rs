@@ -9,9 +9,11 @@
 //! ## Bit budget
 //!
 //! A box test computes `(bound − origin) · (1/dir)` per axis: the difference is below 2^13
-//! world units (2^29 raw), the reciprocal of a direction component at least 2^-16 is at most
-//! 2^16 (2^32 raw in 16 fraction bits), so the product stays below 2^61 in an `i64` with 32
-//! fraction bits: no overflow, and a component of 0 is an infinite reciprocal handled apart.
+//! world units (2^29 raw, an `i32`), the reciprocal of a direction component of at least 2^-15
+//! (2 raw steps) is at most 2^15 (below 2^31 raw in 16 fraction bits, an `i32`), so the
+//! product is one 32 × 32 → 64-bit multiply, below 2^60 with 32 fraction bits: no overflow.
+//! Components of 0 or ±2^-16 are treated as parallel to the axis (their drift over a ray
+//! shorter than 2^10 units stays inside the boxes' padding [`PAD`]).
 
 use crate::trace::intersect::Ray;
 use crate::trace::shape::{Object, Shape};
@@ -447,18 +449,28 @@ pub(crate) struct RayInverse {
     /// 1/dir per axis in 16 fraction bits (|value| < 2^32 raw), truncated (relative error
     /// below 2^-16); `None` for a zero component.
     inv: [Option<i64>; 3],
+    /// The origin's raw I16F16 bits, for the hierarchy's 32-bit box test.
+    origin32: [i32; 3],
+    /// The same reciprocals where they fit an `i32` (every component of at least 2 raw steps);
+    /// 0 for a component of 0 or ±1 raw step, which the 32-bit box test treats as parallel to
+    /// the axis: over a ray shorter than 2^10 units such a component moves the ray less than
+    /// 2^10 · 2^-16 = 2^-6 units, which the boxes' padding [`PAD`] absorbs.
+    inv32: [i32; 3],
 }
 
 impl RayInverse {
     pub(crate) fn new(ray: &Ray) -> RayInverse {
         let d = ray.dir.bits();
+        // One 32-bit division per axis (2^32 − 1 for 2^32: a relative error of 2^-32).
+        let inv = d.map(|c| {
+            let q = i64::from(u32::MAX.checked_div(c.unsigned_abs())?);
+            Some(if c < 0 { -q } else { q })
+        });
         RayInverse {
             origin: ray.origin.bits().map(i64::from),
-            // One 32-bit division per axis (2^32 − 1 for 2^32: a relative error of 2^-32).
-            inv: d.map(|c| {
-                let q = i64::from(u32::MAX.checked_div(c.unsigned_abs())?);
-                Some(if c < 0 { -q } else { q })
-            }),
+            inv32: inv.map(|q| q.and_then(|q| i32::try_from(q).ok()).unwrap_or(0)),
+            origin32: ray.origin.bits(),
+            inv,
         }
     }
 
@@ -467,11 +479,33 @@ impl RayInverse {
         self.inv.get(axis).copied().flatten()
     }
 
-    /// Whether the ray is inside the node's box for some `t` in `[t_min, t_max)`.
+    /// Whether the ray is inside the node's box for some `t` in `[t_min, t_max)`: the slab
+    /// test in 32-bit operands. Per axis `(bound − origin) · (1/dir)` is one 32 × 32 → 64-bit
+    /// multiply (the difference is below 2^29 raw in the envelope, the reciprocal below 2^31),
+    /// the nearer bound chosen by the reciprocal's sign instead of sorting the two times; the
+    /// times are the same 32-fraction-bit values [`span`](Self::span) computes (which the grid
+    /// uses), so the same boxes pass except for the axes treated as parallel (see `inv32`).
     #[inline]
     fn enters(&self, n: &BvhNode, t_min: I16F16, t_max: I16F16) -> bool {
-        self.span(n.min.bits(), n.max.bits().map(i64::from), t_min, t_max)
-            .is_some()
+        let mut lo = i64::from(t_min.to_bits()) << 16;
+        let mut hi = i64::from(t_max.to_bits()) << 16;
+        // Written out per axis: an iterator over the arrays kept its state in memory.
+        let mut slab = |o: i32, inv: i32, a: i32, b: i32| {
+            if inv == 0 {
+                return o >= a && o <= b;
+            }
+            let (near, far) = if inv > 0 { (a, b) } else { (b, a) };
+            let inv = i64::from(inv);
+            lo = lo.max(i64::from(near.wrapping_sub(o)) * inv);
+            hi = hi.min(i64::from(far.wrapping_sub(o)) * inv);
+            true
+        };
+        let ([ox, oy, oz], [ix, iy, iz]) = (self.origin32, self.inv32);
+        let ([ax, ay, az], [bx, by, bz]) = (n.min.bits(), n.max.bits());
+        if !(slab(ox, ix, ax, bx) && slab(oy, iy, ay, by) && slab(oz, iz, az, bz)) {
+            return false;
+        }
+        lo <= hi
     }
 
     /// The interval of `t` (32 fraction bits) within `[t_min, t_max]` in which the ray is
