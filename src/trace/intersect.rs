@@ -62,15 +62,44 @@ fn sphere(s: &Sphere, ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16>
     first_root(nb.wrapping_sub(root), nb.wrapping_add(root), t_min, t_max)
 }
 
-/// `t` where the ray meets the plane `normal·p + offset = 0`.
+/// `t` in `[t_min, t_max)` where the ray meets the plane `normal·p + offset = 0`, if any. The window is checked before the division, on
+/// `t·den = −num` in exact 64-bit products, so a plane met outside it costs no division; the
+/// check decides exactly what filtering the quotient would (the quotient rounds towards 0).
 #[inline]
-fn plane_t(normal: Vec3, offset: I16F16, ray: &Ray) -> Option<I16F16> {
+fn plane_t_in(
+    normal: Vec3,
+    offset: I16F16,
+    ray: &Ray,
+    t_min: I16F16,
+    t_max: I16F16,
+) -> Option<I16F16> {
     let num = normal.dot(ray.origin) + I32F32::from(offset);
-    quotient(-num, normal.dot(ray.dir))
+    let den = normal.dot(ray.dir);
+    // t = n / d with d > 0: the signs moved to the numerator.
+    let (n, d) = if den < I32F32::ZERO {
+        (num.to_bits(), den.to_bits().checked_neg()?)
+    } else {
+        (num.to_bits().checked_neg()?, den.to_bits())
+    };
+    if d == 0 {
+        return None;
+    }
+    if t_min > I16F16::ZERO && t_max >= t_min && n.unsigned_abs() < 1 << 47 {
+        // d ≤ 2^33 raw (a dot product of two unit vectors) and t ≤ 2^31 raw: the products fit
+        // a u64, as does n · 2^16 for |n| < 2^47. A negative n gives t ≤ 0 < t_min.
+        let (d, scaled) = (d as u64, (n as u64) << 16);
+        if n < 0
+            || scaled < u64::from(t_min.to_bits() as u32) * d
+            || scaled >= u64::from(t_max.to_bits() as u32) * d
+        {
+            return None;
+        }
+    }
+    quotient(-num, den).filter(|t| *t >= t_min && *t < t_max)
 }
 
 fn plane(p: &Plane, ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
-    plane_t(p.normal, p.offset, ray).filter(|t| *t >= t_min && *t < t_max)
+    plane_t_in(p.normal, p.offset, ray, t_min, t_max)
 }
 
 /// The two coordinates of `p` other than `axis`, raw I16F16 bits.
@@ -111,7 +140,7 @@ fn inside(vertices: &[Vec3], axis: u8, p: Vec3) -> bool {
 }
 
 fn facet(f: &Facet, vertices: &[Vec3], ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
-    let t = plane_t(f.normal, f.offset, ray).filter(|t| *t >= t_min && *t < t_max)?;
+    let t = plane_t_in(f.normal, f.offset, ray, t_min, t_max)?;
     inside(vertices, f.axis, ray.origin.along(ray.dir, t)).then_some(t)
 }
 

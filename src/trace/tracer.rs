@@ -324,8 +324,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             shadow: 0,
         };
         let raw = self.camera.pixel_direction(column, row);
-        let len = sqrt(raw.dot(raw));
-        let Some(dir) = raw.normalized() else {
+        let Some((dir, len)) = raw.normalized_with_length() else {
             return (out, stats);
         };
         // Eye depth = t / len (the raw direction has unit forward component).
@@ -512,10 +511,8 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 LightKind::Directional(d) => (d, I16F16::MAX),
                 LightKind::Point(p) => {
                     let v = p.sub(point);
-                    match v.normalized() {
-                        Some(d) => (d, sqrt(v.dot(v))),
-                        None => (Vec3::ZERO, I16F16::ZERO),
-                    }
+                    v.normalized_with_length()
+                        .unwrap_or((Vec3::ZERO, I16F16::ZERO))
                 }
             };
             let nl = I16F16::from_bits(narrow_bits(normal.dot_bits(towards)));

@@ -127,7 +127,15 @@ impl Vec3 {
     /// give a direction with 16 fraction bits: see [`normalize_bits`]).
     #[inline]
     pub fn normalized(self) -> Option<Vec3> {
-        normalize_bits(self.bits()).map(|[x, y, z]| Vec3::from_bits(x, y, z))
+        self.normalized_with_length().map(|(unit, _)| unit)
+    }
+
+    /// The unit vector along `self` and the length it was divided by ([`sqrt`] of `self ·
+    /// self`), or `None` for a vector shorter than 2^-8: one square root for both.
+    #[inline]
+    pub fn normalized_with_length(self) -> Option<(Vec3, I16F16)> {
+        let len = sqrt(self.dot(self));
+        normalize_by(self.bits(), len.to_bits()).map(|[x, y, z]| (Vec3::from_bits(x, y, z), len))
     }
 }
 
@@ -253,7 +261,13 @@ pub const fn sqrt(v: I32F32) -> I16F16 {
 #[inline]
 pub fn normalize_bits(v: [i32; 3]) -> Option<[i32; 3]> {
     let len2 = Vec3::from_bits(v[0], v[1], v[2]).dot_bits(Vec3::from_bits(v[0], v[1], v[2]));
-    let len = sqrt(I32F32::from_bits(len2)).to_bits();
+    normalize_by(v, sqrt(I32F32::from_bits(len2)).to_bits())
+}
+
+/// Raw I16F16 components divided by their length `len` (raw I16F16, from [`sqrt`]), or `None`
+/// when `len` is below 2^-8.
+#[inline]
+fn normalize_by(v: [i32; 3], len: i32) -> Option<[i32; 3]> {
     if len < 1 << 8 {
         return None;
     }
