@@ -271,9 +271,35 @@ fn normalize_by(v: [i32; 3], len: i32) -> Option<[i32; 3]> {
     if len < 1 << 8 {
         return None;
     }
-    let inv = (1i64 << 46) / len as i64; // 1/length in 30 fraction bits
+    let inv = reciprocal46(len as u32);
     let c = |x: i32| ((x as i64 * inv) >> 30) as i32;
     Some([c(v[0]), c(v[1]), c(v[2])])
+}
+
+/// 2^46 / `len` (1/length in 30 fraction bits for a raw I16F16 length) for `len` in
+/// [2^8, 2^31), without a 64-bit division: `len` is shifted to L in [2^30, 2^31), a 32-bit
+/// division gives 2^62 / L to 14 bits, one Newton step `r += r · (2^62 − L·r) / 2^62` (32 × 32 →
+/// 64-bit products) brings it within 2^-27 relative of the quotient, and a shift by the
+/// normalisation scales it back. The result is below the exact quotient by at most
+/// 2^-26 relative (tested), far under the square root's 2^-15.
+#[inline]
+pub fn reciprocal46(len: u32) -> i64 {
+    let k = len.leading_zeros(); // 1..=23
+    let l = len << (k - 1); // [2^30, 2^31)
+                            // ⌊(2^32 − 1) / (L >> 16)⌋ ≈ 2^48 / L, low by at most 2^-14 relative; scaled to 2^62 / L
+                            // it stays below 2^32.
+    let r0 = (u32::MAX / (l >> 16)).min(u32::MAX >> 14) << 14;
+    // err = 2^62 − L·r0 ≥ 0, below 2^49; the correction r0 · err / 2^62 is formed from err
+    // and r0 with 28 and 20 significant bits.
+    let err = (1u64 << 62).wrapping_sub(u64::from(l) * u64::from(r0)) as i64;
+    let corr = ((err >> 20) * i64::from(r0 >> 12)) >> 30;
+    let r = i64::from(r0) + corr; // ≈ 2^62 / L
+                                  // 2^46 / len = 2^(45 + k) / L = r · 2^(k − 17).
+    if k <= 17 {
+        r >> (17 - k)
+    } else {
+        r << (k - 17)
+    }
 }
 
 #[cfg(test)]
@@ -300,6 +326,23 @@ mod tests {
                     "{name} {v}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn reciprocal46_is_within_its_bound() {
+        let lens = (1u32 << 8..1 << 20)
+            .step_by(7)
+            .chain((1 << 20..1 << 31).step_by(104_729))
+            .chain([1 << 8, 1 << 16, 1 << 30, (1 << 31) - 1, 65_535, 65_537]);
+        for len in lens {
+            let exact = (1i64 << 46) / i64::from(len);
+            let got = reciprocal46(len);
+            // Low by at most 2^-26 relative, plus one unit for the final truncation.
+            assert!(
+                got <= exact && exact - got <= (exact >> 26) + 1,
+                "{len}: {got} vs {exact}"
+            );
         }
     }
 
