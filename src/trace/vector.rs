@@ -276,29 +276,75 @@ fn normalize_by(v: [i32; 3], len: i32) -> Option<[i32; 3]> {
     Some([c(v[0]), c(v[1]), c(v[2])])
 }
 
-/// 2^46 / `len` (1/length in 30 fraction bits for a raw I16F16 length) for `len` in
-/// [2^8, 2^31), without a 64-bit division: `len` is shifted to L in [2^30, 2^31), a 32-bit
-/// division gives 2^62 / L to 14 bits, one Newton step `r += r · (2^62 − L·r) / 2^62` (32 × 32 →
-/// 64-bit products) brings it within 2^-27 relative of the quotient, and a shift by the
-/// normalisation scales it back. The result is below the exact quotient by at most
-/// 2^-26 relative (tested), far under the square root's 2^-15.
+/// ⌊2^46 / `len`⌋ (1/length in 30 fraction bits for a raw I16F16 length) for `len` in
+/// [2^8, 2^31), without a 64-bit division: `len` shifted to L in [2^30, 2^31), then
+/// [`reciprocal62`] scaled back by the shift. Exact for `len` ≥ 2^14 (a length of at least
+/// 1/4); below, the low `k − 17` bits of 2^(45 + k) / L are zero, a relative error below 2^-25
+/// (tested), far under the square root's 2^-15.
 #[inline]
 pub fn reciprocal46(len: u32) -> i64 {
     let k = len.leading_zeros(); // 1..=23
-    let l = len << (k - 1); // [2^30, 2^31)
-                            // ⌊(2^32 − 1) / (L >> 16)⌋ ≈ 2^48 / L, low by at most 2^-14 relative; scaled to 2^62 / L
-                            // it stays below 2^32.
-    let r0 = (u32::MAX / (l >> 16)).min(u32::MAX >> 14) << 14;
-    // err = 2^62 − L·r0 ≥ 0, below 2^49; the correction r0 · err / 2^62 is formed from err
-    // and r0 with 28 and 20 significant bits.
-    let err = (1u64 << 62).wrapping_sub(u64::from(l) * u64::from(r0)) as i64;
-    let corr = ((err >> 20) * i64::from(r0 >> 12)) >> 30;
-    let r = i64::from(r0) + corr; // ≈ 2^62 / L
-                                  // 2^46 / len = 2^(45 + k) / L = r · 2^(k − 17).
+    let r = reciprocal62(len << (k - 1)) as i64;
+    // 2^46 / len = 2^(45 + k) / L = r · 2^(k − 17).
     if k <= 17 {
         r >> (17 - k)
     } else {
         r << (k - 17)
+    }
+}
+
+/// ⌊2^62 / `l`⌋ for `l` in [2^30, 2^31) (so at most 2^32), exact, without a 64-bit division:
+/// a 32-bit division gives it to 14 bits, two Newton steps `r += r · (2^62 − l·r) / 2^62`
+/// (32 × 32 → 64-bit products, the second on the small remainder) bring it within a few
+/// units, and the remainder fixes the last ones.
+#[inline]
+pub fn reciprocal62(l: u32) -> u64 {
+    let l64 = i64::from(l);
+    // ⌊(2^32 − 1) / (l >> 16)⌋ ≈ 2^48 / l within 2^-14 relative (either side); scaled to
+    // 2^62 / l it stays below 2^32.
+    let r0 = i64::from((u32::MAX / (l >> 16).max(1 << 14)).min(u32::MAX >> 14) << 14);
+    // err = 2^62 − l·r0, |err| < 2^49: the correction r0 · err / 2^62 from err and r0 with 29
+    // and 20 significant bits leaves r1 within 2^-27 relative, at most 2^6 units off.
+    let err = (1i64 << 62).wrapping_sub(l64 * r0);
+    let r1 = r0 + (((err >> 20) * (r0 >> 12)) >> 30);
+    // |err| < 2^37 now: the second correction is exact to a unit or two.
+    let err = (1i64 << 62).wrapping_sub(l64.wrapping_mul(r1));
+    let mut r = r1 + (((err >> 5) * (r1 >> 5)) >> 52);
+    // The last units: r·l ≤ 2^62 < (r + 1)·l.
+    let mut rem = (1i64 << 62).wrapping_sub(l64.wrapping_mul(r));
+    while rem < 0 {
+        r -= 1;
+        rem += l64;
+    }
+    while rem >= l64 {
+        r += 1;
+        rem -= l64;
+    }
+    r as u64
+}
+
+/// ⌊n · 2^16 / d⌋ approximately, for `n` below 2^47 and `d` in (0, 2^34), without a 64-bit
+/// division: `d` reduced to 31 significant bits and inverted by [`reciprocal62`], `n` reduced
+/// to 32 significant bits, one 32 × 32 → 64-bit product, a shift. Relative error below 2^-25
+/// (the reductions truncate by at most 2^-30 and 2^-31, the reciprocal by 2^-32; tested), so
+/// within 2 raw steps for a quotient below 2^26 raw (2^10 units).
+#[inline]
+pub fn ratio16(n: u64, d: u64) -> u64 {
+    if n == 0 || d == 0 {
+        return 0;
+    }
+    // d ≈ D · 2^ds with D in [2^30, 2^31); n ≈ N · 2^ns with N below 2^32.
+    let ds = 33 - d.leading_zeros() as i32;
+    let big_d = if ds >= 0 { d >> ds } else { d << -ds } as u32;
+    let ns = (32 - n.leading_zeros() as i32).max(0);
+    let big_n = (n >> ns) as u32;
+    let product = u64::from(big_n) * reciprocal62(big_d); // ≈ N · 2^62 / D
+                                                          // n · 2^16 / d = N · 2^62 / D · 2^(ns + 16 − 62 − ds).
+    let e = ns - ds - 46;
+    if e <= 0 {
+        product.checked_shr((-e) as u32).unwrap_or(0)
+    } else {
+        product.checked_shl(e as u32).unwrap_or(u64::MAX)
     }
 }
 
@@ -342,6 +388,27 @@ mod tests {
             assert!(
                 got <= exact && exact - got <= (exact >> 26) + 1,
                 "{len}: {got} vs {exact}"
+            );
+        }
+    }
+
+    #[test]
+    fn ratio16_is_within_its_bound() {
+        let mut x = 0x1234_5678_9abc_def1u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for _ in 0..200_000 {
+            let n = next() >> (17 + next() % 40);
+            let d = (next() >> (30 + next() % 34)).max(1);
+            let exact = ((u128::from(n) << 16) / u128::from(d)) as f64;
+            let got = ratio16(n, d) as f64;
+            assert!(
+                (got - exact).abs() <= exact * 2f64.powi(-25) + 1.0,
+                "{n} / {d}: {got} vs {exact}"
             );
         }
     }
