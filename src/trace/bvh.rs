@@ -498,14 +498,12 @@ impl RayInverse {
             let inv = i64::from(inv);
             lo = lo.max(i64::from(near.wrapping_sub(o)) * inv);
             hi = hi.min(i64::from(far.wrapping_sub(o)) * inv);
-            true
+            lo <= hi
         };
         let ([ox, oy, oz], [ix, iy, iz]) = (self.origin32, self.inv32);
         let ([ax, ay, az], [bx, by, bz]) = (n.min.bits(), n.max.bits());
-        if !(slab(ox, ix, ax, bx) && slab(oy, iy, ay, by) && slab(oz, iz, az, bz)) {
-            return false;
-        }
-        lo <= hi
+        // Each slab ends the test as soon as the interval is empty.
+        slab(ox, ix, ax, bx) && slab(oy, iy, ay, by) && slab(oz, iz, az, bz)
     }
 
     /// The interval of `t` (32 fraction bits) within `[t_min, t_max]` in which the ray is

@@ -4,7 +4,9 @@
 //! A ray is `origin + t·dir` with `dir` a unit [`Vec3`] and `t` an [`I16F16`] in world units.
 //! Each test returns the smallest root `t` with `t_min ≤ t < t_max`; roots outside the I16F16
 //! range are no hit. Intermediate products are I32F32 (see the bit budget in
-//! [`crate::trace::vector`]); quotients are 64-bit integer divisions of raw bits.
+//! [`crate::trace::vector`]). Planes and polygons (the classic scene's floor) check the window
+//! on exact products and then divide in 32 bits ([`ratio16`], within 2^-25 relative); the
+//! other primitives' quotients are 64-bit integer divisions of raw bits.
 
 use crate::trace::shape::{AaBox, Ellipsoid, Facet, Frustum, Plane, Shape, Sphere};
 use crate::trace::vector::{mul, narrow, narrow_bits, ratio16, sqrt, Vec3};
@@ -62,9 +64,13 @@ fn sphere(s: &Sphere, ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16>
     first_root(nb.wrapping_sub(root), nb.wrapping_add(root), t_min, t_max)
 }
 
-/// `t` in `[t_min, t_max)` where the ray meets the plane `normal·p + offset = 0`, if any. The window is checked before the division, on
-/// `t·den = −num` in exact 64-bit products, so a plane met outside it costs no division; the
-/// check decides exactly what filtering the quotient would (the quotient rounds towards 0).
+/// `t` in `[t_min, t_max)` where the ray meets the plane `normal·p + offset = 0`, if any.
+///
+/// The window is checked first, on `t·den = −num` in exact 64-bit products (the same decision
+/// as filtering the truncated quotient), so a plane met outside it costs no division; inside
+/// it `t` is [`ratio16`] (32-bit reciprocal, within 2^-25 relative), kept in the window. A
+/// window starting at or below 0 or a numerator beyond 2^47 raw takes the exact 64-bit
+/// quotient instead.
 #[inline]
 fn plane_t_in(
     normal: Vec3,

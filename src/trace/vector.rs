@@ -256,7 +256,8 @@ pub const fn sqrt(v: I32F32) -> I16F16 {
 /// shorter than 2^-8.
 ///
 /// The length comes from [`sqrt`]; the components are multiplied by its reciprocal held in
-/// I2F30-like precision (`2^46 / length_bits`, one 64-bit division), so each unit component is
+/// I2F30-like precision (`2^46 / length_bits` by [`reciprocal46`], no 64-bit division), so each
+/// unit component is
 /// within 2 steps of 2^-16 of the exact one.
 #[inline]
 pub fn normalize_bits(v: [i32; 3]) -> Option<[i32; 3]> {
