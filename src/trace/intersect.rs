@@ -100,7 +100,9 @@ fn plane_t_in(
         }
         // Inside the window: t without a 64-bit division (within 2^-25 relative, see
         // `ratio16`), kept inside the window the exact check found.
-        let t = ratio16(n as u64, d).clamp(u64::from(lo), u64::from(hi) - 1);
+        let t = ratio16(n as u64, d)
+            .max(u64::from(lo))
+            .min(u64::from(hi) - 1);
         return Some(I16F16::from_bits(t as i32));
     }
     quotient(-num, den).filter(|t| *t >= t_min && *t < t_max)

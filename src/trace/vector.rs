@@ -215,7 +215,12 @@ pub const fn isqrt32_newton(v: u32) -> u32 {
     let e = (31 - v.leading_zeros()) / 2;
     let mut x = ((((v >> e) + (2u32 << e)) * 182) >> 9) + 1;
     loop {
-        let y = (x + v / x) >> 1;
+        // x ≥ ⌊√v⌋ ≥ 1, so the division never meets 0 (said to the compiler, for the
+        // panic-never link check).
+        let Some(q) = v.checked_div(x) else {
+            return 0;
+        };
+        let y = (x + q) >> 1;
         if y >= x {
             return x;
         }
