@@ -7,7 +7,7 @@
 //! and pieces waiting in buckets + `ACTIVE ·` an active triangle (about 100 for flat shading).
 //! See [`PatchWorkspace::BYTES`].
 
-use super::eval::{dehomogenize, Net};
+use super::eval::{dehomogenize, Column, Hom, Net, TangentColumn};
 use super::tessellate::{self, Levels, ScreenNet, Uv};
 use super::trim::{self, Cut};
 use super::{PatchModel, Tolerance};
@@ -96,6 +96,15 @@ const EMPTY: Entry = Entry {
 /// Pieces of at most this many cells are tessellated, not split further: a split costs a
 /// control-hull bound (32 blossoms, 16 transforms), about as much as a few triangles.
 const LEAF_CELLS: u32 = 4;
+
+/// Columns of cells drawn at a time: two rows of `BLOCK + 1` vertices are on the stack.
+const BLOCK: usize = 8;
+
+/// No flat colour (Gouraud shading colours vertices instead).
+const BLACK_SIDES: Sides<Rgb888> = Sides {
+    front: Rgb888::new(0, 0, 0),
+    back: Rgb888::new(0, 0, 0),
+};
 
 /// All the memory a patch render needs, sized at compile time.
 ///
@@ -353,7 +362,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
 
     /// A model point in eye space.
     #[inline]
-    fn eye(&self, h: super::eval::Hom) -> EyePoint {
+    fn eye(&self, h: Hom) -> EyePoint {
         A::Transform::apply(&self.mv, &dehomogenize(h))
     }
 
@@ -433,31 +442,41 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
     /// colours vertices instead).
     fn face<S: Shading>(&self, patch: u16, net: &Net, [u, v]: Uv) -> Sides<Rgb888> {
         if S::PER_VERTEX {
-            let black = Rgb888::new(0, 0, 0);
-            return Sides {
-                front: black,
-                back: black,
-            };
+            return BLACK_SIDES;
         }
         self.lit(patch, net.normal(u, v))
     }
 
     /// The surface point at `(u, v)` in eye space, lit there for Gouraud shading.
     fn vertex<S: Shading>(&self, patch: u16, net: &Net, [u, v]: Uv) -> Vertex {
-        let color = if S::PER_VERTEX {
-            let lit = self.lit(patch, net.normal(u, v));
-            Sides {
-                front: color_channels(lit.front),
-                back: color_channels(lit.back),
+        let normal = S::PER_VERTEX.then(|| net.normal(u, v));
+        self.vertex_at::<S>(patch, net.point(u, v), normal)
+    }
+
+    /// The vertex at surface point `h` with normal `normal` there (`None` for flat shading,
+    /// `Some(None)` where the normal vanishes).
+    #[inline]
+    fn vertex_at<S: Shading>(
+        &self,
+        patch: u16,
+        h: Hom,
+        normal: Option<Option<[i64; 3]>>,
+    ) -> Vertex {
+        let color = match normal {
+            Some(n) if S::PER_VERTEX => {
+                let lit = self.lit(patch, n);
+                Sides {
+                    front: color_channels(lit.front),
+                    back: color_channels(lit.back),
+                }
             }
-        } else {
-            Sides {
+            _ => Sides {
                 front: [I16F16::ZERO; 3],
                 back: [I16F16::ZERO; 3],
-            }
+            },
         };
         Vertex {
-            p: self.eye(net.point(u, v)),
+            p: self.eye(h),
             color,
         }
     }
@@ -522,8 +541,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         self.stats.trim_overflows += overflows;
     }
 
-    /// Draws interior cells `is × js`, each grid point evaluated once (two rows of points at a
-    /// time), each cell flat-shaded with the normal at its centre.
+    /// Draws interior cells `is × js`, in blocks of at most [`BLOCK`] columns.
     fn cells<S: Shading>(
         &mut self,
         patch: u16,
@@ -532,37 +550,61 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         row: usize,
         f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
-        const SIDE: usize = (1 << super::MAX_LEVEL) + 1;
         let Piece { levels, is, js } = piece;
-        let at = |i: u8, j: u8| {
-            [
-                tessellate::grid(i as u32, levels.u),
-                tessellate::grid(j as u32, levels.v),
-            ]
-        };
-        let zero = [I16F16::ZERO; 3];
-        let empty = Vertex {
-            p: EyePoint {
-                x: I16F16::ZERO,
-                y: I16F16::ZERO,
-                w: I16F16::ZERO,
-            },
-            color: Sides {
-                front: zero,
-                back: zero,
-            },
-        };
-        let points = |this: &Self, j: u8, out: &mut [Vertex; SIDE]| {
-            for (slot, i) in out.iter_mut().zip(is[0]..=is[1]) {
-                *slot = this.vertex::<S>(patch, net, at(i, j));
-            }
+        let mut first = is[0];
+        while first < is[1] {
+            let last = first.saturating_add(BLOCK as u8).min(is[1]);
+            self.block::<S>(patch, net, levels, [first, last], js, row, f);
+            first = last;
+        }
+    }
+
+    /// Draws interior cells `is × js` (`is` at most [`BLOCK`] columns), each grid point
+    /// evaluated once (two rows of points at a time) on its column's curve, each cell
+    /// flat-shaded with the normal at its centre, on its centre column's curve.
+    #[allow(clippy::too_many_arguments)]
+    fn block<S: Shading>(
+        &mut self,
+        patch: u16,
+        net: &Net,
+        levels: Levels,
+        is: [u8; 2],
+        js: [u8; 2],
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        let u = |i: u8| tessellate::grid(i as u32, levels.u);
+        let v = |j: u8| tessellate::grid(j as u32, levels.v);
+        let at = |i: u8, j: u8| [u(i), v(j)];
+        // Interior points only (0 < u, v < 1), where `Net::point` evaluates on columns too.
+        let columns: Vec<(Column, Option<TangentColumn>), { BLOCK + 1 }> = (is[0]..=is[1])
+            .map(|i| {
+                (
+                    net.column(u(i)),
+                    S::PER_VERTEX.then(|| net.tangent_column(u(i))),
+                )
+            })
+            .collect();
+        let centres: Vec<Option<TangentColumn>, BLOCK> = (is[0]..is[1])
+            .map(|i| (!S::PER_VERTEX).then(|| net.tangent_column((u(i) + u(i + 1)) / 2)))
+            .collect();
+        let points = |this: &Self, j: u8| -> Vec<Vertex, { BLOCK + 1 }> {
+            columns
+                .iter()
+                .zip(is[0]..=is[1])
+                .map(|((column, tangents), i)| {
+                    let n = tangents
+                        .as_ref()
+                        .map(|t| t.normal(v(j)).or_else(|| net.normal(u(i), v(j))));
+                    this.vertex_at::<S>(patch, column.point(v(j)), n)
+                })
+                .collect()
         };
         let trims = self.model.trims(patch as usize);
-        let (mut below, mut above) = ([empty; SIDE], [empty; SIDE]);
-        points(self, js[0], &mut below);
+        let mut below = points(self, js[0]);
         for j in js[0]..js[1] {
-            points(self, j + 1, &mut above);
-            for (k, i) in (is[0]..is[1]).enumerate() {
+            let above = points(self, j + 1);
+            for ((k, i), centre) in (is[0]..is[1]).enumerate().zip(&centres) {
                 let (Some(&a), Some(&b), Some(&c), Some(&d)) = (
                     below.get(k),
                     below.get(k + 1),
@@ -572,8 +614,13 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                     break;
                 };
                 let corners = [a, b, c, d];
-                let centre = |p: [u32; 2], q: [u32; 2]| [(p[0] + q[0]) / 2, (p[1] + q[1]) / 2];
-                let face = self.face::<S>(patch, net, centre(at(i, j), at(i + 1, j + 1)));
+                let face = match centre {
+                    Some(t) => {
+                        let (uc, vc) = ((u(i) + u(i + 1)) / 2, (v(j) + v(j + 1)) / 2);
+                        self.lit(patch, t.normal(vc).or_else(|| net.normal(uc, vc)))
+                    }
+                    None => BLACK_SIDES,
+                };
                 let corner_uv = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
                 for t in tessellate::CELL_TRIANGLES {
                     let uv = t.map(|k| corner_uv.get(k).copied().unwrap_or([0; 2]));
