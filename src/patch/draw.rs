@@ -12,6 +12,7 @@ use super::tessellate::{self, Levels, ScreenNet, Uv};
 use super::trim::{self, Cut};
 use super::{PatchModel, Tolerance};
 use crate::arithmetic::Arithmetic;
+use crate::cache::CachedVertex;
 use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping};
 use crate::depth::Depth;
 use crate::options::RenderOptions;
@@ -72,13 +73,23 @@ pub struct PatchStats {
     pub trim_overflows: u32,
 }
 
-/// A patch or a piece of its interior waiting in a row bucket.
+/// A patch or a piece of it waiting in a row bucket.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Entry {
     patch: u16,
-    /// `None`: the whole patch, not tessellated yet. `Some`: interior cells `is × js` of a
-    /// patch tessellated at `levels` (`u`, `v`).
-    piece: Option<Piece>,
+    work: Work,
+}
+
+/// What of a patch an [`Entry`] stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Work {
+    /// The whole patch, not tessellated yet.
+    Patch,
+    /// The boundary strip on `side` (the order of [`Levels::edges`]) of a patch tessellated
+    /// at these levels: the zipper between that edge and the first inner grid line.
+    Side(Levels, u8),
+    /// Interior cells of a patch.
+    Cells(Piece),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -90,12 +101,12 @@ struct Piece {
 
 const EMPTY: Entry = Entry {
     patch: 0,
-    piece: None,
+    work: Work::Patch,
 };
 
 /// Pieces of at most this many cells are tessellated, not split further: a split costs a
 /// control-hull bound (32 blossoms, 16 transforms), about as much as a few triangles.
-const LEAF_CELLS: u32 = 4;
+const LEAF_CELLS: u32 = 16;
 
 /// Columns of cells drawn at a time: two rows of `BLOCK + 1` vertices are on the stack.
 const BLOCK: usize = 8;
@@ -310,7 +321,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                     let entry = Entry {
                         // Below MAX_PATCHES, checked by PatchModel::new.
                         patch: patch as u16,
-                        piece: None,
+                        work: Work::Patch,
                     };
                     // Filing fails only when full; the error below reports it.
                     let _ = self.file(entry, row);
@@ -475,19 +486,52 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                 back: [I16F16::ZERO; 3],
             },
         };
+        let p = self.eye(h);
         Vertex {
-            p: self.eye(h),
+            p,
+            screen: CachedVertex::new::<SUB, A::Projection>(&self.vp, p),
             color,
         }
     }
 
-    /// Tessellates triangle `uv` of `patch` (control net `net`) and draws what its trims keep
-    /// of it ([`Self::draw`]), flat-shaded with the normal at its parameter centroid.
+    /// Draws the boundary strip on `side` of `patch`: the zipper's triangles in order, each
+    /// sharing two vertices with the one before, so each vertex is evaluated once.
+    fn side<S: Shading>(
+        &mut self,
+        patch: u16,
+        net: &Net,
+        levels: &Levels,
+        side: usize,
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        self.stats.pieces += 1;
+        let mut recent: [Option<(Uv, Vertex)>; 4] = [None; 4];
+        let mut next = 0;
+        tessellate::border(levels, side, |uv| {
+            let cv = uv.map(|p| {
+                if let Some((_, v)) = recent.iter().flatten().find(|(q, _)| *q == p) {
+                    return *v;
+                }
+                let v = self.vertex::<S>(patch, net, p);
+                if let Some(slot) = recent.get_mut(next % 4) {
+                    *slot = Some((p, v));
+                }
+                next += 1;
+                v
+            });
+            self.triangle::<S>(patch, net, uv, cv, row, f)
+        });
+    }
+
+    /// Draws what the trims keep of triangle `uv` of `patch` (control net `net`, its vertices
+    /// `cv`) ([`Self::draw`]), flat-shaded with the normal at its parameter centroid.
     fn triangle<S: Shading>(
         &mut self,
         patch: u16,
         net: &Net,
         uv: [Uv; 3],
+        cv: [Vertex; 3],
         row: usize,
         f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
@@ -502,7 +546,6 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
             self.trimmed::<S>(patch, net, uv, face, row, f);
             return;
         }
-        let cv = uv.map(|p| self.vertex::<S>(patch, net, p));
         self.draw(patch, cv, face, row, f);
     }
 
@@ -681,6 +724,17 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
             f(s, face, patch as u32, 0);
         };
         let mut stats = self.stats;
+        // Inside every clip plane: the screen positions projected once per vertex, as the
+        // clipper's path below would project them.
+        let screen = [0, 1, 2].map(|k| {
+            let (v, c) = (t.get(k)?, cv.get(k)?);
+            v.screen.screen::<SUB>(c.color)
+        });
+        if let [Some(a), Some(b), Some(c)] = screen {
+            emit([a, b, c], &mut stats);
+            self.stats = stats;
+            return;
+        }
         match C::clip(&vp, &cv, &mut self.polygon) {
             Clipped::Outside => stats.frame.rejected += 1,
             Clipped::Skipped => stats.frame.unclipped += 1,
@@ -703,8 +757,9 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         self.stats = stats;
     }
 
-    /// A whole patch's first row has come: tessellate its boundary ring now and hand its
-    /// interior on as a piece.
+    /// A whole patch's first row has come: choose its levels, file each side of its boundary
+    /// ring under the first row of that strip's control hull and hand its interior on as a
+    /// piece.
     fn patch<S: Shading>(
         &mut self,
         patch: u16,
@@ -715,9 +770,9 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         let levels = tessellate::levels(&self.screen_net(&net), self.tolerance);
         self.stats.capped += levels.capped as u32;
         for side in 0..4 {
-            tessellate::border(&levels, side, |t| {
-                self.triangle::<S>(patch, &net, t, row, f)
-            });
+            let (u, v) = tessellate::strip(&levels, side);
+            let work = Work::Side(levels, side as u8);
+            self.file_or_draw::<S>(patch, &net, net.piece(u, v), work, row, f);
         }
         let (is, js) = tessellate::interior(&levels);
         if is[0] < is[1] && js[0] < js[1] {
@@ -753,22 +808,50 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         for (is, js) in halves {
             let half = Piece { levels, is, js };
             let range = |r: [u8; 2], level: u8| r.map(|k| tessellate::grid(k as u32, level));
-            let hull = self.hull(&net.piece(range(is, levels.u), range(js, levels.v)));
-            let first = match hull {
-                Hull::Culled => {
-                    self.stats.pieces_culled += 1;
-                    continue;
-                }
-                Hull::FirstRow(first) => first.max(row),
-            };
-            let entry = Entry {
-                patch,
-                piece: Some(half),
-            };
-            if !self.file(entry, first) {
-                self.stats.overflows += 1;
-                self.cells::<S>(patch, net, half, row, f);
+            let sub = net.piece(range(is, levels.u), range(js, levels.v));
+            self.file_or_draw::<S>(patch, net, sub, Work::Cells(half), row, f);
+        }
+    }
+
+    /// Files `work` (a part of `patch` whose control net is `sub`) under the first row of
+    /// `sub`'s control hull (this row if it starts here); drops it if the hull is off screen,
+    /// draws it now if no entry is free.
+    fn file_or_draw<S: Shading>(
+        &mut self,
+        patch: u16,
+        net: &Net,
+        sub: Net,
+        work: Work,
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        let first = match self.hull(&sub) {
+            Hull::Culled => {
+                self.stats.pieces_culled += 1;
+                return;
             }
+            Hull::FirstRow(first) => first.max(row),
+        };
+        if !self.file(Entry { patch, work }, first) {
+            self.stats.overflows += 1;
+            self.work::<S>(patch, net, work, row, f);
+        }
+    }
+
+    /// Does `work` of `patch` (control net `net`) now, at `row`.
+    fn work<S: Shading>(
+        &mut self,
+        patch: u16,
+        net: &Net,
+        work: Work,
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        match work {
+            Work::Patch => self.patch::<S>(patch, row, f),
+            Work::Side(levels, side) => self.side::<S>(patch, net, &levels, side as usize, row, f),
+            // Filed halves are split further when their row comes; overflowed ones not.
+            Work::Cells(piece) => self.cells::<S>(patch, net, piece, row, f),
         }
     }
 }
@@ -782,13 +865,11 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize> RowPieces<SU
         mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         // Pieces filed under this row while it is processed are taken in the same loop.
-        while let Some(entry) = self.take(row) {
-            match entry.piece {
-                None => self.patch::<S>(entry.patch, row, &mut f),
-                Some(piece) => {
-                    let net = Net::of(self.model, entry.patch as usize);
-                    self.piece::<S>(entry.patch, &net, piece, row, &mut f);
-                }
+        while let Some(Entry { patch, work }) = self.take(row) {
+            let net = Net::of(self.model, patch as usize);
+            match work {
+                Work::Cells(piece) => self.piece::<S>(patch, &net, piece, row, &mut f),
+                _ => self.work::<S>(patch, &net, work, row, &mut f),
             }
         }
     }
@@ -801,10 +882,12 @@ struct Sides<T> {
     back: T,
 }
 
-/// A tessellation vertex: its eye-space point and its (Gouraud) colours for either side.
+/// A tessellation vertex: its eye-space point, its screen position if it is inside every
+/// clip plane, and its (Gouraud) colours for either side.
 #[derive(Clone, Copy, Debug)]
 struct Vertex {
     p: EyePoint,
+    screen: CachedVertex,
     color: Sides<[I16F16; 3]>,
 }
 
