@@ -8,7 +8,7 @@
 //! (about 100 for flat shading).
 //! See [`PatchWorkspace::BYTES`].
 
-use super::eval::{dehomogenize, Column, Hom, Net, TangentColumn};
+use super::eval::{dehomogenize, Hom, Net};
 use super::tessellate::{self, Levels, ScreenNet, Uv};
 use super::trim::{self, Cut};
 use super::{PatchModel, Tolerance};
@@ -624,19 +624,18 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         let v = |j: u8| tessellate::grid(j as u32, levels.v);
         let at = |i: u8, j: u8| [u(i), v(j)];
         // Interior points only (0 < u, v < 1), where `Net::point` evaluates on columns too.
-        let columns: Vec<(Column, Option<TangentColumn>), { BLOCK + 1 }> = (is[0]..=is[1])
-            .map(|i| {
-                (
-                    net.column(u(i)),
-                    S::PER_VERTEX.then(|| net.tangent_column(u(i))),
-                )
-            })
-            .collect();
-        let centres: Vec<Option<TangentColumn>, BLOCK> = (is[0]..is[1])
-            .map(|i| (!S::PER_VERTEX).then(|| net.tangent_column((u(i) + u(i + 1)) / 2)))
-            .collect();
+        let columns = (is[0]..=is[1]).map(|i| {
+            (
+                net.column(u(i)),
+                S::PER_VERTEX.then(|| net.tangent_column(u(i))),
+            )
+        });
+        let columns: Vec<_, { BLOCK + 1 }> = gather(columns);
+        let centres = (is[0]..is[1])
+            .map(|i| (!S::PER_VERTEX).then(|| net.tangent_column((u(i) + u(i + 1)) / 2)));
+        let centres: Vec<_, BLOCK> = gather(centres);
         let points = |this: &Self, j: u8| -> Vec<Vertex, { BLOCK + 1 }> {
-            columns
+            let vertices = columns
                 .iter()
                 .zip(is[0]..=is[1])
                 .map(|((column, tangents), i)| {
@@ -644,8 +643,8 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                         .as_ref()
                         .map(|t| t.normal(v(j)).or_else(|| net.normal(u(i), v(j))));
                     this.vertex_at::<S>(patch, column.point(v(j)), n)
-                })
-                .collect()
+                });
+            gather(vertices)
         };
         let trims = self.model.trims(patch as usize);
         let mut below = points(self, js[0]);
@@ -877,6 +876,17 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize> RowPieces<SU
             }
         }
     }
+}
+
+/// The first `N` items of `items` (callers pass at most `N`), without `collect`'s panic
+/// when there are more.
+fn gather<T, const N: usize>(items: impl Iterator<Item = T>) -> Vec<T, N> {
+    let mut out = Vec::new();
+    for item in items.take(N) {
+        // Room for `N`: never fails.
+        let _ = out.push(item);
+    }
+    out
 }
 
 /// Something with a value for each side of the surface.
