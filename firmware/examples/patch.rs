@@ -19,21 +19,33 @@
 
 /// On the host it draws the same frames with the same code and prints their hashes: a target
 /// for a host profiler (`valgrind --tool=callgrind`, see `docs/patch-scanline.md`).
+/// An argument, a tolerance in pixels (default 0.5), draws at that tolerance.
 #[cfg(not(target_os = "none"))]
 fn main() -> Result<(), &'static str> {
     use embedded_graphics::pixelcolor::Rgb565;
+    use scanline3d::patch::Tolerance;
     use scanline3d::sink::HashSink;
     use scanline3d_demo::patches::{self, PanelPatches, FIRMWARE_FRAMES};
     println!("patch example on the host; on a target, e.g.");
     println!("  cargo run --profile firmware --example patch --target thumbv7em-none-eabihf");
+    let tolerance = match std::env::args().nth(1) {
+        Some(t) => Tolerance::from_num(t.parse::<f64>().map_err(|_| "a tolerance in pixels")?),
+        None => patches::TOLERANCE,
+    };
     let mut ws = Box::new(PanelPatches::new(Rgb565::new(0, 0, 0)));
     for frame in FIRMWARE_FRAMES {
         let mut sink = HashSink::new();
-        let stats = patches::render_frame(&mut ws, frame, &mut sink)?;
+        let stats = patches::render_frame_at(&mut ws, frame, tolerance, &mut sink)?;
         println!(
-            "frame {frame} hash {:08x} triangles {}",
+            "frame {frame} hash {:08x} triangles {} peak_active {} pieces {} pieces_culled {} overflows {} late {} dropped {}",
             sink.hash(),
-            stats.frame.triangles_in
+            stats.frame.triangles_in,
+            stats.frame.peak_active,
+            stats.pieces,
+            stats.pieces_culled,
+            stats.overflows,
+            stats.late,
+            stats.frame.dropped,
         );
     }
     Ok(())

@@ -3,15 +3,17 @@
 //!
 //! # Memory (bytes)
 //!
-//! `4·W` depth row + `size_of::<P>()·W` pixels + `2·H` bucket heads + `SUBS · 8` for patches
-//! and pieces waiting in buckets + `ACTIVE ·` an active triangle (about 100 for flat shading).
+//! `4·W` depth row + `size_of::<P>()·W` pixels + `2·H` bucket heads + `SUBS ·` (an entry and
+//! its link, 16) for patches and pieces waiting in buckets + `ACTIVE ·` an active triangle
+//! (about 100 for flat shading).
 //! See [`PatchWorkspace::BYTES`].
 
-use super::eval::{dehomogenize, Net};
+use super::eval::{dehomogenize, Hom, Net};
 use super::tessellate::{self, Levels, ScreenNet, Uv};
 use super::trim::{self, Cut};
 use super::{PatchModel, Tolerance};
 use crate::arithmetic::Arithmetic;
+use crate::cache::CachedVertex;
 use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping};
 use crate::depth::Depth;
 use crate::options::RenderOptions;
@@ -50,9 +52,10 @@ pub struct PatchStats {
     /// Patches whose control hull is off screen, behind the near plane or beyond the far
     /// plane: never tessellated.
     pub patches_culled: u32,
-    /// Interior pieces taken from the row buckets (each patch's whole interior counts one).
+    /// Pieces taken from the row buckets: boundary strips (four per patch) and interior
+    /// pieces (each patch's whole interior counts one).
     pub pieces: u32,
-    /// Interior pieces dropped because their control hull is off screen.
+    /// Boundary strips and interior pieces dropped because their control hull is off screen.
     pub pieces_culled: u32,
     /// Splits not made because `SUBS` was full: that piece was tessellated at once, so its
     /// triangles wait on the active list longer (the image is the same unless `ACTIVE`
@@ -72,13 +75,23 @@ pub struct PatchStats {
     pub trim_overflows: u32,
 }
 
-/// A patch or a piece of its interior waiting in a row bucket.
+/// A patch or a piece of it waiting in a row bucket.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Entry {
     patch: u16,
-    /// `None`: the whole patch, not tessellated yet. `Some`: interior cells `is × js` of a
-    /// patch tessellated at `levels` (`u`, `v`).
-    piece: Option<Piece>,
+    work: Work,
+}
+
+/// What of a patch an [`Entry`] stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Work {
+    /// The whole patch, not tessellated yet.
+    Patch,
+    /// The boundary strip on `side` (the order of [`Levels::edges`]) of a patch tessellated
+    /// at these levels: the zipper between that edge and the first inner grid line.
+    Side(Levels, u8),
+    /// Interior cells of a patch.
+    Cells(Piece),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -90,12 +103,23 @@ struct Piece {
 
 const EMPTY: Entry = Entry {
     patch: 0,
-    piece: None,
+    work: Work::Patch,
 };
 
-/// Pieces of at most this many cells are tessellated, not split further: a split costs a
-/// control-hull bound (32 blossoms, 16 transforms), about as much as a few triangles.
-const LEAF_CELLS: u32 = 4;
+/// Pieces of at most this many cells are tessellated, not split further: a split costs two
+/// control-hull bounds (sub-nets by blossoming, 16 transforms and projections each), more than
+/// a few triangles. Against 4 cells, 16 took 31 % fewer host instructions for the firmware's
+/// teapot frames at 0.5 px; the triangles made earlier wait longer on the active list.
+const LEAF_CELLS: u32 = 16;
+
+/// Columns of cells drawn at a time: two rows of `BLOCK + 1` vertices are on the stack.
+const BLOCK: usize = 8;
+
+/// No flat colour (Gouraud shading colours vertices instead).
+const BLACK_SIDES: Sides<Rgb888> = Sides {
+    front: Rgb888::new(0, 0, 0),
+    back: Rgb888::new(0, 0, 0),
+};
 
 /// All the memory a patch render needs, sized at compile time.
 ///
@@ -301,7 +325,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                     let entry = Entry {
                         // Below MAX_PATCHES, checked by PatchModel::new.
                         patch: patch as u16,
-                        piece: None,
+                        work: Work::Patch,
                     };
                     // Filing fails only when full; the error below reports it.
                     let _ = self.file(entry, row);
@@ -353,7 +377,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
 
     /// A model point in eye space.
     #[inline]
-    fn eye(&self, h: super::eval::Hom) -> EyePoint {
+    fn eye(&self, h: Hom) -> EyePoint {
         A::Transform::apply(&self.mv, &dehomogenize(h))
     }
 
@@ -433,42 +457,85 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
     /// colours vertices instead).
     fn face<S: Shading>(&self, patch: u16, net: &Net, [u, v]: Uv) -> Sides<Rgb888> {
         if S::PER_VERTEX {
-            let black = Rgb888::new(0, 0, 0);
-            return Sides {
-                front: black,
-                back: black,
-            };
+            return BLACK_SIDES;
         }
         self.lit(patch, net.normal(u, v))
     }
 
     /// The surface point at `(u, v)` in eye space, lit there for Gouraud shading.
     fn vertex<S: Shading>(&self, patch: u16, net: &Net, [u, v]: Uv) -> Vertex {
-        let color = if S::PER_VERTEX {
-            let lit = self.lit(patch, net.normal(u, v));
-            Sides {
-                front: color_channels(lit.front),
-                back: color_channels(lit.back),
+        let normal = S::PER_VERTEX.then(|| net.normal(u, v));
+        self.vertex_at::<S>(patch, net.point(u, v), normal)
+    }
+
+    /// The vertex at surface point `h` with normal `normal` there (`None` for flat shading,
+    /// `Some(None)` where the normal vanishes).
+    #[inline]
+    fn vertex_at<S: Shading>(
+        &self,
+        patch: u16,
+        h: Hom,
+        normal: Option<Option<[i64; 3]>>,
+    ) -> Vertex {
+        let color = match normal {
+            Some(n) if S::PER_VERTEX => {
+                let lit = self.lit(patch, n);
+                Sides {
+                    front: color_channels(lit.front),
+                    back: color_channels(lit.back),
+                }
             }
-        } else {
-            Sides {
+            _ => Sides {
                 front: [I16F16::ZERO; 3],
                 back: [I16F16::ZERO; 3],
-            }
+            },
         };
+        let p = self.eye(h);
         Vertex {
-            p: self.eye(net.point(u, v)),
+            p,
+            screen: CachedVertex::new::<SUB, A::Projection>(&self.vp, p),
             color,
         }
     }
 
-    /// Tessellates triangle `uv` of `patch` (control net `net`) and draws what its trims keep
-    /// of it ([`Self::draw`]), flat-shaded with the normal at its parameter centroid.
+    /// Draws the boundary strip on `side` of `patch`: the zipper's triangles in order, each
+    /// sharing two vertices with the one before, so each vertex is evaluated once.
+    fn side<S: Shading>(
+        &mut self,
+        patch: u16,
+        net: &Net,
+        levels: &Levels,
+        side: usize,
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        self.stats.pieces += 1;
+        let mut recent: [Option<(Uv, Vertex)>; 4] = [None; 4];
+        let mut next = 0;
+        tessellate::border(levels, side, |uv| {
+            let cv = uv.map(|p| {
+                if let Some((_, v)) = recent.iter().flatten().find(|(q, _)| *q == p) {
+                    return *v;
+                }
+                let v = self.vertex::<S>(patch, net, p);
+                if let Some(slot) = recent.get_mut(next % 4) {
+                    *slot = Some((p, v));
+                }
+                next += 1;
+                v
+            });
+            self.triangle::<S>(patch, net, uv, cv, row, f)
+        });
+    }
+
+    /// Draws what the trims keep of triangle `uv` of `patch` (control net `net`, its vertices
+    /// `cv`) ([`Self::draw`]), flat-shaded with the normal at its parameter centroid.
     fn triangle<S: Shading>(
         &mut self,
         patch: u16,
         net: &Net,
         uv: [Uv; 3],
+        cv: [Vertex; 3],
         row: usize,
         f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
@@ -483,7 +550,6 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
             self.trimmed::<S>(patch, net, uv, face, row, f);
             return;
         }
-        let cv = uv.map(|p| self.vertex::<S>(patch, net, p));
         self.draw(patch, cv, face, row, f);
     }
 
@@ -522,8 +588,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         self.stats.trim_overflows += overflows;
     }
 
-    /// Draws interior cells `is × js`, each grid point evaluated once (two rows of points at a
-    /// time), each cell flat-shaded with the normal at its centre.
+    /// Draws interior cells `is × js`, in blocks of at most [`BLOCK`] columns.
     fn cells<S: Shading>(
         &mut self,
         patch: u16,
@@ -532,37 +597,60 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         row: usize,
         f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
-        const SIDE: usize = (1 << super::MAX_LEVEL) + 1;
         let Piece { levels, is, js } = piece;
-        let at = |i: u8, j: u8| {
-            [
-                tessellate::grid(i as u32, levels.u),
-                tessellate::grid(j as u32, levels.v),
-            ]
-        };
-        let zero = [I16F16::ZERO; 3];
-        let empty = Vertex {
-            p: EyePoint {
-                x: I16F16::ZERO,
-                y: I16F16::ZERO,
-                w: I16F16::ZERO,
-            },
-            color: Sides {
-                front: zero,
-                back: zero,
-            },
-        };
-        let points = |this: &Self, j: u8, out: &mut [Vertex; SIDE]| {
-            for (slot, i) in out.iter_mut().zip(is[0]..=is[1]) {
-                *slot = this.vertex::<S>(patch, net, at(i, j));
-            }
+        let mut first = is[0];
+        while first < is[1] {
+            let last = first.saturating_add(BLOCK as u8).min(is[1]);
+            self.block::<S>(patch, net, levels, [first, last], js, row, f);
+            first = last;
+        }
+    }
+
+    /// Draws interior cells `is × js` (`is` at most [`BLOCK`] columns), each grid point
+    /// evaluated once (two rows of points at a time) on its column's curve, each cell
+    /// flat-shaded with the normal at its centre, on its centre column's curve.
+    #[allow(clippy::too_many_arguments)]
+    fn block<S: Shading>(
+        &mut self,
+        patch: u16,
+        net: &Net,
+        levels: Levels,
+        is: [u8; 2],
+        js: [u8; 2],
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        let u = |i: u8| tessellate::grid(i as u32, levels.u);
+        let v = |j: u8| tessellate::grid(j as u32, levels.v);
+        let at = |i: u8, j: u8| [u(i), v(j)];
+        // Interior points only (0 < u, v < 1), where `Net::point` evaluates on columns too.
+        let columns = (is[0]..=is[1]).map(|i| {
+            (
+                net.column(u(i)),
+                S::PER_VERTEX.then(|| net.tangent_column(u(i))),
+            )
+        });
+        let columns: Vec<_, { BLOCK + 1 }> = gather(columns);
+        let centres = (is[0]..is[1])
+            .map(|i| (!S::PER_VERTEX).then(|| net.tangent_column((u(i) + u(i + 1)) / 2)));
+        let centres: Vec<_, BLOCK> = gather(centres);
+        let points = |this: &Self, j: u8| -> Vec<Vertex, { BLOCK + 1 }> {
+            let vertices = columns
+                .iter()
+                .zip(is[0]..=is[1])
+                .map(|((column, tangents), i)| {
+                    let n = tangents
+                        .as_ref()
+                        .map(|t| t.normal(v(j)).or_else(|| net.normal(u(i), v(j))));
+                    this.vertex_at::<S>(patch, column.point(v(j)), n)
+                });
+            gather(vertices)
         };
         let trims = self.model.trims(patch as usize);
-        let (mut below, mut above) = ([empty; SIDE], [empty; SIDE]);
-        points(self, js[0], &mut below);
+        let mut below = points(self, js[0]);
         for j in js[0]..js[1] {
-            points(self, j + 1, &mut above);
-            for (k, i) in (is[0]..is[1]).enumerate() {
+            let above = points(self, j + 1);
+            for ((k, i), centre) in (is[0]..is[1]).enumerate().zip(&centres) {
                 let (Some(&a), Some(&b), Some(&c), Some(&d)) = (
                     below.get(k),
                     below.get(k + 1),
@@ -572,8 +660,13 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                     break;
                 };
                 let corners = [a, b, c, d];
-                let centre = |p: [u32; 2], q: [u32; 2]| [(p[0] + q[0]) / 2, (p[1] + q[1]) / 2];
-                let face = self.face::<S>(patch, net, centre(at(i, j), at(i + 1, j + 1)));
+                let face = match centre {
+                    Some(t) => {
+                        let (uc, vc) = ((u(i) + u(i + 1)) / 2, (v(j) + v(j + 1)) / 2);
+                        self.lit(patch, t.normal(vc).or_else(|| net.normal(uc, vc)))
+                    }
+                    None => BLACK_SIDES,
+                };
                 let corner_uv = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
                 for t in tessellate::CELL_TRIANGLES {
                     let uv = t.map(|k| corner_uv.get(k).copied().unwrap_or([0; 2]));
@@ -634,6 +727,17 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
             f(s, face, patch as u32, 0);
         };
         let mut stats = self.stats;
+        // Inside every clip plane: the screen positions projected once per vertex, as the
+        // clipper's path below would project them.
+        let screen = [0, 1, 2].map(|k| {
+            let (v, c) = (t.get(k)?, cv.get(k)?);
+            v.screen.screen::<SUB>(c.color)
+        });
+        if let [Some(a), Some(b), Some(c)] = screen {
+            emit([a, b, c], &mut stats);
+            self.stats = stats;
+            return;
+        }
         match C::clip(&vp, &cv, &mut self.polygon) {
             Clipped::Outside => stats.frame.rejected += 1,
             Clipped::Skipped => stats.frame.unclipped += 1,
@@ -656,8 +760,9 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         self.stats = stats;
     }
 
-    /// A whole patch's first row has come: tessellate its boundary ring now and hand its
-    /// interior on as a piece.
+    /// A whole patch's first row has come: choose its levels, file each side of its boundary
+    /// ring under the first row of that strip's control hull and hand its interior on as a
+    /// piece.
     fn patch<S: Shading>(
         &mut self,
         patch: u16,
@@ -668,9 +773,9 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         let levels = tessellate::levels(&self.screen_net(&net), self.tolerance);
         self.stats.capped += levels.capped as u32;
         for side in 0..4 {
-            tessellate::border(&levels, side, |t| {
-                self.triangle::<S>(patch, &net, t, row, f)
-            });
+            let (u, v) = tessellate::strip(&levels, side);
+            let work = Work::Side(levels, side as u8);
+            self.file_or_draw::<S>(patch, &net, net.piece(u, v), work, row, f);
         }
         let (is, js) = tessellate::interior(&levels);
         if is[0] < is[1] && js[0] < js[1] {
@@ -706,22 +811,50 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         for (is, js) in halves {
             let half = Piece { levels, is, js };
             let range = |r: [u8; 2], level: u8| r.map(|k| tessellate::grid(k as u32, level));
-            let hull = self.hull(&net.piece(range(is, levels.u), range(js, levels.v)));
-            let first = match hull {
-                Hull::Culled => {
-                    self.stats.pieces_culled += 1;
-                    continue;
-                }
-                Hull::FirstRow(first) => first.max(row),
-            };
-            let entry = Entry {
-                patch,
-                piece: Some(half),
-            };
-            if !self.file(entry, first) {
-                self.stats.overflows += 1;
-                self.cells::<S>(patch, net, half, row, f);
+            let sub = net.piece(range(is, levels.u), range(js, levels.v));
+            self.file_or_draw::<S>(patch, net, sub, Work::Cells(half), row, f);
+        }
+    }
+
+    /// Files `work` (a part of `patch` whose control net is `sub`) under the first row of
+    /// `sub`'s control hull (this row if it starts here); drops it if the hull is off screen,
+    /// draws it now if no entry is free.
+    fn file_or_draw<S: Shading>(
+        &mut self,
+        patch: u16,
+        net: &Net,
+        sub: Net,
+        work: Work,
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        let first = match self.hull(&sub) {
+            Hull::Culled => {
+                self.stats.pieces_culled += 1;
+                return;
             }
+            Hull::FirstRow(first) => first.max(row),
+        };
+        if !self.file(Entry { patch, work }, first) {
+            self.stats.overflows += 1;
+            self.work::<S>(patch, net, work, row, f);
+        }
+    }
+
+    /// Does `work` of `patch` (control net `net`) now, at `row`.
+    fn work<S: Shading>(
+        &mut self,
+        patch: u16,
+        net: &Net,
+        work: Work,
+        row: usize,
+        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+    ) {
+        match work {
+            Work::Patch => self.patch::<S>(patch, row, f),
+            Work::Side(levels, side) => self.side::<S>(patch, net, &levels, side as usize, row, f),
+            // Filed halves are split further when their row comes; overflowed ones not.
+            Work::Cells(piece) => self.cells::<S>(patch, net, piece, row, f),
         }
     }
 }
@@ -735,16 +868,25 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize> RowPieces<SU
         mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         // Pieces filed under this row while it is processed are taken in the same loop.
-        while let Some(entry) = self.take(row) {
-            match entry.piece {
-                None => self.patch::<S>(entry.patch, row, &mut f),
-                Some(piece) => {
-                    let net = Net::of(self.model, entry.patch as usize);
-                    self.piece::<S>(entry.patch, &net, piece, row, &mut f);
-                }
+        while let Some(Entry { patch, work }) = self.take(row) {
+            let net = Net::of(self.model, patch as usize);
+            match work {
+                Work::Cells(piece) => self.piece::<S>(patch, &net, piece, row, &mut f),
+                _ => self.work::<S>(patch, &net, work, row, &mut f),
             }
         }
     }
+}
+
+/// The first `N` items of `items` (callers pass at most `N`), without `collect`'s panic
+/// when there are more.
+fn gather<T, const N: usize>(items: impl Iterator<Item = T>) -> Vec<T, N> {
+    let mut out = Vec::new();
+    for item in items.take(N) {
+        // Room for `N`: never fails.
+        let _ = out.push(item);
+    }
+    out
 }
 
 /// Something with a value for each side of the surface.
@@ -754,10 +896,12 @@ struct Sides<T> {
     back: T,
 }
 
-/// A tessellation vertex: its eye-space point and its (Gouraud) colours for either side.
+/// A tessellation vertex: its eye-space point, its screen position if it is inside every
+/// clip plane, and its (Gouraud) colours for either side.
 #[derive(Clone, Copy, Debug)]
 struct Vertex {
     p: EyePoint,
+    screen: CachedVertex,
     color: Sides<[I16F16; 3]>,
 }
 

@@ -178,6 +178,20 @@ fn oriented(t: [Uv; 3]) -> Option<[Uv; 3]> {
     }
 }
 
+/// The parameter ranges `(u, v)` of the boundary strip on `side` (the order of
+/// [`Levels::edges`]): between that edge and the first inner grid line, where [`border`]
+/// puts its triangles.
+pub(crate) fn strip(l: &Levels, side: usize) -> ([u32; 2], [u32; 2]) {
+    let (du, dv) = (grid(1, l.u), grid(1, l.v));
+    let all = [0, PARAM_ONE];
+    match side {
+        0 => (all, [0, dv]),
+        1 => ([PARAM_ONE - du, PARAM_ONE], all),
+        2 => (all, [PARAM_ONE - dv, PARAM_ONE]),
+        _ => ([0, du], all),
+    }
+}
+
 /// Calls `f` with each triangle of the boundary strip on `side` (the order of
 /// [`Levels::edges`]).
 pub(crate) fn border(l: &Levels, side: usize, mut f: impl FnMut([Uv; 3])) {
@@ -274,7 +288,16 @@ mod tests {
                     };
                     let mut tris = Vec::new();
                     for side in 0..4 {
-                        border(&l, side, |t| tris.push(t));
+                        // Each side's triangles lie in its strip (the renderer files them
+                        // under the strip's control hull).
+                        let (su, sv) = strip(&l, side);
+                        let inside = |p: Uv| {
+                            (su[0]..=su[1]).contains(&p[0]) && (sv[0]..=sv[1]).contains(&p[1])
+                        };
+                        border(&l, side, |t| {
+                            assert!(t.iter().all(|&p| inside(p)), "{l:?} side {side}: {t:?}");
+                            tris.push(t)
+                        });
                     }
                     let (is, js) = interior(&l);
                     cells(&l, is, js, |t| tris.push(t));

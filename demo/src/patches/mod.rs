@@ -22,7 +22,7 @@ pub const TOLERANCE: Tolerance = Tolerance::lit("0.5");
 /// Patches and pieces that may wait in row buckets.
 pub const SUBS: usize = 512;
 /// Triangles that may be active at once.
-pub const ACTIVE: usize = 2048;
+pub const ACTIVE: usize = 2560;
 
 /// The workspace the firmware uses: RGB565 rows of [`SIDE`] pixels, flat shading.
 pub type PanelPatches = PanelPatchesOf<Rgb565>;
