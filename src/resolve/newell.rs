@@ -40,6 +40,12 @@
 //! affected lie within about half a sub-pixel of where the two planes meet, where the depth
 //! gap is below the renderer's error bound.
 //!
+//! A thin piece may be straddled by a plane and still have no part of any area once the cut
+//! points are rounded. Its region of the original can hold pixel centres all the same (a
+//! sliver along a column of them), so it is not dropped: it is kept whole and *pressed*, the
+//! depths of its vertices on the other side of the plane than its centroid moved onto the
+//! plane, and ordered as if it lay on its centroid's side ([`SortStats::pressed`]).
+//!
 //! The rounded parts are only used to find the order. What is painted is the original
 //! piece, cut by a *split tree*: each split records the screen lines between its parts (the
 //! line through the two rounded cut points, and the diagonal of a four-sided part), and every
@@ -141,11 +147,16 @@ pub struct SortStats {
     pub re_moves: u32,
     /// Pieces split (cyclic overlap or interpenetration).
     pub splits: u32,
-    /// Parts of a split that have no screen area once their new vertices are rounded (they
-    /// cover nothing, so leaving them out changes no pixel).
+    /// Parts of a split that have no screen area once their new vertices are rounded, left
+    /// out: their region of the original (which may still hold pixel centres) goes to a
+    /// neighbouring part of the same split, and takes that part's place in the order.
     pub dropped_slivers: u32,
     /// Search steps taken.
     pub steps: u32,
+    /// Pieces that a plane straddles but whose parts would all have no screen area once
+    /// rounded: kept whole, with the depths of the vertices on the minority side moved onto
+    /// the plane (the order is then decided as if the piece lay on its centroid's side).
+    pub pressed: u32,
     /// Cycles that no plane of their pieces cuts beyond the rounding cell (pieces of
     /// interpenetrating triangles meeting within it), broken by drawing the head first.
     pub cycles_within_rounding: u32,
@@ -251,6 +262,7 @@ impl<
                 splits: 0,
                 dropped_slivers: 0,
                 steps: 0,
+                pressed: 0,
                 cycles_within_rounding: 0,
             },
         }
@@ -734,7 +746,19 @@ impl Sort<'_> {
             return Ok(());
         };
         let t = *self.piece(x);
-        let parts = cut(&t, &plane);
+        let mut parts = cut(&t, &plane);
+        if parts.parts.iter().all(Option::is_none) {
+            // No part keeps any area on the grid, but the piece's region of the original may
+            // still hold pixel centres (a sliver along a column of them): dropping it would
+            // leave them unpainted. Keep it whole, pressed onto the side of the plane that
+            // holds its centroid, so that it is ordered.
+            self.stats.pressed += 1;
+            parts = Parts {
+                parts: [Some(press(&t, &plane)), None, None],
+                made: 1,
+                lines: parts.lines,
+            };
+        }
         let count = parts.parts.iter().flatten().count();
         // An original keeps its entry (the painter walks it); a part's entry goes to its
         // first part.
@@ -1105,6 +1129,23 @@ fn cut(t: &StoredTriangle, plane: &PlaneEq) -> Parts {
             lines: [line(&i1, &i2, &a), line(&i1, &c, &b)],
         }
     }
+}
+
+/// `t` with the depths of its vertices on the other side of `plane` than its centroid moved
+/// onto the plane (to the nearest I2F30 step), so that `plane` no longer straddles it.
+fn press(t: &StoredTriangle, plane: &PlaneEq) -> StoredTriangle {
+    let s = [0, 1, 2].map(|k| plane.at(t, k));
+    let front = s.iter().sum::<i128>() >= 0;
+    let mut q = t.q;
+    for (q, s) in q.iter_mut().zip(s) {
+        if (s < 0) == front {
+            // `s` changes by `n_q` per step of `q`: the rounded step leaves `2·|s| <= n_q`,
+            // within the plane's tolerance.
+            let moved = *q as i128 - div_round(s, plane.n[2]);
+            *q = moved.clamp(i32::MIN as i128, i32::MAX as i128) as i32;
+        }
+    }
+    StoredTriangle { q, ..*t }
 }
 
 /// A vertex of a piece being cut: position, depth and colour.

@@ -74,9 +74,9 @@ fn table(name: &str, spec: &SceneSpec) -> Vec<(String, Metrics)> {
 /// with the default command line (culling decided, here two-sided for the soup), every correct
 /// method has no real mismatches and at most 2 % id mismatches, and the exact preset at most
 /// 0.1 %. Newell–Newell–Sancha reaches that on the soup from inside and on the scanned mesh;
-/// from outside it still leaves real mismatches where pieces of interpenetrating triangles
-/// meet (order errors: see docs/realworld.md), so there it must only finish the frame within
-/// its capacities, which it used not to.
+/// from outside it leaves one real mismatch (a sliver part left out of a split gives its
+/// pixel to the part on the other side of the plane: docs/realworld.md), so there it must
+/// finish the frame within its capacities, which it used not to, with at most that one.
 #[test]
 fn hard_scenes_every_method() {
     let soup = real_world::soup();
@@ -100,6 +100,12 @@ fn hard_scenes_every_method() {
                 && (method != Algorithm::Newell.to_string() || name != "soup outside");
             if correct && (m.real > 0 || m.id_mismatch_percent() > limit) {
                 failures.push(format!("{name} {method}: {m}"));
+            }
+            if !correct
+                && method == Algorithm::Newell.to_string()
+                && (m.real > 1 || m.id_mismatch_percent() > limit)
+            {
+                failures.push(format!("{name} {method}, traced to 1 real: {m}"));
             }
         }
     }
