@@ -390,6 +390,8 @@ mod firmware {
         arch::start_counter()?;
         measure::calibrate()?;
         let mut complete = true;
+        // `cargo xtask profile` with a scene renders that corpus scene alone.
+        #[cfg(not(scanline3d_corpus_only))]
         {
             variants(&mut Orbit {
                 count: &|| Counter(arch::start()),
