@@ -113,6 +113,8 @@ trait Renders {
 }
 
 /// The demo orbit; `report(variant, frame, result)`.
+// Not rendered by a `--cfg scanline3d_corpus_only` profile build.
+#[cfg_attr(scanline3d_corpus_only, allow(dead_code))]
 struct Orbit<'a, C, R> {
     count: &'a C,
     report: R,
