@@ -18,6 +18,8 @@ fn main() {
         "cargo::rustc-check-cfg=cfg(scanline3d_variant, values(\"fast\", \"balanced\", \"exact\", \"default\", \"bits0\", \"micromath\", \"narrowtransform\", \"reciprocal\", \"narrownormals\", \"depth16\", \"gouraudaffine\", \"gouraudsegments16\", \"gouraudsegments8\", \"gouraudperpixel\"))"
     );
     println!("cargo::rustc-check-cfg=cfg(scanline3d_corpus)");
+    // `--cfg scanline3d_corpus_only`: the corpus alone, without the demo orbit (`cargo xtask profile`).
+    println!("cargo::rustc-check-cfg=cfg(scanline3d_corpus_only)");
     // `examples/firmware.rs` and `examples/tradeoff.rs` with `--cfg scanline3d_vertex_cache`
     // render with a vertex cache (`cargo xtask firmware` and `cargo xtask speed` measure both).
     println!("cargo::rustc-check-cfg=cfg(scanline3d_vertex_cache)");

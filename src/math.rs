@@ -91,9 +91,82 @@ pub(crate) fn cosine_i64(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
     // |s_i · unit_i| < 2^60 and, by Cauchy–Schwarz, every partial sum is at most
     // |s| · |unit| < 2^61: no overflow, and the quotient is within about ±2^30.
     let dot: i64 = (0..3).map(|k| s[k] * unit[k] as i64).sum();
-    // Unsigned division: `len` is known non-zero here, so no panic branch is emitted.
-    let q = (dot.unsigned_abs() / len) as i32;
+    // `len <= sqrt(3) · 2^30` fits 32 bits and is non-zero here.
+    let q = div_rem_u64_u32(dot.unsigned_abs(), len as u32).0 as i32;
     Some(if dot < 0 { -q } else { q })
+}
+
+/// `n.div_euclid(d)` (the floor of `n / d`) for `d >= 1` (`d < 1` is taken as 1), through
+/// [`div_rem_u64_u32`] when `d` fits 32 bits.
+#[inline]
+pub(crate) fn floor_div_i64(n: i64, d: i64) -> i64 {
+    let d = d.max(1);
+    match u32::try_from(d) {
+        Ok(d32) => {
+            let (q, r) = div_rem_u64_u32(n.unsigned_abs(), d32);
+            // |n| <= 2^63 and d >= 1: the quotient of a negative n fits i64 when negated.
+            let q = q as i64;
+            if n >= 0 {
+                q
+            } else {
+                q.wrapping_neg() - (r != 0) as i64
+            }
+        }
+        Err(_) => n.div_euclid(d),
+    }
+}
+
+/// `(n / d, n % d)` for a 64-bit `n` and a 32-bit `d >= 1`, exactly as `u64` division, from
+/// 32-bit divisions only (Hacker's Delight `divlu`: two 16-bit quotient digits, each estimated
+/// from the normalized divisor's top half and corrected at most twice). Cores with a 32-bit
+/// divider (Cortex-M3/M4, RV32IM) have none for 64 bits, and `compiler_builtins` builds the
+/// 64-bit division from a software 32-bit one: this is several times cheaper there. On cores
+/// without any divider (Cortex-M0) each 32-bit division is a call, and the two cost about the
+/// same (the icosphere frame within 0.1 %).
+#[inline]
+pub(crate) fn div_rem_u64_u32(n: u64, d: u32) -> (u64, u32) {
+    let d = d.max(1);
+    let (hi, lo) = ((n >> 32) as u32, n as u32);
+    let (q_hi, r_hi) = (hi / d, hi % d);
+    let (q_lo, r) = div_rem_below(r_hi, lo, d);
+    (((q_hi as u64) << 32) | q_lo as u64, r)
+}
+
+/// `(u1·2^32 + u0) / v` and its remainder for `u1 < v` (so the quotient fits 32 bits).
+#[inline]
+fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
+    const B: u32 = 1 << 16;
+    if u1 == 0 {
+        // The common case (numerator below 2^32): one division.
+        let v = v.max(1);
+        return (u0 / v, u0 % v);
+    }
+    // Normalize: the divisor's top bit set (u1 < v, so v > 0 and the shift is below 32).
+    let s = v.leading_zeros();
+    let v = v << s;
+    let (vn1, vn0) = (v >> 16, v & 0xFFFF);
+    let un32 = (u1 << s) | if s == 0 { 0 } else { u0 >> (32 - s) };
+    let un10 = u0 << s;
+    let (un1, un0) = (un10 >> 16, un10 & 0xFFFF);
+    // One 16-bit digit of the quotient of `top·2^16 + next` (`top < v`): the estimate from
+    // `vn1 >= 2^15` is at most two too large (Knuth, Algorithm D).
+    let digit = |top: u32, next: u32| {
+        let mut q = top / vn1;
+        let mut rhat = top - q * vn1;
+        while q >= B || q * vn0 > (rhat << 16 | next) {
+            q -= 1;
+            rhat += vn1;
+            if rhat >= B {
+                break;
+            }
+        }
+        q
+    };
+    let q1 = digit(un32, un1);
+    let un21 = (un32 << 16 | un1).wrapping_sub(q1.wrapping_mul(v));
+    let q0 = digit(un21, un0);
+    let r = (un21 << 16 | un0).wrapping_sub(q0.wrapping_mul(v)) >> s;
+    (q1 << 16 | q0, r)
 }
 
 /// `floor(sqrt(n))`, exactly `n.isqrt()`. Where the core has a double-precision square root
@@ -196,6 +269,62 @@ pub(crate) fn cosine_i32(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn division_by_32_bits_is_exact() {
+        let ns = [
+            0u64,
+            1,
+            2,
+            u32::MAX as u64,
+            1 << 32,
+            (1 << 32) + 1,
+            u64::MAX,
+            u64::MAX - 1,
+        ];
+        let ds = [
+            1u32,
+            2,
+            3,
+            0xFFFF,
+            0x1_0000,
+            0x8000_0000,
+            0x8000_0001,
+            u32::MAX,
+        ];
+        let check = |n: u64, d: u32| {
+            let want = (n / d as u64, (n % d as u64) as u32);
+            assert_eq!(div_rem_u64_u32(n, d), want, "{n} / {d}");
+        };
+        for n in ns {
+            for d in ds {
+                check(n, d);
+            }
+        }
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..400_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let n = x >> (x % 64);
+            let d = ((x >> 7) as u32) >> ((x >> 40) % 32);
+            check(n, d.max(1));
+            // Quotients at the digit boundaries: n = q·d + r with chosen q.
+            let q = (x >> 20) & 0xFFFF_FFFF;
+            check(q * d.max(1) as u64 + (x % d.max(1) as u64), d.max(1));
+            let (n, d) = (x as i64 >> (x % 63), (x >> 11) as i64 >> ((x >> 50) % 63));
+            assert_eq!(
+                floor_div_i64(n, d.max(1)),
+                n.div_euclid(d.max(1)),
+                "{n} / {d}"
+            );
+        }
+        for n in [i64::MIN, i64::MIN + 1, -1, 0, 1, i64::MAX] {
+            for d in [1i64, 2, 3, u32::MAX as i64, 1 << 32, i64::MAX] {
+                assert_eq!(floor_div_i64(n, d), n.div_euclid(d), "{n} / {d}");
+            }
+        }
+    }
 
     #[test]
     fn square_root_is_exact() {

@@ -14,6 +14,7 @@
 //! * Depth `q = near / w` in I2F30: `near · 2^30 < 2^61`.
 
 use crate::depth::Depth;
+use crate::math::floor_div_i64;
 use crate::vertex::EyePoint;
 use fixed::types::I16F16;
 
@@ -179,7 +180,7 @@ impl<const S: u32> Viewport<S> {
         let x = floor_div(cx * w + 2 * nx + w, 2 * w);
         let y = floor_div(cy * w - 2 * ny + w, 2 * w);
         let q = if depth {
-            ((self.near.to_bits() as i64) << 30) / w
+            floor_div_i64((self.near.to_bits() as i64) << 30, w)
         } else {
             0
         };
@@ -240,7 +241,7 @@ fn floor_div(n: i64, d: i64) -> i64 {
             return q as i64;
         }
     }
-    n.div_euclid(d.max(1))
+    floor_div_i64(n, d)
 }
 
 /// A projected vertex from its position and depth bits (within range after clipping; the

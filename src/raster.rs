@@ -27,6 +27,7 @@
 //! solved in i128 once per triangle and stepped in i64 (depth) or i32 (colour).
 
 use crate::depth::Depth;
+use crate::math::floor_div_i64;
 use crate::project::ScreenVertex;
 use core::cmp::Ordering;
 use fixed::types::I16F16;
@@ -415,9 +416,10 @@ fn cross_diff_i64(a: i64, b: i64, c: i64, d: i64) -> Option<i64> {
 #[inline]
 fn round_div_i64(n: i64, d: i64) -> Option<i64> {
     let d = d.max(1);
-    n.checked_mul(2)?
-        .checked_add(d)?
-        .checked_div_euclid(d.checked_mul(2)?)
+    Some(floor_div_i64(
+        n.checked_mul(2)?.checked_add(d)?,
+        d.checked_mul(2)?,
+    ))
 }
 
 /// `a·b − c·d`, exactly. When every factor fits 31 bits the products and their difference fit
@@ -440,9 +442,7 @@ fn round_div(n: i128, d: i64) -> i128 {
     let d = d.max(1);
     let (num, den) = (2 * n + d as i128, 2 * d as i128);
     if let (Ok(num), Ok(den)) = (i64::try_from(num), i64::try_from(den)) {
-        if let Some(q) = num.checked_div_euclid(den) {
-            return q as i128;
-        }
+        return floor_div_i64(num, den) as i128;
     }
     num.div_euclid(den.max(1))
 }

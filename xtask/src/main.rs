@@ -169,8 +169,17 @@ fn main() -> ExitCode {
         }
         "profile" => {
             let variant = std::env::args().nth(2).unwrap_or_else(|| "balanced".into());
-            let cache = std::env::args().nth(3).as_deref() == Some("cache");
-            install().and_then(|_| profile::profile(&variant, cache))
+            let rest: Vec<String> = std::env::args().skip(3).collect();
+            let cache = rest.iter().any(|a| a == "cache");
+            let target = rest
+                .iter()
+                .find(|a| a.contains("-none-") || a.contains("-unknown-"))
+                .map_or(profile::DEFAULT_TARGET, String::as_str);
+            let scene = rest
+                .iter()
+                .find(|a| *a != "cache" && a.as_str() != target)
+                .map(String::as_str);
+            install().and_then(|_| profile::profile(&variant, cache, target, scene))
         }
         // The host renders build whole-frame workspaces (megabytes at 60,000 polygons) by value:
         // give them a thread with room for that.
@@ -191,7 +200,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask test | firmware | trace | metaball | metaball-trade | patch | patch-trade | lean | package | hsr-table | peers | tradeoff | profile [VARIANT [cache]] | speed [before|after|doc] | fuzz [SECONDS]"
+                "usage: cargo xtask test | firmware | trace | metaball | metaball-trade | patch | patch-trade | lean | package | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | speed [before|after|doc] | fuzz [SECONDS]"
             );
             return ExitCode::from(2);
         }

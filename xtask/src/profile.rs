@@ -1,18 +1,40 @@
-//! `cargo xtask profile [VARIANT [cache]]`: where a trade-off variant's demo frames spend their
-//! instructions on thumbv6m (with `cache`, rendered with a vertex cache). QEMU logs every translated block and every block it executes
+//! `cargo xtask profile [VARIANT [cache] [TARGET] [SCENE]]`: where a trade-off variant's frames
+//! spend their instructions (with `cache`, rendered with a vertex cache), on thumbv6m unless a
+//! TARGET (`thumbv7em-none-eabihf`, ...) is named; the demo orbit, or with a corpus SCENE
+//! (`icosphere`, ...) every view of that scene alone (`--cfg scanline3d_corpus_only`). QEMU logs every translated block and every block it executes
 //! (`-d in_asm,exec,nochain`); the count of each block times its length gives exact
 //! instructions per block. Prints the share of compiler built-ins (64-bit multiply and divide,
 //! memcpy), the top functions, and the top source lines of this repository, with the
 //! built-ins charged to the call site that entered them (`llvm-addr2line`; the release profile
 //! keeps debug info).
 
-use crate::tradeoff::{build_example_with_cfgs, run_on_qemu_with};
+use crate::tradeoff::{build_example_with_cfgs, run_on_qemu_with, CORPUS};
 use crate::{root, step};
 use std::collections::HashMap;
 use std::io::BufRead;
 use std::process::Command;
 
-const TARGET: &str = "thumbv6m-none-eabi";
+/// The target profiled unless one is named.
+pub const DEFAULT_TARGET: &str = "thumbv6m-none-eabi";
+
+/// The corpus source with `scene` the only entry of `SCENES`.
+fn only_scene(source: &str, scene: &str) -> Result<String, String> {
+    let entry = format!("CorpusScene {{ name: {scene:?},");
+    if !source.contains(&entry) {
+        return Err(format!("no corpus scene {scene:?}"));
+    }
+    Ok(source
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("CorpusScene { name:") || l.contains(&entry))
+        .map(
+            |l| match l.strip_prefix("pub static SCENES: [CorpusScene; ") {
+                Some(_) => "pub static SCENES: [CorpusScene; 1] = [",
+                None => l,
+            },
+        )
+        .collect::<Vec<_>>()
+        .join("\n"))
+}
 
 /// Function symbols of `elf`: (start, size, name), sorted.
 fn symbols(elf: &std::path::Path) -> Result<Vec<(u64, u64, String)>, String> {
@@ -83,10 +105,16 @@ fn percent(n: u64, total: u64) -> f64 {
     100.0 * n as f64 / total.max(1) as f64
 }
 
-pub fn profile(variant: &str, cache: bool) -> Result<(), String> {
+pub fn profile(
+    variant: &str,
+    cache: bool,
+    target: &str,
+    scene: Option<&str>,
+) -> Result<(), String> {
     step(&format!(
-        "trade-off firmware, {variant} alone{}, for {TARGET}",
-        if cache { ", vertex cache" } else { "" }
+        "trade-off firmware, {variant} alone{}, {}, for {target}",
+        if cache { ", vertex cache" } else { "" },
+        scene.map_or("demo orbit".to_string(), |s| format!("corpus scene {s}"))
     ));
     let mut cfgs = vec![format!(
         "scanline3d_variant=\"{}\"",
@@ -95,11 +123,20 @@ pub fn profile(variant: &str, cache: bool) -> Result<(), String> {
     if cache {
         cfgs.push("scanline3d_vertex_cache".into());
     }
-    let elf = build_example_with_cfgs("tradeoff", Some(TARGET), &cfgs, None)?;
+    let corpus_file = root().join("target/profile-corpus/corpus.rs");
+    if let Some(scene) = scene {
+        let corpus = scanline3d_sim::export::corpus_source(240, 240, 10)?;
+        let dir = root().join("target/profile-corpus");
+        std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+        std::fs::write(&corpus_file, only_scene(&corpus, scene)?).map_err(|e| e.to_string())?;
+        cfgs.push("scanline3d_corpus_only".into());
+    }
+    let generated = scene.map(|_| (CORPUS, corpus_file.as_path()));
+    let elf = build_example_with_cfgs("tradeoff", Some(target), &cfgs, generated)?;
     let log = root().join("target/profile-trace.log");
     step("run on QEMU, logging every executed block (a few GB, removed afterwards)");
     let out = run_on_qemu_with(
-        TARGET,
+        target,
         &elf,
         &[
             "-d".as_ref(),
@@ -108,7 +145,15 @@ pub fn profile(variant: &str, cache: bool) -> Result<(), String> {
             log.as_os_str(),
         ],
     )?;
-    let frames = out.lines().filter(|l| l.starts_with("variant ")).count();
+    let frame_lines: Vec<&str> = out
+        .lines()
+        .filter(|l| l.starts_with("variant ") || l.starts_with("corpus "))
+        .collect();
+    // Each frame's own count (SysTick or minstret, as `cargo xtask speed` reads it).
+    for line in &frame_lines {
+        println!("{line}");
+    }
+    let frames = frame_lines.len();
     step("count instructions per block, charging built-ins to the call site that entered them");
     let syms = symbols(&elf)?;
     let file = std::fs::File::open(&log).map_err(|e| format!("{}: {e}", log.display()))?;
@@ -156,7 +201,8 @@ pub fn profile(variant: &str, cache: bool) -> Result<(), String> {
     }
     std::fs::remove_file(&log).map_err(|e| e.to_string())?;
     println!(
-        "\n{frames} frames of `{variant}` on {TARGET} (QEMU mps2-an385): {total} instructions, {:.1} % of them in compiler built-ins (software 64-bit multiply and divide, memcpy, ...)",
+        "\n{frames} frames of `{variant}` on {target}: {total} instructions ({} a frame, set-up and output included), {:.1} % of them in compiler built-ins (software 64-bit multiply and divide, memcpy, ...)",
+        total / frames.max(1) as u64,
         percent(builtin, total)
     );
     let mut functions: HashMap<&str, u64> = HashMap::new();
@@ -185,7 +231,7 @@ pub fn profile(variant: &str, cache: bool) -> Result<(), String> {
     let mut by_line: Vec<_> = by_line.into_iter().collect();
     by_line.sort_by_key(|l| std::cmp::Reverse(l.1));
     println!("\nsource lines, with the built-ins they call:");
-    for (line, n) in by_line.iter().take(25) {
+    for (line, n) in by_line.iter().take(40) {
         println!("{:6.2} %  {line}", percent(*n, total));
     }
     Ok(())
