@@ -99,6 +99,10 @@ pub enum CapacityKind {
     /// [`PatchWorkspace`](crate::patch::PatchWorkspace)): every patch whose control hull is on
     /// screen needs one at the start of a frame.
     Patches,
+    /// Room to cut triangles by trim loops (`TRIM` of a
+    /// [`PatchWorkspace`](crate::patch::PatchWorkspace)): a workspace with `TRIM` = 0 has
+    /// no trim code and cannot draw a model with trim loops (`needed` counts its loops).
+    Trims,
 }
 
 impl core::fmt::Display for CapacityKind {
@@ -111,6 +115,7 @@ impl core::fmt::Display for CapacityKind {
             Self::WindowStack => "Warnock window stack (STACK)",
             Self::SortSteps => "Newell sort steps",
             Self::Patches => "patches waiting in row buckets (SUBS)",
+            Self::Trims => "trim loops (TRIM = 0 has no trim code)",
         })
     }
 }

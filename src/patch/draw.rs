@@ -135,7 +135,9 @@ const BLACK_SIDES: Sides<Rgb888> = Sides {
 ///   and two per trim edge crossing it; triangles waiting after splits at trim vertices), on
 ///   the stack while a trimmed triangle is cut: about `125·TRIM` bytes on a 32-bit target.
 ///   A triangle that needs more is kept or dropped whole and [`PatchStats::trim_overflows`]
-///   counts it.
+///   counts it. `TRIM` = 0 leaves the trim code out of the build (a firmware whose models
+///   have no trims carries none): such a workspace rejects a model with trim loops
+///   ([`RenderError::Capacity`] of [`CapacityKind::Trims`]).
 pub struct PatchWorkspace<
     P: RowPixel,
     S: Shading,
@@ -228,6 +230,13 @@ impl<
         let vp = Viewport::<SUB>::new(width, height, camera.focal(), camera.near(), camera.far())
             .ok_or(RenderError::InvalidTarget)?;
         let model = scene.model;
+        if TRIM == 0 && !model.trim_loops().is_empty() {
+            return Err(RenderError::Capacity {
+                what: CapacityKind::Trims,
+                needed: model.trim_loops().len(),
+                capacity: 0,
+            });
+        }
         let bits = model.max_abs_bits();
         let mv = ModelView::new(&scene.transform, &camera.view().world_to_eye, bits)
             .map_err(|error| RenderError::Transform { instance: 0, error })?;
@@ -299,8 +308,8 @@ struct PatchRows<'a, 'm, const SUB: u32, C, A: Arithmetic, const TRIM: usize> {
     clipping: core::marker::PhantomData<C>,
 }
 
-impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
-    PatchRows<'_, '_, SUB, C, A, TRIM>
+impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
+    PatchRows<'_, 'm, SUB, C, A, TRIM>
 {
     /// Pass 1: every patch whose control hull is on screen goes into the bucket of the hull's
     /// first row, in reverse order so each bucket lists patches in ascending order.
@@ -373,6 +382,15 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         *link = self.free;
         self.free = slot;
         Some(entry)
+    }
+
+    /// The trim loops of `patch`: none without room to cut (`TRIM` = 0, whose workspace
+    /// rejects trimmed models), so the trim code is left out of such a build.
+    fn trims(&self, patch: u16) -> trim::Trims<'m> {
+        if TRIM == 0 {
+            return trim::Trims::NONE;
+        }
+        self.model.trims(patch as usize)
     }
 
     /// A model point in eye space.
@@ -539,7 +557,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         row: usize,
         f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
-        let trims = self.model.trims(patch as usize);
+        let trims = self.trims(patch);
         let cut = trim::classify(&trims, uv);
         if cut == Cut::Drop {
             return;
@@ -567,7 +585,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         self.stats.trim_cut += 1;
-        let trims = self.model.trims(patch as usize);
+        let trims = self.trims(patch);
         let overflows = trim::clip::<TRIM>(&trims, uv, |polygon| {
             let Some((&first, rest)) = polygon.split_first() else {
                 return;
@@ -646,7 +664,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                 });
             gather(vertices)
         };
-        let trims = self.model.trims(patch as usize);
+        let trims = self.trims(patch);
         let mut below = points(self, js[0]);
         for j in js[0]..js[1] {
             let above = points(self, j + 1);

@@ -189,6 +189,12 @@ pub(crate) struct Trims<'a> {
 }
 
 impl<'a> Trims<'a> {
+    /// No trims: the whole patch is kept.
+    pub(crate) const NONE: Self = Trims {
+        loops: &[],
+        points: &[],
+    };
+
     /// Whether the patch is untrimmed.
     pub(crate) fn is_empty(&self) -> bool {
         self.loops.is_empty()

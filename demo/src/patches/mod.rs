@@ -23,11 +23,14 @@ pub const TOLERANCE: Tolerance = Tolerance::lit("0.5");
 pub const SUBS: usize = 512;
 /// Triangles that may be active at once.
 pub const ACTIVE: usize = 2560;
+/// Room to cut triangles by trim loops: none, the teapot has no trims, so the firmware
+/// carries no trim code.
+pub const TRIM: usize = 0;
 
 /// The workspace the firmware uses: RGB565 rows of [`SIDE`] pixels, flat shading.
 pub type PanelPatches = PanelPatchesOf<Rgb565>;
 /// [`PanelPatches`] for another pixel type (the host renders ids through it).
-pub type PanelPatchesOf<P> = PatchWorkspace<P, Flat, SIDE, SIDE, SUBS, ACTIVE>;
+pub type PanelPatchesOf<P> = PatchWorkspace<P, Flat, SIDE, SIDE, SUBS, ACTIVE, TRIM>;
 
 /// The frames the patch firmware draws (every eighth of the turn).
 pub const FIRMWARE_FRAMES: [u32; 3] = [0, 8, 16];
