@@ -345,6 +345,7 @@ impl PlaneSolver {
 
     /// Solves the plane through values `f` at the three vertices (raw bits of any format below
     /// 2^32 in magnitude), returning it with `extra` more fractional bits.
+    #[inline]
     pub fn plane(&self, f: [i64; 3], extra: u32) -> Plane {
         let (d1, d2) = (f[1] - f[0], f[2] - f[0]);
         if let Some(p) = self.plane_i64(f[0], d1, d2, extra) {

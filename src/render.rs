@@ -67,6 +67,10 @@ impl SortKey for u32 {
 pub(crate) trait Resolve<P: RowPixel, S: Shading> {
     /// The per-triangle sort key (`()` unless the method sorts by depth).
     type Key: SortKey;
+    /// Whether rows are resolved in bands of more than one ([`Self::band_rows`]): a constant,
+    /// so row-at-a-time methods leave the band code out of the triangle activation, which a
+    /// renderer's row pieces (patches) may call from far from the row loop.
+    const BANDED: bool = false;
     /// Rows resolved together: 1 for row-at-a-time methods, `B` for a band z-buffer.
     fn band_rows(&self) -> usize {
         1
@@ -747,7 +751,7 @@ pub(crate) fn walk_rows<
                         active.retain(|t| !t.walk.is_done());
                         done = 0;
                     }
-                    let kept = if band > 1 {
+                    let kept = if R::BANDED && band > 1 {
                         // Band z-buffer: draw it into the band now; keep it only if it reaches
                         // the next band (so a full z-buffer keeps nothing).
                         let order = active.len();

@@ -837,6 +837,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
     /// Files `work` (a part of `patch` whose control net is `sub`) under the first row of
     /// `sub`'s control hull (this row if it starts here); drops it if the hull is off screen,
     /// draws it now if no entry is free.
+    #[inline(never)]
     fn file_or_draw<S: Shading>(
         &mut self,
         patch: u16,

@@ -86,6 +86,7 @@ impl<P: RowPixel, Z> Band<'_, P, Z> {
 
 impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for Band<'_, P, Z> {
     type Key = ();
+    const BANDED: bool = true;
     fn band_rows(&self) -> usize {
         self.spans.len()
     }
