@@ -450,7 +450,9 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
     }
 
     /// The colours of a surface of `patch`'s colour with normal `n` (model space), lit on
-    /// its front and, drawn two-sided, on its back (the normal reversed).
+    /// its front and, drawn two-sided, on its back (the normal reversed). Out of line: once
+    /// per cell or boundary triangle, beside many more evaluations.
+    #[inline(never)]
     fn lit(&self, patch: u16, n: Option<[i64; 3]>) -> Sides<Rgb888> {
         let base = self.model.color(patch as usize);
         let n = n.unwrap_or([0; 3]);
@@ -784,20 +786,20 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
     fn patch<S: Shading>(
         &mut self,
         patch: u16,
+        net: &Net,
         row: usize,
         f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
-        let net = Net::of(self.model, patch as usize);
-        let levels = tessellate::levels(&self.screen_net(&net), self.tolerance);
+        let levels = tessellate::levels(&self.screen_net(net), self.tolerance);
         self.stats.capped += levels.capped as u32;
         for side in 0..4 {
             let (u, v) = tessellate::strip(&levels, side);
             let work = Work::Side(levels, side as u8);
-            self.file_or_draw::<S>(patch, &net, net.piece(u, v), work, row, f);
+            self.file_or_draw::<S>(patch, net, net.piece(u, v), work, row, f);
         }
         let (is, js) = tessellate::interior(&levels);
         if is[0] < is[1] && js[0] < js[1] {
-            self.piece::<S>(patch, &net, Piece { levels, is, js }, row, f);
+            self.piece::<S>(patch, net, Piece { levels, is, js }, row, f);
         }
     }
 
@@ -870,7 +872,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         match work {
-            Work::Patch => self.patch::<S>(patch, row, f),
+            Work::Patch => self.patch::<S>(patch, net, row, f),
             Work::Side(levels, side) => self.side::<S>(patch, net, &levels, side as usize, row, f),
             // Filed halves are split further when their row comes; overflowed ones not.
             Work::Cells(piece) => self.cells::<S>(patch, net, piece, row, f),

@@ -74,12 +74,13 @@ fn point_and_tangent(q: [Hom; 4], t: u32) -> (Hom, Hom) {
 #[inline]
 pub(crate) fn edge_point(q: [Hom; 4], t: u32) -> Hom {
     let reversed = (q[3], q[2]) < (q[0], q[1]);
-    if reversed {
+    let (q, t) = if reversed {
         let [a, b, c, d] = q;
-        blossom([d, c, b, a], [PARAM_ONE - t; 3])
+        ([d, c, b, a], PARAM_ONE - t)
     } else {
-        blossom(q, [t; 3])
-    }
+        (q, t)
+    };
+    blossom(q, [t; 3])
 }
 
 /// The 16 homogeneous control points of a patch (or of a piece of one), row-major:
@@ -90,7 +91,9 @@ pub(crate) struct Net {
 }
 
 impl Net {
-    /// The control net of patch `index` of `model` (validated, so in the envelope).
+    /// The control net of patch `index` of `model` (validated, so in the envelope). Out of
+    /// line: once per patch or piece taken from a bucket.
+    #[inline(never)]
     pub(crate) fn of(model: &PatchModel<'_>, index: usize) -> Net {
         let zero = [[I16F16::ZERO; 3]; 16];
         let points = model.points().get(index).unwrap_or(&zero);
@@ -133,17 +136,19 @@ impl Net {
     /// The surface point at `(u, v)`. On the boundary it depends only on that edge's four
     /// control points, evaluated direction-independently ([`edge_point`]).
     pub(crate) fn point(&self, u: u32, v: u32) -> Hom {
-        if v == 0 {
-            edge_point(self.along_u(0), u)
+        // One edge evaluation for the four edges (the code is as long as a blossom).
+        let (edge, t) = if v == 0 {
+            (self.along_u(0), u)
         } else if v == PARAM_ONE {
-            edge_point(self.along_u(3), u)
+            (self.along_u(3), u)
         } else if u == 0 {
-            edge_point(self.along_v(0), v)
+            (self.along_v(0), v)
         } else if u == PARAM_ONE {
-            edge_point(self.along_v(3), v)
+            (self.along_v(3), v)
         } else {
-            self.column(u).point(v)
-        }
+            return self.column(u).point(v);
+        };
+        edge_point(edge, t)
     }
 
     /// The curve `u = const` through the interior, for evaluating many points on it: its

@@ -58,7 +58,9 @@ fn length(d: [i64; 2]) -> i64 {
     x.max(y).saturating_add(x.min(y) / 2 + 1)
 }
 
-/// `|a − 2b + c|` (bounded above by [`length`]); `None` if a point is not projected.
+/// `|a − 2b + c|` (bounded above by [`length`]); `None` if a point is not projected. Out of
+/// line: [`levels`] (once per patch) takes 33 of these in loops the compiler unrolls.
+#[inline(never)]
 fn second_difference(a: Option<[i64; 2]>, b: Option<[i64; 2]>, c: Option<[i64; 2]>) -> Option<i64> {
     let (a, b, c) = (a?, b?, c?);
     Some(length([0, 1].map(|k| a[k] - 2 * b[k] + c[k])))
