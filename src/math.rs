@@ -144,12 +144,10 @@ fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
     // Normalize: the divisor's top bit set (u1 < v, so v > 0 and the shift is below 32).
     let s = v.leading_zeros();
     let v = v << s;
-    let vn0 = v & 0xFFFF;
-    // Normalized, the divisor's top half is at least 2^15: a non-zero divisor the compiler
-    // can see (no division-by-zero panic on the render path).
-    let Some(vn1) = core::num::NonZeroU32::new(v >> 16) else {
-        return (0, 0);
-    };
+    // `vn1 >= 2^15` as normalised; the `max` says so to the compiler, which cannot see it
+    // through the shift and would otherwise keep a division-by-zero panic (the panic-never
+    // link check).
+    let (vn1, vn0) = ((v >> 16).max(1 << 15), v & 0xFFFF);
     let un32 = (u1 << s) | if s == 0 { 0 } else { u0 >> (32 - s) };
     let un10 = u0 << s;
     let (un1, un0) = (un10 >> 16, un10 & 0xFFFF);
@@ -157,10 +155,10 @@ fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
     // `vn1 >= 2^15` is at most two too large (Knuth, Algorithm D).
     let digit = |top: u32, next: u32| {
         let mut q = top / vn1;
-        let mut rhat = top - q * vn1.get();
+        let mut rhat = top - q * vn1;
         while q >= B || q * vn0 > (rhat << 16 | next) {
             q -= 1;
-            rhat += vn1.get();
+            rhat += vn1;
             if rhat >= B {
                 break;
             }

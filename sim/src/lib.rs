@@ -5,27 +5,27 @@
 // workspace root also builds this default member) the crate is empty.
 #![cfg_attr(target_os = "none", no_std)]
 
-#[cfg(not(target_os = "none"))]
+#[cfg(all(not(target_os = "none"), feature = "tools"))]
 pub mod analyze;
 #[cfg(not(target_os = "none"))]
 pub mod bsp;
 #[cfg(not(target_os = "none"))]
 pub mod corpus;
-#[cfg(not(target_os = "none"))]
+#[cfg(all(not(target_os = "none"), feature = "tools"))]
 pub mod export;
 #[cfg(not(target_os = "none"))]
 pub mod fuzz;
 #[cfg(not(target_os = "none"))]
 pub mod hsr;
-#[cfg(not(target_os = "none"))]
+#[cfg(all(not(target_os = "none"), feature = "tools"))]
 pub mod interpolation;
 #[cfg(not(target_os = "none"))]
 pub use scanline3d_meshgen as meshgen;
-#[cfg(not(target_os = "none"))]
+#[cfg(all(not(target_os = "none"), feature = "tools"))]
 pub mod metaball;
 #[cfg(not(target_os = "none"))]
 pub mod metrics;
-#[cfg(not(target_os = "none"))]
+#[cfg(all(not(target_os = "none"), feature = "tools"))]
 pub mod patch;
 #[cfg(all(not(target_os = "none"), feature = "peers"))]
 pub mod peers;
@@ -35,9 +35,9 @@ pub mod progress;
 pub mod reference;
 #[cfg(not(target_os = "none"))]
 pub mod scene;
-#[cfg(not(target_os = "none"))]
+#[cfg(all(not(target_os = "none"), feature = "tools"))]
 pub mod trace;
-#[cfg(not(target_os = "none"))]
+#[cfg(all(not(target_os = "none"), feature = "tools"))]
 pub mod tradeoff;
 #[cfg(not(target_os = "none"))]
 pub mod world;

@@ -39,10 +39,24 @@ pub(crate) fn summary_field(output: &str, name: &str) -> u64 {
         .unwrap_or(0)
 }
 
-/// The lean firmware on every target: frame hashes must equal the host's render of the OBJ the
-/// scene was exported from; then flash and RAM of the minimal and full builds, with the
-/// renderer's share measured against the renderer-less baseline.
+/// The lean firmware examples, as `cargo build --example` names them.
+pub(crate) const LEAN_EXAMPLES: [&str; 4] =
+    ["lean_bsp", "lean_minimal", "lean_full", "lean_baseline"];
+
+/// `cargo xtask lean`: the lean firmware built with the size-optimised `lean` profile on every
+/// target, its frame hashes checked, and its flash and RAM table.
 pub(crate) fn lean() -> Result<(), String> {
+    step("lean firmware for every target");
+    build_firmware_examples("lean", &LEAN_EXAMPLES)?;
+    lean_runs("lean", true)
+}
+
+/// The lean firmware on every target, built beforehand with `profile`: frame hashes must equal
+/// the host's render of the OBJ the scene was exported from. `with_table` also prints the flash
+/// and RAM of the minimal and full builds, with the renderer's share measured against the
+/// renderer-less baseline (meaningful for the `lean` profile only: the test command checks the
+/// hashes of a `firmware`-profile build, whose dependencies it has already built).
+pub(crate) fn lean_runs(profile: &str, with_table: bool) -> Result<(), String> {
     use scanline3d_sim::scene::{MeshData, SceneSpec};
     let mesh = MeshData::load_obj(&root().join(LEAN_OBJ))?;
     let base = SceneSpec::single(
@@ -77,21 +91,11 @@ pub(crate) fn lean() -> Result<(), String> {
             .panel_hash_with(240, 240, scanline3d_sim::scene::Algorithm::Bsp)
         })
         .collect::<Result<Vec<u32>, String>>()?;
-    step("lean firmware for every target");
-    let examples: Vec<String> = ["bsp"]
-        .into_iter()
-        .chain(LEAN_VARIANTS)
-        .map(|v| format!("lean_{v}"))
-        .collect();
-    build_firmware_examples(
-        "lean",
-        &examples.iter().map(String::as_str).collect::<Vec<_>>(),
-    )?;
     let mut table = Vec::new();
     let mut bsp_table = Vec::new();
     for (target, machine) in FIRMWARE {
         step(&format!("lean firmware (bsp) on QEMU {machine}, {target}"));
-        let out = run_example(target, "lean", "lean_bsp")?;
+        let out = run_example(target, profile, "lean_bsp")?;
         print!("{out}");
         if view_hashes(&out) != bsp_expected {
             return Err(format!(
@@ -100,7 +104,7 @@ pub(crate) fn lean() -> Result<(), String> {
             ));
         }
         println!("view hashes equal the host's BSP render of {LEAN_BSP_OBJ}");
-        let elf_path = firmware_elf(target, "lean", "lean_bsp");
+        let elf_path = firmware_elf(target, profile, "lean_bsp");
         bsp_table.push(format!(
             "| {target} | {} | {} | {} |",
             flash_bytes(&elf_path)?,
@@ -112,7 +116,7 @@ pub(crate) fn lean() -> Result<(), String> {
             step(&format!(
                 "lean firmware ({variant}) on QEMU {machine}, {target}"
             ));
-            let out = run_example(target, "lean", &format!("lean_{variant}"))?;
+            let out = run_example(target, profile, &format!("lean_{variant}"))?;
             print!("{out}");
             let hashes = view_hashes(&out);
             if variant != "baseline" {
@@ -121,7 +125,7 @@ pub(crate) fn lean() -> Result<(), String> {
                 }
                 println!("view hashes equal the host render of {LEAN_OBJ}");
             }
-            let elf_path = firmware_elf(target, "lean", &format!("lean_{variant}"));
+            let elf_path = firmware_elf(target, profile, &format!("lean_{variant}"));
             flash.insert(variant, (flash_bytes(&elf_path)?, out));
         }
         let (base_flash, base_out) = &flash["baseline"];
@@ -136,6 +140,9 @@ pub(crate) fn lean() -> Result<(), String> {
                 stack.saturating_sub(base_stack)
             ));
         }
+    }
+    if !with_table {
+        return Ok(());
     }
     println!("\nlean firmware, {LEAN_OBJ} (80 triangles), 240x240, `lean` profile (opt-level z):");
     println!("| target | build | firmware flash B | renderer flash B (minus baseline) | workspace B | render stack B (peak minus baseline) |");

@@ -104,7 +104,11 @@ pub(crate) fn test() -> Result<(), String> {
     step("library for every target: no_std, the panic-never link check, the firmware examples");
     build_firmware_examples(
         "firmware",
-        &["panic_never", "firmware", "trace", "metaball", "patch"],
+        &[
+            &["panic_never", "firmware", "trace", "metaball", "patch"][..],
+            &LEAN_EXAMPLES,
+        ]
+        .concat(),
     )?;
     package()?;
     // The example crates compile (two jobs) while the firmware runs under QEMU, one core a
@@ -117,8 +121,10 @@ pub(crate) fn test() -> Result<(), String> {
     example_builds
         .join()
         .map_err(|_| "the example build thread panicked".to_string())??;
-    // Likewise the lean firmware builds and runs beside the fuzzer, which takes one core.
-    let lean_step = std::thread::spawn(lean);
+    // Likewise the lean firmware runs beside the fuzzer, which takes one core. It was built above
+    // with the `firmware` profile, whose dependencies were built: its hashes are checked here,
+    // and `cargo xtask lean` builds it size-optimised for the flash and RAM table.
+    let lean_step = std::thread::spawn(|| lean_runs("firmware", false));
     fuzz_with(fuzz_build, FUZZ_SECONDS_IN_TEST)?;
     lean_step
         .join()
