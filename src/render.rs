@@ -21,7 +21,7 @@ use crate::math::NormalPrecision;
 use crate::options::RenderOptions;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{
-    color_channels, first_row, signed_area, xy, DepthPlane, PlaneSolver, TriangleWalk,
+    color_channels, first_row_xy, signed_area_xy, xy, DepthPlane, PlaneSolver, TriangleWalk,
 };
 use crate::scene::{Instance, MeshColors, Scene, MAX_SCENE_TRIANGLES};
 use crate::shading::{Shading, SpanDepth};
@@ -221,7 +221,60 @@ enum Fate {
     Visible { first_row: i32, clipped: bool },
 }
 
+/// Where one screen triangle stands after back-face culling and the screen test.
+enum Placement {
+    /// Zero area.
+    Degenerate,
+    /// A back face, culled.
+    Back,
+    /// No pixel centre of the screen in its bounding box.
+    Offscreen,
+    /// Drawn, starting on this row.
+    FirstRow(i32),
+}
+
+impl Placement {
+    #[inline]
+    fn of<const S: u32>(s: &[(i32, i32); 3], vp: &Viewport<S>, cull: bool) -> Self {
+        let area = signed_area_xy(s);
+        // Front faces have negative area in y-down screen coordinates.
+        if area == 0 {
+            return Placement::Degenerate;
+        }
+        if cull && area > 0 {
+            return Placement::Back;
+        }
+        match first_row_xy::<S>(s, vp.width as i32, vp.height as i32) {
+            Some(r) => Placement::FirstRow(r),
+            None => Placement::Offscreen,
+        }
+    }
+}
+
 impl<T: TransformPrecision> InstanceSetup<'_, T> {
+    /// Pass 1's short way for a triangle whose three vertices have cached screen positions
+    /// (`None` for any other: [`Self::screen_triangles`] decides): the same fate from the
+    /// cached positions alone, with no colours, clipping or pieces.
+    #[inline(always)]
+    fn cached_fate<const S: u32>(
+        &self,
+        tri: usize,
+        cache: &[CachedVertex],
+        vp: &Viewport<S>,
+        cull: bool,
+    ) -> Option<Fate> {
+        let &idx = self.instance.mesh.triangles().get(tri)?;
+        let s = CachedVertex::positions(self.cached(cache, idx)?)?;
+        Some(match Placement::of(&s, vp, cull) {
+            Placement::Degenerate | Placement::Offscreen => Fate::Rejected,
+            Placement::Back => Fate::Culled,
+            Placement::FirstRow(first_row) => Fate::Visible {
+                first_row,
+                clipped: false,
+            },
+        })
+    }
+
     fn vertex_colors(&self, tri: usize, idx: [u16; 3]) -> [Rgb888; 3] {
         let mesh = self.instance.mesh;
         let pick = |i: u16| match mesh.colors() {
@@ -343,24 +396,17 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
             return Fate::Rejected;
         };
         let colors = self.vertex_attributes::<A>(tri, idx, lit);
-        let (w, h) = (vp.width as i32, vp.height as i32);
         let mut first: Option<i32> = None;
         let mut culled = false;
-        let mut emit = |s: [ScreenVertex<S>; 3]| {
-            let area = signed_area(&s);
-            // Front faces have negative area in y-down screen coordinates.
-            if area == 0 {
-                return;
-            }
-            if cull && area > 0 {
-                culled = true;
-                return;
-            }
-            if let Some(r) = first_row(&s, w, h) {
-                first = Some(first.map_or(r, |f| f.min(r)));
-                f(s);
-            }
-        };
+        let mut emit =
+            |s: [ScreenVertex<S>; 3]| match Placement::of(&s.each_ref().map(xy), vp, cull) {
+                Placement::Degenerate | Placement::Offscreen => {}
+                Placement::Back => culled = true,
+                Placement::FirstRow(r) => {
+                    first = Some(first.map_or(r, |f| f.min(r)));
+                    f(s);
+                }
+            };
         let project = |c: &ClipVertex| vp.project_as::<A::Projection>(&c.p, c.color, depth);
         let mut polygon = ClipPolygon::new();
         let clipped = 'pieces: {
@@ -369,9 +415,8 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                     if CachedVertex::all_outside_one_plane(c) {
                         return Fate::Rejected;
                     }
-                    let screen = [0, 1, 2].map(|k| c[k].screen::<S>(colors[k]));
-                    if let [Some(a), Some(b), Some(d)] = screen {
-                        emit([a, b, d]);
+                    if let Some(s) = CachedVertex::triangle::<S>(c, colors) {
+                        emit(s);
                         break 'pieces false;
                     }
                     // The cache keeps no eye-space points: transform again (same result).
@@ -506,20 +551,19 @@ pub(crate) fn drive<
         let (mut q_sum, mut q_count) = (0u64, 0u64);
         // Only a depth sort needs depths in pass 1; the others skip their division.
         let depth = sorted && rank.is_none();
-        let fate = setup.screen_triangles::<SUB, C, A>(
-            tri,
-            cache,
-            vp,
-            options.cull_back_faces,
-            false,
-            depth,
-            |s| {
+        let cull = options.cull_back_faces;
+        let quick = match depth {
+            false => setup.cached_fate::<SUB>(tri, cache, vp, cull),
+            true => None,
+        };
+        let fate = quick.unwrap_or_else(|| {
+            setup.screen_triangles::<SUB, C, A>(tri, cache, vp, cull, false, depth, |s| {
                 if depth {
                     q_sum += s.iter().map(|v| v.q.to_bits().max(0) as u64).sum::<u64>();
                     q_count += 3;
                 }
-            },
-        );
+            })
+        });
         match fate {
             Fate::Culled => stats.culled += 1,
             Fate::Rejected => stats.rejected += 1,
