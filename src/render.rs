@@ -378,7 +378,10 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
     }
 
     /// Clips and projects triangle `tri`, calling `f` with each visible screen triangle (whose
-    /// depths are 0 unless `depth` or the vertex `cache`, when not empty, has them).
+    /// depths are 0 unless `depth` or the vertex `cache`, when not empty, has them). `filed`:
+    /// pass 1 filed this triangle (pass 2 asks), so if its vertices all have cached positions
+    /// it is drawn whole without culling and the screen test again (the fate's first row is
+    /// then not computed: 0).
     #[allow(clippy::too_many_arguments)]
     fn screen_triangles<const S: u32, C: Clipping, A: Arithmetic<Transform = T>>(
         &self,
@@ -388,6 +391,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         cull: bool,
         lit: bool,
         depth: bool,
+        filed: bool,
         mut f: impl FnMut([ScreenVertex<S>; 3]),
     ) -> Fate {
         let Some(&idx) = self.instance.mesh.triangles().get(tri) else {
@@ -398,15 +402,21 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         let colors = self.vertex_attributes::<A>(tri, idx, lit);
         let mut first: Option<i32> = None;
         let mut culled = false;
-        let mut emit =
-            |s: [ScreenVertex<S>; 3]| match Placement::of(&s.each_ref().map(xy), vp, cull) {
+        // `placed`: pass 1 placed `s` from these same cached positions and filed it.
+        let mut emit = |s: [ScreenVertex<S>; 3], placed: bool| {
+            let placement = match placed {
+                true => Placement::FirstRow(0),
+                false => Placement::of(&s.each_ref().map(xy), vp, cull),
+            };
+            match placement {
                 Placement::Degenerate | Placement::Offscreen => {}
                 Placement::Back => culled = true,
                 Placement::FirstRow(r) => {
                     first = Some(first.map_or(r, |f| f.min(r)));
                     f(s);
                 }
-            };
+            }
+        };
         let project = |c: &ClipVertex| vp.project_as::<A::Projection>(&c.p, c.color, depth);
         let mut polygon = ClipPolygon::new();
         let clipped = 'pieces: {
@@ -416,7 +426,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                         return Fate::Rejected;
                     }
                     if let Some(s) = CachedVertex::triangle::<S>(c, colors) {
-                        emit(s);
+                        emit(s, filed);
                         break 'pieces false;
                     }
                     // The cache keeps no eye-space points: transform again (same result).
@@ -429,7 +439,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                 Clipped::Skipped => return Fate::Unclipped,
                 Clipped::Inside => {
                     if let [Some(a), Some(b), Some(c)] = cv.each_ref().map(project) {
-                        emit([a, b, c]);
+                        emit([a, b, c], false);
                     }
                     false
                 }
@@ -438,7 +448,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                     let mut fan = polygon.iter().filter_map(project);
                     if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
                         for c in fan {
-                            emit([a, b, c]);
+                            emit([a, b, c], false);
                             b = c;
                         }
                     }
@@ -557,7 +567,7 @@ pub(crate) fn drive<
             true => None,
         };
         let fate = quick.unwrap_or_else(|| {
-            setup.screen_triangles::<SUB, C, A>(tri, cache, vp, cull, false, depth, |s| {
+            setup.screen_triangles::<SUB, C, A>(tri, cache, vp, cull, false, depth, false, |s| {
                 if depth {
                     q_sum += s.iter().map(|v| v.q.to_bits().max(0) as u64).sum::<u64>();
                     q_count += 3;
@@ -720,9 +730,16 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> ActivePieces<SUB>
             setup.face_color::<A::Normals>(tri, idx)
         };
         let (vp, cache) = (self.vp, self.cache);
-        setup.screen_triangles::<SUB, C, A>(tri, cache, vp, self.cull, S::PER_VERTEX, true, |s| {
-            f(s, face, id as u32, key)
-        });
+        setup.screen_triangles::<SUB, C, A>(
+            tri,
+            cache,
+            vp,
+            self.cull,
+            S::PER_VERTEX,
+            true,
+            true,
+            |s| f(s, face, id as u32, key),
+        );
     }
 }
 
@@ -944,6 +961,7 @@ pub(crate) fn for_each_screen_piece<
                 options.cull_back_faces,
                 S::PER_VERTEX,
                 true,
+                false,
                 |s| f(s, face, id),
             );
             match fate {
