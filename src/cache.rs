@@ -116,6 +116,26 @@ impl CachedVertex {
         })
     }
 
+    /// The screen triangle of `v` with vertex colours `colors`, if all three have a cached
+    /// position.
+    #[inline]
+    pub(crate) fn triangle<const S: u32>(
+        v: [&Self; 3],
+        colors: [[I16F16; 3]; 3],
+    ) -> Option<[ScreenVertex<S>; 3]> {
+        let [Some(a), Some(b), Some(c)] = [0, 1, 2].map(|k| v[k].screen::<S>(colors[k])) else {
+            return None;
+        };
+        Some([a, b, c])
+    }
+
+    /// The sub-pixel screen positions `(x, y)` of `v`, if all three have one cached.
+    #[inline]
+    pub(crate) fn positions(v: [&Self; 3]) -> Option<[(i32, i32); 3]> {
+        let projected = (v[0].q[0] | v[1].q[0] | v[2].q[0]) & NOT_PROJECTED == 0;
+        projected.then(|| v.map(|c| (c.x as i32, c.y as i32)))
+    }
+
     /// Whether all of `v` lie outside one clip plane (the triangle is invisible).
     #[inline]
     pub(crate) fn all_outside_one_plane(v: [&Self; 3]) -> bool {

@@ -144,10 +144,10 @@ fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
     // Normalize: the divisor's top bit set (u1 < v, so v > 0 and the shift is below 32).
     let s = v.leading_zeros();
     let v = v << s;
-    // `vn1 >= 2^15` as normalised; the `max` says so to the compiler, which cannot see it
-    // through the shift and would otherwise keep a division-by-zero panic (the panic-never
+    // `v`'s top bit is set, so `vn1 >= 2^15` already: or-ing that bit in changes nothing but
+    // lets the compiler see it is not zero (no division-by-zero panic path: the panic-never
     // link check).
-    let (vn1, vn0) = ((v >> 16).max(1 << 15), v & 0xFFFF);
+    let (vn1, vn0) = ((v >> 16) | 0x8000, v & 0xFFFF);
     let un32 = (u1 << s) | if s == 0 { 0 } else { u0 >> (32 - s) };
     let un10 = u0 << s;
     let (un1, un0) = (un10 >> 16, un10 & 0xFFFF);

@@ -627,7 +627,13 @@ pub fn xy<const S: u32>(v: &ScreenVertex<S>) -> (i32, i32) {
 /// in the world as seen by the camera).
 #[inline]
 pub fn signed_area<const S: u32>(v: &[ScreenVertex<S>; 3]) -> i64 {
-    let (a, b, c) = (xy(&v[0]), xy(&v[1]), xy(&v[2]));
+    signed_area_xy(&v.each_ref().map(xy))
+}
+
+/// [`signed_area`] of the sub-pixel positions `(x, y)` of a triangle's vertices.
+#[inline]
+pub fn signed_area_xy(v: &[(i32, i32); 3]) -> i64 {
+    let [a, b, c] = *v;
     (b.0 as i64 - a.0 as i64) * (c.1 as i64 - a.1 as i64)
         - (c.0 as i64 - a.0 as i64) * (b.1 as i64 - a.1 as i64)
 }
@@ -636,7 +642,13 @@ pub fn signed_area<const S: u32>(v: &[ScreenVertex<S>; 3]) -> i64 {
 /// its bounding box holds no pixel centre of the screen (by the same half-open rules as the
 /// walk, so nothing the walk would draw is rejected). Used by bucketing.
 pub fn first_row<const S: u32>(v: &[ScreenVertex<S>; 3], width: i32, height: i32) -> Option<i32> {
-    let range = |k: fn(&ScreenVertex<S>) -> i32, limit: i32| {
+    first_row_xy::<S>(&v.each_ref().map(xy), width, height)
+}
+
+/// [`first_row`] of the sub-pixel positions `(x, y)` of a triangle's vertices.
+#[inline]
+pub fn first_row_xy<const S: u32>(v: &[(i32, i32); 3], width: i32, height: i32) -> Option<i32> {
+    let range = |k: fn(&(i32, i32)) -> i32, limit: i32| {
         let (lo, hi) = v
             .iter()
             .map(k)
@@ -645,8 +657,8 @@ pub fn first_row<const S: u32>(v: &[ScreenVertex<S>; 3], width: i32, height: i32
         let end = first_centre_at_or_after::<S>(2 * hi as i64).min(limit as i64);
         (first < end).then_some(first as i32)
     };
-    range(|s| s.x.0, width)?;
-    range(|s| s.y.0, height)
+    range(|p| p.0, width)?;
+    range(|p| p.1, height)
 }
 
 #[cfg(test)]

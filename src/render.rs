@@ -21,7 +21,7 @@ use crate::math::NormalPrecision;
 use crate::options::RenderOptions;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{
-    color_channels, first_row, signed_area, xy, DepthPlane, PlaneSolver, TriangleWalk,
+    color_channels, first_row_xy, signed_area_xy, xy, DepthPlane, PlaneSolver, TriangleWalk,
 };
 use crate::scene::{Instance, MeshColors, Scene, MAX_SCENE_TRIANGLES};
 use crate::shading::{Shading, SpanDepth};
@@ -225,7 +225,60 @@ enum Fate {
     Visible { first_row: i32, clipped: bool },
 }
 
+/// Where one screen triangle stands after back-face culling and the screen test.
+enum Placement {
+    /// Zero area.
+    Degenerate,
+    /// A back face, culled.
+    Back,
+    /// No pixel centre of the screen in its bounding box.
+    Offscreen,
+    /// Drawn, starting on this row.
+    FirstRow(i32),
+}
+
+impl Placement {
+    #[inline]
+    fn of<const S: u32>(s: &[(i32, i32); 3], vp: &Viewport<S>, cull: bool) -> Self {
+        let area = signed_area_xy(s);
+        // Front faces have negative area in y-down screen coordinates.
+        if area == 0 {
+            return Placement::Degenerate;
+        }
+        if cull && area > 0 {
+            return Placement::Back;
+        }
+        match first_row_xy::<S>(s, vp.width as i32, vp.height as i32) {
+            Some(r) => Placement::FirstRow(r),
+            None => Placement::Offscreen,
+        }
+    }
+}
+
 impl<T: TransformPrecision> InstanceSetup<'_, T> {
+    /// Pass 1's short way for a triangle whose three vertices have cached screen positions
+    /// (`None` for any other: [`Self::screen_triangles`] decides): the same fate from the
+    /// cached positions alone, with no colours, clipping or pieces.
+    #[inline(always)]
+    fn cached_fate<const S: u32>(
+        &self,
+        tri: usize,
+        cache: &[CachedVertex],
+        vp: &Viewport<S>,
+        cull: bool,
+    ) -> Option<Fate> {
+        let &idx = self.instance.mesh.triangles().get(tri)?;
+        let s = CachedVertex::positions(self.cached(cache, idx)?)?;
+        Some(match Placement::of(&s, vp, cull) {
+            Placement::Degenerate | Placement::Offscreen => Fate::Rejected,
+            Placement::Back => Fate::Culled,
+            Placement::FirstRow(first_row) => Fate::Visible {
+                first_row,
+                clipped: false,
+            },
+        })
+    }
+
     fn vertex_colors(&self, tri: usize, idx: [u16; 3]) -> [Rgb888; 3] {
         let mesh = self.instance.mesh;
         let pick = |i: u16| match mesh.colors() {
@@ -329,7 +382,10 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
     }
 
     /// Clips and projects triangle `tri`, calling `f` with each visible screen triangle (whose
-    /// depths are 0 unless `depth` or the vertex `cache`, when not empty, has them).
+    /// depths are 0 unless `depth` or the vertex `cache`, when not empty, has them). `filed`:
+    /// pass 1 filed this triangle (pass 2 asks), so if its vertices all have cached positions
+    /// it is drawn whole without culling and the screen test again (the fate's first row is
+    /// then not computed: 0).
     #[allow(clippy::too_many_arguments)]
     fn screen_triangles<const S: u32, C: Clipping, A: Arithmetic<Transform = T>>(
         &self,
@@ -339,6 +395,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         cull: bool,
         lit: bool,
         depth: bool,
+        filed: bool,
         mut f: impl FnMut([ScreenVertex<S>; 3]),
     ) -> Fate {
         let Some(&idx) = self.instance.mesh.triangles().get(tri) else {
@@ -347,22 +404,21 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
             return Fate::Rejected;
         };
         let colors = self.vertex_attributes::<A>(tri, idx, lit);
-        let (w, h) = (vp.width as i32, vp.height as i32);
         let mut first: Option<i32> = None;
         let mut culled = false;
-        let mut emit = |s: [ScreenVertex<S>; 3]| {
-            let area = signed_area(&s);
-            // Front faces have negative area in y-down screen coordinates.
-            if area == 0 {
-                return;
-            }
-            if cull && area > 0 {
-                culled = true;
-                return;
-            }
-            if let Some(r) = first_row(&s, w, h) {
-                first = Some(first.map_or(r, |f| f.min(r)));
-                f(s);
+        // `placed`: pass 1 placed `s` from these same cached positions and filed it.
+        let mut emit = |s: [ScreenVertex<S>; 3], placed: bool| {
+            let placement = match placed {
+                true => Placement::FirstRow(0),
+                false => Placement::of(&s.each_ref().map(xy), vp, cull),
+            };
+            match placement {
+                Placement::Degenerate | Placement::Offscreen => {}
+                Placement::Back => culled = true,
+                Placement::FirstRow(r) => {
+                    first = Some(first.map_or(r, |f| f.min(r)));
+                    f(s);
+                }
             }
         };
         let project = |c: &ClipVertex| vp.project_as::<A::Projection>(&c.p, c.color, depth);
@@ -373,9 +429,8 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                     if CachedVertex::all_outside_one_plane(c) {
                         return Fate::Rejected;
                     }
-                    let screen = [0, 1, 2].map(|k| c[k].screen::<S>(colors[k]));
-                    if let [Some(a), Some(b), Some(d)] = screen {
-                        emit([a, b, d]);
+                    if let Some(s) = CachedVertex::triangle::<S>(c, colors) {
+                        emit(s, filed);
                         break 'pieces false;
                     }
                     // The cache keeps no eye-space points: transform again (same result).
@@ -388,7 +443,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                 Clipped::Skipped => return Fate::Unclipped,
                 Clipped::Inside => {
                     if let [Some(a), Some(b), Some(c)] = cv.each_ref().map(project) {
-                        emit([a, b, c]);
+                        emit([a, b, c], false);
                     }
                     false
                 }
@@ -397,7 +452,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                     let mut fan = polygon.iter().filter_map(project);
                     if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
                         for c in fan {
-                            emit([a, b, c]);
+                            emit([a, b, c], false);
                             b = c;
                         }
                     }
@@ -510,20 +565,19 @@ pub(crate) fn drive<
         let (mut q_sum, mut q_count) = (0u64, 0u64);
         // Only a depth sort needs depths in pass 1; the others skip their division.
         let depth = sorted && rank.is_none();
-        let fate = setup.screen_triangles::<SUB, C, A>(
-            tri,
-            cache,
-            vp,
-            options.cull_back_faces,
-            false,
-            depth,
-            |s| {
+        let cull = options.cull_back_faces;
+        let quick = match depth {
+            false => setup.cached_fate::<SUB>(tri, cache, vp, cull),
+            true => None,
+        };
+        let fate = quick.unwrap_or_else(|| {
+            setup.screen_triangles::<SUB, C, A>(tri, cache, vp, cull, false, depth, false, |s| {
                 if depth {
                     q_sum += s.iter().map(|v| v.q.to_bits().max(0) as u64).sum::<u64>();
                     q_count += 3;
                 }
-            },
-        );
+            })
+        });
         match fate {
             Fate::Culled => stats.culled += 1,
             Fate::Rejected => stats.rejected += 1,
@@ -680,9 +734,16 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> ActivePieces<SUB>
             setup.face_color::<A::Normals>(tri, idx)
         };
         let (vp, cache) = (self.vp, self.cache);
-        setup.screen_triangles::<SUB, C, A>(tri, cache, vp, self.cull, S::PER_VERTEX, true, |s| {
-            f(s, face, id as u32, key)
-        });
+        setup.screen_triangles::<SUB, C, A>(
+            tri,
+            cache,
+            vp,
+            self.cull,
+            S::PER_VERTEX,
+            true,
+            true,
+            |s| f(s, face, id as u32, key),
+        );
     }
 }
 
@@ -904,6 +965,7 @@ pub(crate) fn for_each_screen_piece<
                 options.cull_back_faces,
                 S::PER_VERTEX,
                 true,
+                false,
                 |s| f(s, face, id),
             );
             match fate {

@@ -205,12 +205,15 @@ fn millions(n: f64) -> String {
 }
 
 /// The saved labels, in table order, with their column titles.
-const LABELS: [(&str, &str); 5] = [
+const LABELS: [(&str, &str); 6] = [
     ("before", "before"),
     ("before-cache", "before, cache"),
     // The first set-up rework with the 8-byte vertex cache (main at 717759d), kept to show
     // what each later step gained.
     ("rework1-cache", "first rework, cache"),
+    // The second rework (32-bit divisions, main at 924d071), before pass 1's and pass 2's
+    // short ways for triangles with cached screen positions.
+    ("rework2-cache", "second rework, cache"),
     ("after", "after"),
     ("after-cache", "after, cache"),
 ];
