@@ -46,6 +46,15 @@
 //! depths of its vertices on the other side of the plane than its centroid moved onto the
 //! plane, and ordered as if it lay on its centroid's side ([`SortStats::pressed`]).
 //!
+//! Likewise a cut whose two cut points round onto one line can leave one side of the plane
+//! without a part of any area while that side's exact region holds pixel centres (a sliver one
+//! sub-pixel wide, cut across). Its pixels would go to a part on the other side, ordered
+//! there. Then the cut points are rounded apart instead, each to a corner of its sub-pixel
+//! cell: the nearest pair that keeps them on the plane within the tolerance (their depths are
+//! the piece's plane there), keeps every part's orientation and puts those centres in the
+//! side's part ([`SortStats::rounded_apart`]). A side whose region holds no centre is still
+//! left out ([`SortStats::dropped_slivers`]): a part there would only cost splits.
+//!
 //! The rounded parts are only used to find the order. What is painted is the original
 //! piece, cut by a *split tree*: each split records the screen lines between its parts (the
 //! line through the two rounded cut points, and the diagonal of a four-sided part), and every
@@ -1514,6 +1523,49 @@ mod tests {
         for p in parts.iter().flatten() {
             assert!(!plane.straddled_by(p), "{p:?}");
         }
+    }
+
+    #[test]
+    fn a_side_whose_cut_points_round_together_keeps_its_pixel_centres() {
+        // The sliver of the soup seen from outside (docs/realworld.md): one sub-pixel wide,
+        // cut about 55 % along by a steep plane, both cut points round to (2272, 1603), so the
+        // apex's side has no area once rounded, yet its exact region holds the centre of
+        // pixel (141, 99) at 4 sub-pixel bits.
+        let t = tri(
+            [2110, 2404, 2404],
+            [1384, 1782, 1781],
+            [32920895, 34271487, 34263591],
+        );
+        let cutter = tri([1772, 2772, 2272], [1403, 1803, 1604], [0, 0, 1 << 29]);
+        let plane = PlaneEq::of(&cutter).unwrap();
+        assert!(plane.straddled_by(&t));
+        let nearest = cut(&t, &plane);
+        assert!(nearest.parts[0].is_none() && nearest.parts[1].is_some());
+        let grid = Grid {
+            sub: 4,
+            width: 240,
+            height: 240,
+        };
+        let apart = round_apart(&t, &plane, &nearest, grid).expect("rounded apart");
+        assert!(apart.parts[0].is_some(), "the apex's side keeps a part");
+        let line = apart.lines[0];
+        let centre: FineXy = [2264 << FINE, 1592 << FINE];
+        let inside = line.side(line.inside) >= 0;
+        assert_eq!(
+            line.side_fine(centre) >= 0,
+            inside,
+            "and the centre goes to it"
+        );
+        for p in apart.parts.iter().flatten() {
+            assert!(!plane.straddled_by(p), "{p:?}");
+        }
+        // Off the screen there is no centre to keep.
+        let small = Grid { width: 100, ..grid };
+        assert!(round_apart(&t, &plane, &nearest, small).is_none());
+        // A cut that leaves both sides a part is kept as it is.
+        let wide = tri([0, 100, 0], [0, 50, 100], [1000; 3]);
+        let steep = PlaneEq::of(&tri([50, 51, 50], [0, 50, 100], [0, 5000, 10])).unwrap();
+        assert!(round_apart(&wide, &steep, &cut(&wide, &steep), grid).is_none());
     }
 
     #[test]
