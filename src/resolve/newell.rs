@@ -1401,6 +1401,9 @@ fn for_each_centre(region: &[FineXy], grid: Grid, mut f: impl FnMut(FineXy) -> b
             x0 = x0.min(lo);
             x1 = x1.max(hi);
         }
+        if x0 > x1 {
+            continue; // (no edge reaches the row: not for a row within the region's extent)
+        }
         for col in first(x0).max(0)..=last(x1).min(grid.width - 1) {
             let p = [centre(col), y];
             if inside(p) && !f(p) {
