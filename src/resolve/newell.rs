@@ -46,6 +46,15 @@
 //! depths of its vertices on the other side of the plane than its centroid moved onto the
 //! plane, and ordered as if it lay on its centroid's side ([`SortStats::pressed`]).
 //!
+//! Likewise a cut whose two cut points round onto one line can leave one side of the plane
+//! without a part of any area while that side's exact region holds pixel centres (a sliver one
+//! sub-pixel wide, cut across). Its pixels would go to a part on the other side, ordered
+//! there. Then the cut points are rounded apart instead, each to a corner of its sub-pixel
+//! cell: the nearest pair that keeps them on the plane within the tolerance (their depths are
+//! the piece's plane there), keeps every part's orientation and puts those centres in the
+//! side's part ([`SortStats::rounded_apart`]). A side whose region holds no centre is still
+//! left out ([`SortStats::dropped_slivers`]): a part there would only cost splits.
+//!
 //! The rounded parts are only used to find the order. What is painted is the original
 //! piece, cut by a *split tree*: each split records the screen lines between its parts (the
 //! line through the two rounded cut points, and the diagonal of a four-sided part), and every
@@ -160,6 +169,10 @@ pub struct SortStats {
     /// Cycles that no plane of their pieces cuts beyond the rounding cell (pieces of
     /// interpenetrating triangles meeting within it), broken by drawing the head first.
     pub cycles_within_rounding: u32,
+    /// Cuts whose cut points were rounded apart (to other corners of their sub-pixel cells)
+    /// because, rounded to the nearest, they left one side of the plane without a part of any
+    /// area while its region of the piece holds pixel centres.
+    pub rounded_apart: u32,
 }
 
 /// Depth sort after Newell, Newell and Sancha: pieces are ordered far to near, overlapping
@@ -264,6 +277,7 @@ impl<
                 steps: 0,
                 pressed: 0,
                 cycles_within_rounding: 0,
+                rounded_apart: 0,
             },
         }
     }
@@ -315,6 +329,11 @@ impl<
             nodes: &mut self.nodes,
             originals: n,
             n,
+            grid: Grid {
+                sub: SUB_BITS,
+                width: vp.width as i64,
+                height: vp.height as i64,
+            },
             len: 0,
             cuts: 0,
             stats: SortStats::default(),
@@ -415,7 +434,18 @@ impl PlaneEq {
             debug_assert!(false, "internal error: no vertex {k}");
             return 0;
         };
+        self.at_point(x, y, q)
+    }
+
+    /// `s` at the point `(x, y, q)`.
+    fn at_point(&self, x: i32, y: i32, q: i32) -> i128 {
         self.n[0] * x as i128 + self.n[1] * y as i128 + self.n[2] * q as i128 - self.d
+    }
+
+    /// The `q` of the plane at `(x, y)`, to the nearest I2F30 step.
+    fn q_at(&self, x: i32, y: i32) -> i32 {
+        let num = self.d - self.n[0] * x as i128 - self.n[1] * y as i128;
+        div_round(num, self.n[2]).clamp(i32::MIN as i128, i32::MAX as i128) as i32
     }
 
     /// Whether all of `t` is behind this plane or on it.
@@ -510,6 +540,8 @@ struct Sort<'a> {
     originals: usize,
     /// Pieces in the store.
     n: usize,
+    /// The screen, for the pixel centres of cut regions.
+    grid: Grid,
     /// Pieces in the list.
     len: usize,
     stats: SortStats,
@@ -747,6 +779,10 @@ impl Sort<'_> {
         };
         let t = *self.piece(x);
         let mut parts = cut(&t, &plane);
+        if let Some(apart) = round_apart(&t, &plane, &parts, self.grid) {
+            self.stats.rounded_apart += 1;
+            parts = apart;
+        }
         if parts.parts.iter().all(Option::is_none) {
             // No part keeps any area on the grid, but the piece's region of the original may
             // still hold pixel centres (a sliver along a column of them): dropping it would
@@ -924,6 +960,13 @@ impl Line {
         let d = |k: usize| self.b[k] as i64 - self.a[k] as i64;
         d(0) * (p[1] as i64 - self.a[1] as i64) - d(1) * (p[0] as i64 - self.a[0] as i64)
     }
+
+    /// [`Line::side`] of a point in fine units ([`FineXy`]), with the same sign.
+    fn side_fine(&self, p: FineXy) -> i128 {
+        let d = |k: usize| self.b[k] as i128 - self.a[k] as i128;
+        let from = |k: usize| p[k] as i128 - ((self.a[k] as i128) << FINE);
+        d(0) * from(1) - d(1) * from(0)
+    }
 }
 
 /// A node of a split tree: the original piece's region is cut by the line through `a` and `b`
@@ -1088,47 +1131,287 @@ struct Parts {
     lines: [Line; 2],
 }
 
-/// Cuts `t` by `plane` (see [`Parts`]).
+/// Cuts `t` by `plane` (see [`Parts`]), the cut points rounded to the nearest grid point.
 fn cut(t: &StoredTriangle, plane: &PlaneEq) -> Parts {
+    let (v, on_plane) = rotated(t, plane);
+    assemble(t, &v, on_plane, nearest_points(t, plane, &v, on_plane))
+}
+
+/// Where `plane` crosses the edges of `t` (vertices `[a, b, c]` [`rotated`]), rounded to the
+/// nearest grid point: on `bc` (twice) when `a` is on the plane, else on `ab` and `ac`.
+fn nearest_points(
+    t: &StoredTriangle,
+    plane: &PlaneEq,
+    [a, b, c]: &[Vertex; 3],
+    on_plane: bool,
+) -> [Vertex; 2] {
+    let at = |u: &Vertex, w: &Vertex| {
+        let (su, sw) = (plane.at(t, u.k), plane.at(t, w.k));
+        u.toward(w, su, su - sw)
+    };
+    if on_plane {
+        let i = at(b, c);
+        [i, i]
+    } else {
+        [at(a, b), at(a, c)]
+    }
+}
+
+/// `t`'s vertices rotated so that the first is the odd one out: the vertex on `plane` when
+/// one is (then `true`), else the one alone on its side.
+fn rotated(t: &StoredTriangle, plane: &PlaneEq) -> ([Vertex; 3], bool) {
     let s = [0, 1, 2].map(|k| plane.at(t, k).signum());
-    // Rotate so that vertex 0 is the odd one out: the vertex on the plane when one is, else
-    // the one alone on its side.
     let lead = if let Some(z) = (0..3).find(|&k| s[k] == 0) {
         z
     } else {
         // The plane straddles `t`: its signs are +1 and −1, and two of the three agree.
         internal((0..3).find(|&k| s[(k + 1) % 3] == s[(k + 2) % 3]), 0)
     };
-    let v = |k: usize| (lead + k) % 3;
-    let vertex = |k: usize| Vertex::of(t, v(k));
-    let (a, b, c) = (vertex(0), vertex(1), vertex(2));
-    let at = |u: &Vertex, w: &Vertex| {
-        let (su, sw) = (plane.at(t, u.k), plane.at(t, w.k));
-        u.toward(w, su, su - sw)
-    };
+    let on_plane = s.get(lead).is_some_and(|&s| s == 0);
+    ([0, 1, 2].map(|k| Vertex::of(t, (lead + k) % 3)), on_plane)
+}
+
+/// The parts of `t`, whose vertices `[a, b, c]` are [`rotated`], for the cut points `points`:
+/// one point on `bc` (given twice) when `a` is on the plane, else points on `ab` and `ac`.
+fn assemble(
+    t: &StoredTriangle,
+    [a, b, c]: &[Vertex; 3],
+    on_plane: bool,
+    points: [Vertex; 2],
+) -> Parts {
     let tri = |p: [Vertex; 3]| make(t, p);
     let line = |a: &Vertex, b: &Vertex, inside: &Vertex| Line {
         a: [a.x, a.y],
         b: [b.x, b.y],
         inside: [inside.x, inside.y],
     };
-    if s[v(0)] == 0 {
+    let [i1, i2] = points;
+    if on_plane {
         // b and c lie on opposite sides.
-        let i = at(&b, &c);
-        let l = line(&a, &i, &b);
+        let l = line(a, &i1, b);
         Parts {
-            parts: [tri([a, b, i]), tri([a, i, c]), None],
+            parts: [tri([*a, *b, i1]), tri([*a, i1, *c]), None],
             made: 2,
             lines: [l, l],
         }
     } else {
-        let (i1, i2) = (at(&a, &b), at(&a, &c));
         Parts {
-            parts: [tri([a, i1, i2]), tri([i1, b, c]), tri([i1, c, i2])],
+            parts: [tri([*a, i1, i2]), tri([i1, *b, *c]), tri([i1, *c, i2])],
             made: 3,
-            lines: [line(&i1, &i2, &a), line(&i1, &c, &b)],
+            lines: [line(&i1, &i2, a), line(&i1, c, b)],
         }
     }
+}
+
+/// Bits below the sub-pixel grid at which [`round_apart`] places the exact cut points: a
+/// [`FineXy`] is sub-pixels · 2^8. Coordinates below 2^22 sub-pixels stay below 2^30 (their
+/// cross products below 2^63, taken in `i128`), and the interpolation's products below 2^121.
+const FINE: u32 = 8;
+
+/// A screen point in sub-pixels · 2^[`FINE`].
+type FineXy = [i64; 2];
+
+/// The screen a frame is sorted for: its sub-pixel bits and size in pixels.
+#[derive(Clone, Copy, Debug)]
+struct Grid {
+    sub: u32,
+    width: i64,
+    height: i64,
+}
+
+/// When `parts` (the nearest rounding of a cut of `t` by `plane`) leaves one side of the plane
+/// without a part of any area while that side's exact region of `t` holds pixel centres, the
+/// same cut with its cut points rounded apart, each to a corner of the sub-pixel cell that
+/// holds it, so that the side keeps a part whose region in the split tree holds those centres.
+/// Of the corners, the nearest pair (summed squared distance) that keeps every cut point on
+/// the plane within its tolerance (its depth taken from `t`'s plane), every part's
+/// orientation and the dividing line between `t`'s vertices on the two sides, and that puts
+/// every such centre on the lost side's part. `None` if no side is lost, its region holds
+/// no centre, or no pair of corners does all that.
+fn round_apart(t: &StoredTriangle, plane: &PlaneEq, parts: &Parts, grid: Grid) -> Option<Parts> {
+    let (v, on_plane) = rotated(t, plane);
+    let [a, b, c] = &v;
+    let none = parts.parts.each_ref().map(Option::is_none);
+    let fine = |u: &Vertex| [(u.x as i64) << FINE, (u.y as i64) << FINE];
+    let exact = |u: &Vertex, w: &Vertex| {
+        let (su, sw) = (plane.at(t, u.k), plane.at(t, w.k));
+        u.toward_fine(w, su, su - sw)
+    };
+    let (e1, e2) = if on_plane {
+        let e = exact(b, c);
+        (e, e)
+    } else {
+        (exact(a, b), exact(a, c))
+    };
+    // The lost side: its exact region, whether its part lies on the `inside` of the first
+    // dividing line, and which parts may stand for it.
+    let (tri, quad);
+    let (region, inside, lost): (&[FineXy], bool, [bool; 3]) = match (on_plane, none) {
+        (true, [true, false, _]) => {
+            tri = [fine(a), fine(b), e1];
+            (&tri, true, [true, false, false])
+        }
+        (true, [false, true, _]) => {
+            tri = [fine(a), e1, fine(c)];
+            (&tri, false, [false, true, false])
+        }
+        (false, [true, p1, p2]) if !(p1 && p2) => {
+            tri = [fine(a), e1, e2];
+            (&tri, true, [true, false, false])
+        }
+        (false, [false, true, true]) => {
+            quad = [e1, fine(b), fine(c), e2];
+            (&quad, false, [false, true, true])
+        }
+        _ => return None,
+    };
+    if for_each_centre(region, grid, |_| false) {
+        return None; // no pixel centre to keep
+    }
+    let own = PlaneEq::of(t)?;
+    let orientation = signed_area(t).signum();
+    let nearest = nearest_points(t, plane, &v, on_plane);
+    // Only positions change (colours stay the nearest rounding's); depths are `t`'s there.
+    let moved = |p: &[i32; 2], like: &Vertex| Vertex {
+        x: p[0],
+        y: p[1],
+        q: own.q_at(p[0], p[1]),
+        ..*like
+    };
+    let (cells1, cells2) = (corners(e1), corners(e2));
+    let mut best: Option<(i128, Parts)> = None;
+    for (k1, p1) in cells1.iter().enumerate() {
+        // With one cut point (`a` on the plane) both stand for it.
+        let (skip, take) = if on_plane { (k1, 1) } else { (0, 4) };
+        for p2 in cells2.iter().skip(skip).take(take) {
+            let [n1, n2] = &nearest;
+            let points = [moved(p1, n1), moved(p2, n2)];
+            if points
+                .iter()
+                .any(|m| 2 * plane.at_point(m.x, m.y, m.q).abs() > plane.tol)
+            {
+                continue;
+            }
+            let candidate = assemble(t, &v, on_plane, points);
+            let kept = candidate
+                .parts
+                .iter()
+                .zip(lost)
+                .any(|(p, l)| l && p.is_some());
+            let oriented = candidate
+                .parts
+                .iter()
+                .flatten()
+                .all(|p| signed_area(p).signum() == orientation);
+            let [l0, _] = candidate.lines;
+            let side = |u: &Vertex| l0.side([u.x, u.y]).signum();
+            let separates = if on_plane {
+                side(b) * side(c) < 0
+            } else {
+                side(a) != 0 && side(b) == -side(a) && side(c) == -side(a)
+            };
+            if !(kept && oriented && separates) {
+                continue;
+            }
+            let on_inside = |p: FineXy| (l0.side_fine(p) >= 0) == (l0.side(l0.inside) >= 0);
+            if !for_each_centre(region, grid, |p| on_inside(p) == inside) {
+                continue;
+            }
+            let d = |p: &[i32; 2], e: FineXy| {
+                let [dx, dy] = [0, 1].map(|k| (((p[k] as i64) << FINE) - e[k]) as i128);
+                dx * dx + dy * dy
+            };
+            let distance = d(p1, e1) + d(p2, e2);
+            if best.as_ref().is_none_or(|(bd, _)| distance < *bd) {
+                best = Some((distance, candidate));
+            }
+        }
+    }
+    best.map(|(_, p)| p)
+}
+
+/// The four grid points around `e` (corners of its sub-pixel cell; repeated when `e` is on
+/// a grid line).
+fn corners(e: FineXy) -> [[i32; 2]; 4] {
+    let down = |v: i64| (v >> FINE).clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+    let up = |v: i64| (-((-v) >> FINE)).clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+    let [x, y] = e;
+    [
+        [down(x), down(y)],
+        [up(x), down(y)],
+        [down(x), up(y)],
+        [up(x), up(y)],
+    ]
+}
+
+/// Twice the signed screen area of `t` (positive counter-clockwise in `x`, `y`).
+fn signed_area(t: &StoredTriangle) -> i64 {
+    let d = |v: &[i32; 3], k: usize| v[k] as i64 - v[0] as i64;
+    d(&t.x, 1) * d(&t.y, 2) - d(&t.y, 1) * d(&t.x, 2)
+}
+
+/// Calls `f` with each pixel centre (on the screen of `grid`) strictly inside the convex
+/// polygon `region`, row by row, until `f` returns `false`; `true` if it never did. The work
+/// is the rows the region spans plus, per row, the columns between its edges there.
+fn for_each_centre(region: &[FineXy], grid: Grid, mut f: impl FnMut(FineXy) -> bool) -> bool {
+    let shift = grid.sub + FINE;
+    let half = 1i64 << (shift - 1);
+    // First pixel whose centre is at or after `v` / last whose centre is at or before `v`.
+    let first = |v: i64| -((half - v).wrapping_shr(shift));
+    let last = |v: i64| (v - half).wrapping_shr(shift);
+    let centre = |i: i64| (i << shift) + half;
+    let edges = || {
+        region
+            .iter()
+            .zip(region.iter().cycle().skip(1))
+            .map(|(p, q)| (*p, *q))
+    };
+    let cross = |p: FineXy, q: FineXy, r: FineXy| {
+        (q[0] - p[0]) as i128 * (r[1] - p[1]) as i128
+            - (q[1] - p[1]) as i128 * (r[0] - p[0]) as i128
+    };
+    let orientation: i128 = edges()
+        .map(|(p, q)| cross([0, 0], p, q))
+        .sum::<i128>()
+        .signum();
+    let inside =
+        |r: FineXy| orientation != 0 && edges().all(|(p, q)| cross(p, q, r) * orientation > 0);
+    let (y0, y1) = region
+        .iter()
+        .fold((i64::MAX, i64::MIN), |(l, h), p| (l.min(p[1]), h.max(p[1])));
+    for row in first(y0).max(0)..=last(y1).min(grid.height - 1) {
+        let y = centre(row);
+        // The region's extent on this row, rounded outwards.
+        let (mut x0, mut x1) = (i64::MAX, i64::MIN);
+        for (p, q) in edges() {
+            if (p[1] - y) * (q[1] - y) > 0 {
+                continue;
+            }
+            let (lo, hi) = if p[1] == q[1] {
+                (p[0].min(q[0]), p[0].max(q[0]))
+            } else {
+                let (num, den) = (
+                    (y - p[1]) as i128 * (q[0] - p[0]) as i128,
+                    (q[1] - p[1]) as i128,
+                );
+                let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
+                let floor = num.checked_div_euclid(den).unwrap_or(0) as i64;
+                (p[0] + floor, p[0] + floor + 1)
+            };
+            x0 = x0.min(lo);
+            x1 = x1.max(hi);
+        }
+        if x0 > x1 {
+            continue; // (no edge reaches the row: not for a row within the region's extent)
+        }
+        for col in first(x0).max(0)..=last(x1).min(grid.width - 1) {
+            let p = [centre(col), y];
+            if inside(p) && !f(p) {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// `t` with the depths of its vertices on the other side of `plane` than its centroid moved
@@ -1167,6 +1450,18 @@ impl Vertex {
             q: t.q[k],
             color: t.colors[k],
         }
+    }
+
+    /// The screen position `num/den` of the way from `self` to `w`, in fine units
+    /// ([`FineXy`], rounded to the nearest).
+    fn toward_fine(&self, w: &Vertex, num: i128, den: i128) -> FineXy {
+        let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
+        let lerp = |a: i32, b: i32| {
+            let along = div_round(((b as i128 - a as i128) << FINE) * num, den);
+            ((a as i128) << FINE) + along
+        };
+        let clamp = |v: i128| v.clamp(i64::MIN as i128, i64::MAX as i128) as i64;
+        [clamp(lerp(self.x, w.x)), clamp(lerp(self.y, w.y))]
     }
 
     /// The point `num/den` of the way from `self` to `w` (`0 < num/den < 1`), rounded to the
@@ -1231,6 +1526,49 @@ mod tests {
         for p in parts.iter().flatten() {
             assert!(!plane.straddled_by(p), "{p:?}");
         }
+    }
+
+    #[test]
+    fn a_side_whose_cut_points_round_together_keeps_its_pixel_centres() {
+        // The sliver of the soup seen from outside (docs/realworld.md): one sub-pixel wide,
+        // cut about 55 % along by a steep plane, both cut points round to (2272, 1603), so the
+        // apex's side has no area once rounded, yet its exact region holds the centre of
+        // pixel (141, 99) at 4 sub-pixel bits.
+        let t = tri(
+            [2110, 2404, 2404],
+            [1384, 1782, 1781],
+            [32920895, 34271487, 34263591],
+        );
+        let cutter = tri([1772, 2772, 2272], [1403, 1803, 1604], [0, 0, 1 << 29]);
+        let plane = PlaneEq::of(&cutter).unwrap();
+        assert!(plane.straddled_by(&t));
+        let nearest = cut(&t, &plane);
+        assert!(nearest.parts[0].is_none() && nearest.parts[1].is_some());
+        let grid = Grid {
+            sub: 4,
+            width: 240,
+            height: 240,
+        };
+        let apart = round_apart(&t, &plane, &nearest, grid).expect("rounded apart");
+        assert!(apart.parts[0].is_some(), "the apex's side keeps a part");
+        let line = apart.lines[0];
+        let centre: FineXy = [2264 << FINE, 1592 << FINE];
+        let inside = line.side(line.inside) >= 0;
+        assert_eq!(
+            line.side_fine(centre) >= 0,
+            inside,
+            "and the centre goes to it"
+        );
+        for p in apart.parts.iter().flatten() {
+            assert!(!plane.straddled_by(p), "{p:?}");
+        }
+        // Off the screen there is no centre to keep.
+        let small = Grid { width: 100, ..grid };
+        assert!(round_apart(&t, &plane, &nearest, small).is_none());
+        // A cut that leaves both sides a part is kept as it is.
+        let wide = tri([0, 100, 0], [0, 50, 100], [1000; 3]);
+        let steep = PlaneEq::of(&tri([50, 51, 50], [0, 50, 100], [0, 5000, 10])).unwrap();
+        assert!(round_apart(&wide, &steep, &cut(&wide, &steep), grid).is_none());
     }
 
     #[test]

@@ -73,10 +73,8 @@ fn table(name: &str, spec: &SceneSpec) -> Vec<(String, Metrics)> {
 /// The numbers: on the soup from outside and inside and on the scanned-style mesh,
 /// with the default command line (culling decided, here two-sided for the soup), every correct
 /// method has no real mismatches and at most 2 % id mismatches, and the exact preset at most
-/// 0.1 %. Newell–Newell–Sancha reaches that on the soup from inside and on the scanned mesh;
-/// from outside it leaves one real mismatch (a sliver part left out of a split gives its
-/// pixel to the part on the other side of the plane: docs/realworld.md), so there it must
-/// finish the frame within its capacities, which it used not to, with at most that one.
+/// 0.1 %. Newell–Newell–Sancha included: it must also finish the soup within its capacities,
+/// which it used not to (docs/realworld.md).
 #[test]
 fn hard_scenes_every_method() {
     let soup = real_world::soup();
@@ -96,16 +94,9 @@ fn hard_scenes_every_method() {
     ] {
         for (method, m) in table(name, &spec) {
             let limit = if method == "exact" { 0.1 } else { 2.0 };
-            let correct = method != Algorithm::DepthSort.to_string()
-                && (method != Algorithm::Newell.to_string() || name != "soup outside");
+            let correct = method != Algorithm::DepthSort.to_string();
             if correct && (m.real > 0 || m.id_mismatch_percent() > limit) {
                 failures.push(format!("{name} {method}: {m}"));
-            }
-            if !correct
-                && method == Algorithm::Newell.to_string()
-                && (m.real > 1 || m.id_mismatch_percent() > limit)
-            {
-                failures.push(format!("{name} {method}, traced to 1 real: {m}"));
             }
         }
     }
