@@ -260,7 +260,10 @@ fn widest_axis(lo: Vec3, hi: Vec3) -> u8 {
 /// Half the surface area of the box `lo..hi` in raw units (2^-32 square world units): below
 /// 3 · 2^60 for boxes within the envelope, so it and its products with counts fit a `u128`.
 fn half_area(lo: Vec3, hi: Vec3) -> u128 {
-    let [x, y, z] = hi.sub(lo).bits().map(|e| u128::from(e.max(0).unsigned_abs()));
+    let [x, y, z] = hi
+        .sub(lo)
+        .bits()
+        .map(|e| u128::from(e.max(0).unsigned_abs()));
     x * y + y * z + z * x
 }
 
@@ -316,8 +319,11 @@ fn best_split(
         for id in range {
             let (a, b) = object_box(*id);
             // (c − c0) · BINS / (c1 − c0 + 1) lies in 0..BINS: below 2^31 · 2^4, no overflow.
-            let k = (i64::from(centre(a, b, axis)) - c0) * BINS as i64 / (c1 - c0 + 1);
-            if let Some(bin) = usize::try_from(k).ok().and_then(|k| bins.get_mut(k)) {
+            let k = ((i64::from(centre(a, b, axis)) - c0) * BINS as i64).checked_div(c1 - c0 + 1);
+            if let Some(bin) = k
+                .and_then(|k| usize::try_from(k).ok())
+                .and_then(|k| bins.get_mut(k))
+            {
                 *bin = merge(*bin, (a, b, 1));
             }
         }
