@@ -83,14 +83,15 @@ impl MathBackend for Micromath {
 /// truncation (of `v`, of the root, of the quotient) within a few 2^-30. Integer only (exact `isqrt`), so lighting is identical on
 /// every target.
 pub(crate) fn cosine_i64(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
-    let s = fit_bits(v, 30)?;
-    let len = isqrt_u64(s.iter().map(|&c| (c * c) as u64).sum());
+    // |s_i| <= 2^30: each fits `i32`, so the products below are 32 × 32 → 64 bits.
+    let s = fit_bits(v, 30)?.map(|c| c as i32);
+    let len = isqrt_u64(s.iter().map(|&c| (c as i64 * c as i64) as u64).sum());
     if len == 0 {
         return None;
     }
     // |s_i · unit_i| < 2^60 and, by Cauchy–Schwarz, every partial sum is at most
     // |s| · |unit| < 2^61: no overflow, and the quotient is within about ±2^30.
-    let dot: i64 = (0..3).map(|k| s[k] * unit[k] as i64).sum();
+    let dot: i64 = (0..3).map(|k| s[k] as i64 * unit[k] as i64).sum();
     // `len <= sqrt(3) · 2^30` fits 32 bits and is non-zero here.
     let q = div_rem_u64_u32(dot.unsigned_abs(), len as u32).0 as i32;
     Some(if dot < 0 { -q } else { q })
@@ -172,9 +173,74 @@ fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
     (q1 << 16 | q0, r)
 }
 
-/// `floor(sqrt(n))`, exactly `n.isqrt()`. Where the core has a double-precision square root
-/// (x86-64, AArch64) its correctly rounded estimate is within one of the answer and one
-/// integer step on each side makes it exact; elsewhere the integer algorithm of `core`.
+/// ⌊√v⌋ for a 32-bit integer: [`isqrt32_newton`] where the target divides 32-bit integers in
+/// hardware (Cortex-M3/M4 `udiv`, RV32 `M`, the host), [`isqrt32_bitwise`] on ARMv6-M, whose
+/// division is a library call. Both are exact, so every target gets the same bits.
+#[inline]
+pub const fn isqrt32(v: u32) -> u32 {
+    // ARMv6-M is the Arm profile without 32-bit atomics (and without a divider).
+    if cfg!(all(target_arch = "arm", not(target_has_atomic = "32"))) {
+        isqrt32_bitwise(v)
+    } else {
+        isqrt32_newton(v)
+    }
+}
+
+/// ⌊√v⌋ bit by bit (one step per result bit, no division), starting at `v`'s highest bit.
+#[inline]
+pub const fn isqrt32_bitwise(v: u32) -> u32 {
+    if v == 0 {
+        return 0;
+    }
+    let mut rem = v;
+    let mut root = 0u32;
+    // The highest power of 4 not above v.
+    let mut bit = 1u32 << ((31 - v.leading_zeros()) & !1);
+    while bit != 0 {
+        if rem >= root + bit {
+            rem -= root + bit;
+            root = (root >> 1) + bit;
+        } else {
+            root >>= 1;
+        }
+        bit >>= 2;
+    }
+    root
+}
+
+/// ⌊√v⌋ by Newton's iteration `x ← (x + v/x) / 2` from above: seeded with the tangent to √m
+/// at m = 2, on `v`'s leading bits, at most 6.7 % above the root, so three steps reach ⌊√v⌋
+/// and a fourth confirms it (from any start at or above ⌊√v⌋ the iterates decrease until
+/// the floor).
+#[inline]
+pub const fn isqrt32_newton(v: u32) -> u32 {
+    if v < 2 {
+        return v;
+    }
+    // v = m · 4^e with m in [1, 4): √v ≈ (m + 2) / (2√2) · 2^e, the tangent at m = 2, which
+    // lies above √m. 182/512 is 1/(2√2) rounded up; (v >> e) + 2^(e+1) < 2^18, so the
+    // product fits; the + 1 covers the truncations.
+    let e = (31 - v.leading_zeros()) / 2;
+    let mut x = ((((v >> e) + (2u32 << e)) * 182) >> 9) + 1;
+    loop {
+        // x ≥ ⌊√v⌋ ≥ 1, so the division never meets 0 (said to the compiler, for the
+        // panic-never link check).
+        let Some(q) = v.checked_div(x) else {
+            return 0;
+        };
+        let y = (x + q) >> 1;
+        if y >= x {
+            return x;
+        }
+        x = y;
+    }
+}
+
+/// `floor(sqrt(n))` for `n < 2^62`, exactly `n.isqrt()`. Where the core has a
+/// double-precision square root (x86-64, AArch64) its correctly rounded estimate is within one
+/// of the answer and one integer step on each side makes it exact; on ARMv6-M (no divider: a
+/// 32-bit division is a call) the integer algorithm of `core`, which measured cheaper there;
+/// elsewhere [`isqrt_u62`] in 32-bit operations.
 #[inline]
 fn isqrt_u64(n: u64) -> u64 {
     #[cfg(any(target_feature = "sse2", target_arch = "aarch64"))]
@@ -191,8 +257,46 @@ fn isqrt_u64(n: u64) -> u64 {
     }
     #[cfg(not(any(target_feature = "sse2", target_arch = "aarch64")))]
     {
-        n.isqrt()
+        // ARMv6-M is the Arm profile without 32-bit atomics (and without a divider).
+        if cfg!(all(target_arch = "arm", not(target_has_atomic = "32"))) {
+            n.isqrt()
+        } else {
+            isqrt_u62(n)
+        }
     }
+}
+
+/// `floor(sqrt(n))` for `n < 2^62` in 32-bit operations (a larger `n` is taken as
+/// `2^62 - 1`): the 32-bit root of `n`'s top bits, then one Newton step and one
+/// correction. `core`'s `u64::isqrt` works in 64-bit integers throughout, several times the
+/// cost on a 32-bit core.
+///
+/// Why it is exact: with `n >> 2k` below 2^32 and at least 2^30 (`k` chosen so), the root
+/// `r0 = isqrt32(n >> 2k) · 2^k` is at most `√n` and at least `2^(15+k)`, and
+/// `√n − r0 < 2^k · (√(t+1) − √t + 1) <= 2^k · (1 + 2^-16)` for `t = n >> 2k`. A Newton step
+/// `r1 = ⌊(r0 + ⌊n / r0⌋) / 2⌋` from any positive `r0` is at least `⌊√n⌋` (the arithmetic and
+/// geometric means), and it exceeds `√n` by at most `(√n − r0)² / (2 · r0)`, below
+/// `2^(k−16) · 1.0001 < 1` for `k <= 15` (`n < 2^62`): so `r1` is `⌊√n⌋` or one more, and
+/// one comparison of its square settles it. Test `square_root_is_exact`.
+#[inline]
+#[cfg_attr(
+    any(target_feature = "sse2", target_arch = "aarch64"),
+    allow(dead_code) // (tested on the host against `u64::isqrt`)
+)]
+fn isqrt_u62(n: u64) -> u64 {
+    let n = n.min((1 << 62) - 1);
+    if n >> 32 == 0 {
+        return isqrt32(n as u32) as u64;
+    }
+    // n >= 2^32: `2k` makes `n >> 2k` 31 or 32 bits long (k in 1..=15).
+    let bits = 64 - n.leading_zeros();
+    let k = (bits - 31) / 2;
+    let r0 = isqrt32((n >> (2 * k)) as u32) << k;
+    // r0 >= 2^15 (the top bits are at least 2^30), and below 2^31.
+    let (q, _) = div_rem_u64_u32(n, r0);
+    let r1 = (r0 as u64 + q) >> 1;
+    // r1 <= ⌊√n⌋ + 1 < 2^31 + 1: its square cannot overflow.
+    r1 - (r1 * r1 > n) as u64
 }
 
 /// `v` shifted (left or right, the same for every component) so that its largest component
@@ -200,7 +304,8 @@ fn isqrt_u64(n: u64) -> u64 {
 /// vector. Scaling small vectors up keeps the integer square root of `|v|²`, which truncates,
 /// within a relative 2^(1-bits) of the true length.
 pub(crate) fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i64; 3]> {
-    let max = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
+    // The or of the magnitudes has the largest one's length, for less than their maximum.
+    let max = v.iter().fold(0, |m, c| m | c.unsigned_abs());
     if max == 0 {
         return None;
     }
@@ -345,8 +450,22 @@ mod tests {
                 x >> 2,
             ] {
                 assert_eq!(isqrt_u64(n), n.isqrt(), "sqrt {n}");
+                // (root < 2^31, so every n here but `x >> 2` is below 2^62.)
+                let m = n.min((1 << 62) - 1);
+                assert_eq!(isqrt_u62(m), m.isqrt(), "32-bit sqrt {m}");
+            }
+            // The lighting's range, [2^58, 3 · 2^60) (`cosine_i64`).
+            let n = (1 << 58) + (x >> 2) % (11 << 58);
+            assert_eq!(isqrt_u62(n), n.isqrt(), "32-bit sqrt {n}");
+        }
+        // Every shift `k` and the ends of each: powers of two and their neighbours.
+        for j in 0..62 {
+            let p = 1u64 << j;
+            for n in [p - 1, p, p + 1, (p - 1) | p, ((1 << 62) - 1) >> (j & !1)] {
+                assert_eq!(isqrt_u62(n), n.isqrt(), "32-bit sqrt {n}");
             }
         }
+        assert_eq!(isqrt_u62(u64::MAX), ((1u64 << 62) - 1).isqrt());
     }
 
     /// Pseudo-random integer vectors at every scale from a few units to 2^62.
@@ -369,6 +488,36 @@ mod tests {
         let vf = v.map(|c| c as f64);
         let vlen = vf.iter().map(|c| c * c).sum::<f64>().sqrt();
         (unit, (0..3).map(|k| vf[k] * u[k]).sum::<f64>() / vlen)
+    }
+
+    /// The lighting's shades do not depend on how the root and the scaling are computed:
+    /// `cosine_i64` equals the formula in plain 64-bit operations (`u64::isqrt`, `/`).
+    #[test]
+    fn cosine_equals_the_64_bit_formula() {
+        let dirs = [[0.3, -0.5, 0.8], [1.0, 0.0, 0.0], [-0.2, -0.9, -0.1]];
+        for (i, v) in vectors(200_000).enumerate() {
+            let (unit, _) = exact(v, dirs[i % 3]);
+            let max = v.iter().map(|c| c.unsigned_abs()).max().unwrap();
+            let want = (max != 0).then(|| {
+                let len = 64 - max.leading_zeros();
+                let s = v.map(|c| {
+                    if len > 30 {
+                        c >> (len - 30)
+                    } else {
+                        c << (30 - len)
+                    }
+                });
+                let root = s.iter().map(|&c| (c * c) as u64).sum::<u64>().isqrt();
+                let dot: i64 = (0..3).map(|k| s[k] * unit[k] as i64).sum();
+                let q = (dot.unsigned_abs() / root) as i32;
+                if dot < 0 {
+                    -q
+                } else {
+                    q
+                }
+            });
+            assert_eq!(cosine_i64(v, unit), want, "{v:?}");
+        }
     }
 
     #[test]

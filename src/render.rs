@@ -112,15 +112,17 @@ pub(crate) fn fill_span<P: RowPixel, S: Shading, Z: DepthFormat, K>(
 ) -> u32 {
     let (q, dq) = t.depth.span_start(l, y);
     let span = SpanDepth { x0: l, y, q, dq };
-    let cols = l as usize..r as usize;
-    match (depth.get_mut(cols.clone()), pixels.get_mut(cols)) {
-        (Some(d), Some(p)) => S::fill(&t.payload, t.depth.origin(), span, d, p),
-        _ => {
-            // walk_band clamps spans to the row.
-            debug_assert!(false, "internal error: span {l}..{r} out of the row");
-            0
+    let (l, r) = (l as usize, r as usize);
+    // One test for both rows (which then need none of their own), and slices of one length,
+    // so the fill's loop counts one of them.
+    if l < r && r <= depth.len() && r <= pixels.len() {
+        if let (Some(d), Some(p)) = (depth.get_mut(l..r), pixels.get_mut(l..r)) {
+            return S::fill(&t.payload, t.depth.origin(), span, d, p);
         }
     }
+    // walk_band clamps spans to the row and passes only non-empty ones.
+    debug_assert!(false, "internal error: span {l}..{r} out of the row");
+    0
 }
 
 pub(crate) const NO_ENTRY: u16 = u16::MAX;

@@ -304,10 +304,11 @@ impl Lighting {
     /// 30 bits, so with the matrix's entries within ±2^30 each product is below 2^60 and each
     /// sum below 3 · 2^60. No normalization here: the cosine divides by the length once.
     fn normal_to_world(&self, n: [i64; 3]) -> Option<[i64; 3]> {
-        let n = fit_bits(n, 30)?;
+        // |n_k| <= 2^30 fits `i32`: 32 × 32 → 64-bit products.
+        let n = fit_bits(n, 30)?.map(|c| c as i32);
         Some(
             self.normal_matrix
-                .map(|row| (0..3).map(|k| row[k] as i64 * n[k]).sum()),
+                .map(|row| (0..3).map(|k| row[k] as i64 * n[k] as i64).sum()),
         )
     }
 

@@ -12,6 +12,7 @@
 //! below one I16F16 step) and is checked: a value outside the I16F16 range is an error, never a
 //! wrapped number.
 
+pub use crate::math::{isqrt32, isqrt32_bitwise, isqrt32_newton};
 use fixed::types::{I16F16, I32F32};
 
 /// The largest scene coordinate magnitude (any axis), in world units: 2^12.
@@ -163,69 +164,6 @@ pub fn mul(a: I16F16, b: I16F16) -> I16F16 {
 #[inline]
 pub fn narrow(v: I32F32) -> Option<I16F16> {
     i32::try_from(v.to_bits() >> 16).ok().map(I16F16::from_bits)
-}
-
-/// ⌊√v⌋ for a 32-bit integer: [`isqrt32_newton`] where the target divides 32-bit integers in
-/// hardware (Cortex-M3/M4 `udiv`, RV32 `M`, the host), [`isqrt32_bitwise`] on ARMv6-M, whose
-/// division is a library call. Both are exact, so every target gets the same bits.
-#[inline]
-pub const fn isqrt32(v: u32) -> u32 {
-    // ARMv6-M is the Arm profile without 32-bit atomics (and without a divider).
-    if cfg!(all(target_arch = "arm", not(target_has_atomic = "32"))) {
-        isqrt32_bitwise(v)
-    } else {
-        isqrt32_newton(v)
-    }
-}
-
-/// ⌊√v⌋ bit by bit (one step per result bit, no division), starting at `v`'s highest bit.
-#[inline]
-pub const fn isqrt32_bitwise(v: u32) -> u32 {
-    if v == 0 {
-        return 0;
-    }
-    let mut rem = v;
-    let mut root = 0u32;
-    // The highest power of 4 not above v.
-    let mut bit = 1u32 << ((31 - v.leading_zeros()) & !1);
-    while bit != 0 {
-        if rem >= root + bit {
-            rem -= root + bit;
-            root = (root >> 1) + bit;
-        } else {
-            root >>= 1;
-        }
-        bit >>= 2;
-    }
-    root
-}
-
-/// ⌊√v⌋ by Newton's iteration `x ← (x + v/x) / 2` from above: seeded with the tangent to √m
-/// at m = 2, on `v`'s leading bits, at most 6.7 % above the root, so three steps reach ⌊√v⌋
-/// and a fourth confirms it (from any start at or above ⌊√v⌋ the iterates decrease until
-/// the floor).
-#[inline]
-pub const fn isqrt32_newton(v: u32) -> u32 {
-    if v < 2 {
-        return v;
-    }
-    // v = m · 4^e with m in [1, 4): √v ≈ (m + 2) / (2√2) · 2^e, the tangent at m = 2, which
-    // lies above √m. 182/512 is 1/(2√2) rounded up; (v >> e) + 2^(e+1) < 2^18, so the
-    // product fits; the + 1 covers the truncations.
-    let e = (31 - v.leading_zeros()) / 2;
-    let mut x = ((((v >> e) + (2u32 << e)) * 182) >> 9) + 1;
-    loop {
-        // x ≥ ⌊√v⌋ ≥ 1, so the division never meets 0 (said to the compiler, for the
-        // panic-never link check).
-        let Some(q) = v.checked_div(x) else {
-            return 0;
-        };
-        let y = (x + q) >> 1;
-        if y >= x {
-            return x;
-        }
-        x = y;
-    }
 }
 
 /// √v for a non-negative I32F32, as an I16F16 (negative input gives 0).

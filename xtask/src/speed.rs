@@ -205,7 +205,7 @@ fn millions(n: f64) -> String {
 }
 
 /// The saved labels, in table order, with their column titles.
-const LABELS: [(&str, &str); 6] = [
+const LABELS: [(&str, &str); 7] = [
     ("before", "before"),
     ("before-cache", "before, cache"),
     // The first set-up rework with the 8-byte vertex cache (main at 717759d), kept to show
@@ -214,6 +214,9 @@ const LABELS: [(&str, &str); 6] = [
     // The second rework (32-bit divisions, main at 924d071), before pass 1's and pass 2's
     // short ways for triangles with cached screen positions.
     ("rework2-cache", "second rework, cache"),
+    // The third rework (pass 1's and pass 2's short ways, main at cfdca08), before the
+    // exact 32-bit square root in lighting and one bounds test per span.
+    ("rework3-cache", "third rework, cache"),
     ("after", "after"),
     ("after-cache", "after, cache"),
 ];
