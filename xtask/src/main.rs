@@ -12,45 +12,22 @@ mod install;
 mod package;
 mod test;
 
-// The commands that render on the host (the `host` feature; see Cargo.toml).
-#[cfg(feature = "host")]
-mod firmware;
-#[cfg(feature = "host")]
-mod hsr_table;
-#[cfg(feature = "host")]
-mod lean;
-#[cfg(feature = "host")]
-mod metaball;
-#[cfg(feature = "host")]
-mod patch;
-#[cfg(feature = "host")]
-mod peers;
-#[cfg(feature = "host")]
-mod profile;
-#[cfg(feature = "host")]
-mod report;
-#[cfg(feature = "host")]
-mod speed;
-#[cfg(feature = "host")]
-mod trace;
-#[cfg(feature = "host")]
-mod tradeoff;
+/// Declares modules compiled only with the `host` feature: the commands that render on the host
+/// (see Cargo.toml).
+macro_rules! host_modules {
+    ($($module:ident),*) => { $( #[cfg(feature = "host")] mod $module; )* };
+}
+host_modules!(
+    firmware, hsr_table, lean, metaball, patch, peers, profile, report, speed, trace, tradeoff
+);
 
-#[cfg(feature = "host")]
-use firmware::*;
 use firmware_build::*;
 use fuzz::*;
-#[cfg(feature = "host")]
-use hsr_table::*;
 use install::*;
-#[cfg(feature = "host")]
-use lean::*;
 use package::*;
-#[cfg(feature = "host")]
-use peers::*;
-#[cfg(feature = "host")]
-use report::*;
 use test::*;
+#[cfg(feature = "host")]
+use {firmware::*, hsr_table::*, lean::*, peers::*, report::*};
 
 pub(crate) const TARGETS: [&str; 3] = [
     "thumbv6m-none-eabi",
