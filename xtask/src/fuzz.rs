@@ -3,12 +3,15 @@
 use crate::*;
 
 /// Length of the bounded fuzzing session inside `cargo xtask test`.
+#[cfg(feature = "host")]
 pub(crate) const FUZZ_SECONDS_IN_TEST: u32 = 60;
 
 /// Coverage-guided fuzzing of scene/OBJ input with AFL++ (`cargo afl`, stable Rust) for
 /// `seconds`, seeded with the corpus. Fails on any crash or hang.
+#[cfg(feature = "host")]
 pub(crate) fn fuzz(seconds: u32) -> Result<(), String> {
-    fuzz_with(start_fuzz_build()?, seconds)
+    finish_fuzz_build(start_fuzz_build()?)?;
+    fuzz_built(seconds)
 }
 
 /// Starts building the AFL-instrumented fuzz target in the background (its own workspace and
@@ -44,16 +47,23 @@ pub(crate) fn start_fuzz_build() -> Result<std::process::Child, String> {
         .map_err(|e| format!("cargo afl build: {e}"))
 }
 
-/// Waits for the fuzz target `build` started, then fuzzes for `seconds`.
-pub(crate) fn fuzz_with(mut build: std::process::Child, seconds: u32) -> Result<(), String> {
+/// Waits for the fuzz target `build` started, and shows its log if it failed.
+pub(crate) fn finish_fuzz_build(mut build: std::process::Child) -> Result<(), String> {
+    let status = build.wait().map_err(|e| format!("cargo afl build: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        let log = std::fs::read_to_string(root().join("target/fuzz-build.log")).unwrap_or_default();
+        Err(format!("cargo afl build failed ({status}):\n{log}"))
+    }
+}
+
+/// Fuzzes the built fuzz target for `seconds`, seeded with the corpus.
+#[cfg(feature = "host")]
+pub(crate) fn fuzz_built(seconds: u32) -> Result<(), String> {
     step(&format!(
         "fuzz scene input for {seconds} s (AFL++ via cargo afl)"
     ));
-    let status = build.wait().map_err(|e| format!("cargo afl build: {e}"))?;
-    if !status.success() {
-        let log = std::fs::read_to_string(root().join("target/fuzz-build.log")).unwrap_or_default();
-        return Err(format!("cargo afl build failed ({status}):\n{log}"));
-    }
     let dir = root().join("target/fuzz");
     let _ = std::fs::remove_dir_all(&dir);
     let seeds = dir.join("seeds");

@@ -39,10 +39,6 @@ pub(crate) fn summary_field(output: &str, name: &str) -> u64 {
         .unwrap_or(0)
 }
 
-/// The lean firmware examples, as `cargo build --example` names them.
-pub(crate) const LEAN_EXAMPLES: [&str; 4] =
-    ["lean_bsp", "lean_minimal", "lean_full", "lean_baseline"];
-
 /// `cargo xtask lean`: the lean firmware built with the size-optimised `lean` profile on every
 /// target, its frame hashes checked, and its flash and RAM table.
 pub(crate) fn lean() -> Result<(), String> {

@@ -62,6 +62,17 @@ fn cargo_test_with(
     }
 }
 
+/// The xtask built (with `host`) by the debug test run: the test command's second stage.
+fn host_xtask() -> std::path::PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| root().join("target"))
+        .join("debug/xtask")
+}
+
+/// The test command's first stage, which needs no host renderer: format, lints, tests, the
+/// package and every build. Its debug test run also builds the xtask with `host`, which then
+/// runs the second stage ([`test_targets`]) on what was built.
 pub(crate) fn test() -> Result<(), String> {
     install()?;
     // The instrumented fuzz build (its own workspace and target directory) runs in the
@@ -78,12 +89,21 @@ pub(crate) fn test() -> Result<(), String> {
     // Clippy lints the workspace while the debug tests compile: clippy-driver is the compiler
     // of the workspace's crates there (as `cargo clippy` sets it), so the crate graph is not
     // checked once and built again. The benchmarks, which the tests do not build, are then
-    // compiled the same way (their dependencies are the tests' dev-dependencies, built).
+    // compiled the same way (their dependencies are the tests' dev-dependencies, built). The
+    // xtask is built with `host` here (for its `dispatch` test), and linted with it.
     let mut totals = (0, 0);
     step("tests, debug (overflow checks on), compiled through clippy (warnings denied)");
-    cargo_test_with(&[], CLIPPY_WRAPPER, &mut totals)?;
+    cargo_test_with(&["--features", "xtask/host"], CLIPPY_WRAPPER, &mut totals)?;
     step("benchmarks compiled through clippy (warnings denied), not run");
-    cargo_test_with(&["--benches", "--no-run"], CLIPPY_WRAPPER, &mut totals)?;
+    cargo_test_with(
+        &["--benches", "--no-run", "--features", "xtask/host"],
+        CLIPPY_WRAPPER,
+        &mut totals,
+    )?;
+    step("the xtask without the host renderers, through clippy (warnings denied)");
+    run(cargo()
+        .args(["clippy", "--package", "xtask", "--", "-D", "warnings"])
+        .env("CARGO_TARGET_DIR", root().join("target/xtask-lint")))?;
     // Doctests ran above; in release they would only be compiled again, one binary each.
     step("tests, release, without doctests (with the peer renderers: sim/tests/peers.rs)");
     cargo_test(
@@ -111,6 +131,21 @@ pub(crate) fn test() -> Result<(), String> {
         .concat(),
     )?;
     package()?;
+    finish_fuzz_build(fuzz_build)?;
+    step("second stage: the firmware on QEMU against the host's renders, the examples, fuzzing");
+    let elapsed = START.get().map_or(0, |s| s.elapsed().as_secs());
+    run(Command::new(host_xtask())
+        .arg("test-targets")
+        .env(CLOCK_OFFSET, elapsed.to_string()))?;
+    println!("\nxtask: {} passed, {} failed", totals.0, totals.1);
+    Ok(())
+}
+
+/// The test command's second stage (`xtask test-targets`, with `host`): the firmware under
+/// QEMU with its frame hashes checked against the host's renders, the example crates, and the
+/// fuzzer.
+#[cfg(feature = "host")]
+pub(crate) fn test_targets() -> Result<(), String> {
     // The example crates compile (two jobs) while the firmware runs under QEMU, one core a
     // run; their output interleaves.
     let example_builds = std::thread::spawn(examples);
@@ -121,14 +156,13 @@ pub(crate) fn test() -> Result<(), String> {
     example_builds
         .join()
         .map_err(|_| "the example build thread panicked".to_string())??;
-    // Likewise the lean firmware runs beside the fuzzer, which takes one core. It was built above
+    // Likewise the lean firmware runs beside the fuzzer, which takes one core. It was built
     // with the `firmware` profile, whose dependencies were built: its hashes are checked here,
     // and `cargo xtask lean` builds it size-optimised for the flash and RAM table.
     let lean_step = std::thread::spawn(|| lean_runs("firmware", false));
-    fuzz_with(fuzz_build, FUZZ_SECONDS_IN_TEST)?;
+    fuzz_built(FUZZ_SECONDS_IN_TEST)?;
     lean_step
         .join()
         .map_err(|_| "the lean firmware thread panicked".to_string())??;
-    println!("\nxtask: {} passed, {} failed", totals.0, totals.1);
     Ok(())
 }

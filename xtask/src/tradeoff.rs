@@ -99,7 +99,7 @@ pub(crate) fn build_example_with_cfgs(
     // A target build shares the target directory of `build_firmware_examples`, whose
     // dependencies are then already compiled for that target and profile.
     if let Some(t) = target {
-        cmd.env("CARGO_TARGET_DIR", crate::firmware::firmware_target_dir(t));
+        cmd.env("CARGO_TARGET_DIR", crate::firmware_target_dir(t));
     }
     run(&mut cmd)?;
     Ok(match target {
