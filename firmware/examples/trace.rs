@@ -52,7 +52,9 @@ mod firmware {
     use super::{arch, classic, row_count::RowCounted, view};
     use embedded_graphics::pixelcolor::Rgb565;
     use scanline3d::sink::HashSink;
-    use scanline3d::trace::{Scene, ScreenBound, TraceCamera, TraceOptions, TraceStats, Tracer};
+    use scanline3d::trace::{
+        Scene, ScreenBound, ShadowCandidate, TraceCamera, TraceOptions, TraceStats, Tracer,
+    };
     use semihosting::println;
 
     use crate::measure::{self, _stack_start};
@@ -105,9 +107,11 @@ mod firmware {
         {
             let mut bounds = [ScreenBound::default(); classic::OBJECTS.len()];
             let mut active = [ScreenBound::default(); classic::OBJECTS.len()];
+            let mut shadow =
+                [ShadowCandidate::default(); classic::LIGHTS.len() * classic::OBJECTS.len()];
             let mut sink = RowCounted::new(HashSink::new());
             let stats = tracer
-                .render_hybrid(&mut bounds, &mut active, &mut row, &mut sink)
+                .render_hybrid(&mut bounds, &mut active, &mut shadow, &mut row, &mut sink)
                 .map_err(|_| "hybrid render")?;
             report(1, "hybrid", &stats, sink.instructions, sink.sink.hash())?;
             peak_ray_stack = peak_ray_stack.max(stats.peak_stack);
@@ -139,7 +143,7 @@ mod firmware {
         let rays = u64::from(stats.rays());
         let tests = u64::from(stats.intersection_tests);
         println!(
-            "frame {} hash {:08x} mode {} instructions {} instr_per_pixel {} instr_per_ray {} instr_per_test {} rays {} primary {} secondary {} shadow {} shadow_cache_hits {} tests {} tests_per_ray_x100 {} box_tests_per_ray_x100 {} fallback_rows {}",
+            "frame {} hash {:08x} mode {} instructions {} instr_per_pixel {} instr_per_ray {} instr_per_test {} rays {} primary {} secondary {} shadow {} shadow_cache_hits {} tests {} tests_per_ray_x100 {} box_tests_per_ray_x100 {} fallback_rows {} shadow_fallback_rows {}",
             frame,
             hash,
             mode,
@@ -155,7 +159,8 @@ mod firmware {
             tests,
             tests * 100 / rays.max(1),
             u64::from(stats.box_tests) * 100 / rays.max(1),
-            stats.fallback_rows
+            stats.fallback_rows,
+            stats.shadow_fallback_rows
         );
         Ok(())
     }

@@ -48,6 +48,7 @@ pub mod bvh;
 pub mod grid;
 pub mod hybrid;
 pub mod intersect;
+pub mod row_shadow;
 pub mod scene;
 pub mod shape;
 pub mod tracer;
@@ -55,6 +56,7 @@ pub mod vector;
 
 pub use hybrid::ScreenBound;
 pub use intersect::Ray;
+pub use row_shadow::ShadowCandidate;
 pub use scene::{Colour, Light, LightKind, Material, Scene, TraceCamera, TraceSceneError};
 pub use shape::{Object, Plane, Polygon, Shape, ShapeError, Sphere, Triangle};
 pub use tracer::{PixelTrace, ShadowCache, TraceError, TraceOptions, TraceStats, Tracer};

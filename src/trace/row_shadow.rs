@@ -1,0 +1,275 @@
+//! Hybrid mode's per-row shadow candidates: once a row's visible objects are known, per light
+//! the objects that can block a shadow ray from one of the row's first hits towards it, so the
+//! shadow rays of those hits test a short list instead of walking the hierarchy.
+//!
+//! The row's first hits lie in the padded boxes of the objects active on the row (the hybrid
+//! mode's candidates), so in their union box `B`. A shadow ray from a point of `B` runs inside
+//! the hull of `B` and a point light `L` (points `L + s·(b − L)`, `b` in `B`, `s` in [0, 1]),
+//! or, for a directional light `D`, inside `B` swept along `D` (`b + s·D`, `s ≥ 0`). An
+//! object whose padded box misses that region cannot block such a ray: the ray's rounding
+//! (direction within 2^-14 rad, a drift below 2^-10 units over the envelope's rays, as for the
+//! hierarchy) stays far inside the padding [`PAD`]. The test is exact integer arithmetic on
+//! raw I16F16 bits (per axis a range of `s`, intersected as fractions with 64-bit cross
+//! products: differences below 2^30 raw, so products below 2^60).
+//!
+//! Whether a shadow ray is blocked does not depend on the order objects are tested in, so the
+//! list gives the hierarchy's answer. Planar objects sharing one plane (the checkered floor's
+//! polygons) are grouped: a shadow ray that does not meet the plane within its window skips
+//! the whole group, since every planar test starts by meeting its plane
+//! ([`meets_plane`]). Unbounded objects (planes) are candidates for every light.
+
+use crate::trace::bvh::{self, heap_sort_by_key, PAD};
+use crate::trace::intersect::{meets_plane, Ray};
+use crate::trace::scene::{LightKind, Scene, MAX_LIGHTS};
+use crate::trace::shape::Object;
+use crate::trace::vector::Vec3;
+use fixed::types::I16F16;
+
+/// One entry of a light's candidate list (8 bytes; the caller's buffer holds the lists of all
+/// lights for one row).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ShadowCandidate {
+    /// The object's id.
+    pub object: u32,
+    /// At the first of two or more consecutive planar objects lying in one plane: how many
+    /// there are (a shadow ray that does not meet the plane skips them all); 0 otherwise.
+    pub plane_run: u32,
+}
+
+/// The candidate lists of one row: light `k`'s list is `candidates[ranges[k].0..ranges[k].1]`.
+pub(crate) struct RowShadows<'b> {
+    candidates: &'b [ShadowCandidate],
+    ranges: [(u16, u16); MAX_LIGHTS],
+}
+
+impl<'b> RowShadows<'b> {
+    /// Light `k`'s candidates.
+    pub(crate) fn for_light(&self, k: usize) -> Option<&'b [ShadowCandidate]> {
+        let (start, end) = *self.ranges.get(k)?;
+        self.candidates.get(usize::from(start)..usize::from(end))
+    }
+}
+
+/// The padded box of an object, raw I16F16 bits; `None` for an unbounded one.
+fn padded_box(object: &Object<'_>) -> Option<([i32; 3], [i32; 3])> {
+    let pad = Vec3 {
+        x: PAD,
+        y: PAD,
+        z: PAD,
+    };
+    bvh::bounds(&object.shape).map(|(lo, hi)| (lo.sub(pad).bits(), hi.add(pad).bits()))
+}
+
+/// Builds the candidate lists of the row whose visible objects are `active` into `out`;
+/// `None` when `out` is too small or an active object is unbounded (the row's first hits are
+/// then not bounded): the row's shadow rays walk the hierarchy.
+pub(crate) fn row_shadows<'b>(
+    scene: &Scene<'_>,
+    active: impl Iterator<Item = u32>,
+    out: &'b mut [ShadowCandidate],
+) -> Option<RowShadows<'b>> {
+    let mut region: Option<([i32; 3], [i32; 3])> = None;
+    for id in active {
+        let (lo, hi) = padded_box(scene.objects.get(id as usize)?)?;
+        region = Some(match region {
+            None => (lo, hi),
+            Some((a, b)) => (
+                core::array::from_fn(|i| a[i].min(lo[i])),
+                core::array::from_fn(|i| b[i].max(hi[i])),
+            ),
+        });
+    }
+    let mut ranges = [(0u16, 0u16); MAX_LIGHTS];
+    let mut used = 0usize;
+    // No visible object: no first hit, no shadow ray; every list stays empty.
+    if let Some(region) = region {
+        for (light, range) in scene.lights.iter().zip(ranges.iter_mut()) {
+            let start = used;
+            for (id, object) in scene.objects.iter().enumerate() {
+                let candidate = padded_box(object)
+                    .is_none_or(|object| sweep_meets(region, &light.kind, object));
+                if candidate {
+                    let slot = out.get_mut(used)?;
+                    *slot = ShadowCandidate {
+                        object: id as u32,
+                        plane_run: 0,
+                    };
+                    used += 1;
+                }
+            }
+            let list = out.get_mut(start..used)?;
+            group_planes(scene, list);
+            *range = (u16::try_from(start).ok()?, u16::try_from(used).ok()?);
+        }
+    }
+    Some(RowShadows {
+        candidates: out.get(..used)?,
+        ranges,
+    })
+}
+
+/// Sorts `list` so the planar objects lying in one plane are consecutive, and marks each
+/// group of two or more at its first entry.
+fn group_planes(scene: &Scene<'_>, list: &mut [ShadowCandidate]) {
+    let plane = |c: &ShadowCandidate| {
+        scene
+            .objects
+            .get(c.object as usize)
+            .and_then(|o| o.shape.plane())
+            .map(|(n, d)| (n.bits(), d.to_bits()))
+    };
+    heap_sort_by_key(list, |c| (plane(&c), c.object));
+    let mut start = 0;
+    while let Some(first) = list.get(start) {
+        let key = plane(first);
+        let run = list
+            .get(start..)
+            .unwrap_or(&[])
+            .iter()
+            .take_while(|c| key.is_some() && plane(c) == key)
+            .count();
+        if run >= 2 {
+            if let Some(first) = list.get_mut(start) {
+                first.plane_run = run as u32;
+            }
+        }
+        start += run.max(1);
+    }
+}
+
+/// Whether `blocks` holds for some candidate of `list` that a shadow ray `ray` with window
+/// `[EPSILON, t_max)` can meet (a group whose plane the ray does not meet is skipped).
+pub(crate) fn any_blocks(
+    scene: &Scene<'_>,
+    list: &[ShadowCandidate],
+    ray: &Ray,
+    t_min: I16F16,
+    t_max: I16F16,
+    mut blocks: impl FnMut(u32) -> bool,
+) -> bool {
+    let mut i = 0;
+    while let Some(c) = list.get(i) {
+        if c.plane_run >= 2 {
+            let plane = scene
+                .objects
+                .get(c.object as usize)
+                .and_then(|o| o.shape.plane());
+            if plane.is_some_and(|p| !meets_plane(p, ray, t_min, t_max)) {
+                i += c.plane_run as usize;
+                continue;
+            }
+        }
+        if blocks(c.object) {
+            return true;
+        }
+        i += 1;
+    }
+    false
+}
+
+/// A range of the sweep parameter `s`: `lo ≤ s ≤ hi`, each bound a fraction `n / d` with
+/// `d > 0`; `hi = None` is unbounded.
+struct Range {
+    lo: (i64, i64),
+    hi: Option<(i64, i64)>,
+}
+
+impl Range {
+    /// Adds `s · c ≤ r` (`at_most`) or `s · c ≥ r`; false when it cannot hold.
+    fn add(&mut self, c: i64, r: i64, at_most: bool) -> bool {
+        // Dividing by a negative c flips the inequality.
+        let (n, d, upper) = match c {
+            0 => return if at_most { r >= 0 } else { r <= 0 },
+            c if c > 0 => (r, c, at_most),
+            c => (-r, -c, !at_most),
+        };
+        if upper {
+            if self.hi.is_none_or(|(hn, hd)| n * hd < hn * d) {
+                self.hi = Some((n, d));
+            }
+        } else if n * self.lo.1 > self.lo.0 * d {
+            self.lo = (n, d);
+        }
+        self.hi
+            .is_none_or(|(hn, hd)| self.lo.0 * hd <= hn * self.lo.1)
+    }
+}
+
+/// Whether the box `object` (raw bits, inclusive) meets the region shadow rays from the box
+/// `region` towards `light` run in (see the module's text).
+fn sweep_meets(
+    region: ([i32; 3], [i32; 3]),
+    light: &LightKind,
+    object: ([i32; 3], [i32; 3]),
+) -> bool {
+    let ((b0, b1), (o0, o1)) = (region, object);
+    let w = |v: i32| i64::from(v);
+    match light {
+        LightKind::Point(p) => {
+            // L + s·(b − L), s in [0, 1]: per axis s·(B0 − L) ≤ O1 − L and s·(B1 − L) ≥ O0 − L.
+            let l = p.bits();
+            let mut s = Range {
+                lo: (0, 1),
+                hi: Some((1, 1)),
+            };
+            (0..3).all(|i| {
+                s.add(w(b0[i]) - w(l[i]), w(o1[i]) - w(l[i]), true)
+                    && s.add(w(b1[i]) - w(l[i]), w(o0[i]) - w(l[i]), false)
+            })
+        }
+        LightKind::Directional(d) => {
+            // b + s·D, s ≥ 0: per axis s·D ≤ O1 − B0 and s·D ≥ O0 − B1.
+            let d = d.bits();
+            let mut s = Range {
+                lo: (0, 1),
+                hi: None,
+            };
+            (0..3).all(|i| {
+                s.add(w(d[i]), w(o1[i]) - w(b0[i]), true)
+                    && s.add(w(d[i]), w(o0[i]) - w(b1[i]), false)
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube(c: [i32; 3], half: i32) -> ([i32; 3], [i32; 3]) {
+        let f = |v: i32| v << 16;
+        (c.map(|v| f(v - half)), c.map(|v| f(v + half)))
+    }
+
+    #[test]
+    fn the_sweep_towards_a_point_light_is_the_hull() {
+        // Region around the origin, light at (0, 10, 0).
+        let region = cube([0, 0, 0], 1);
+        let light = LightKind::Point(Vec3::from_bits(0, 10 << 16, 0));
+        // Between the region and the light: inside the hull.
+        assert!(sweep_meets(region, &light, cube([0, 5, 0], 1)));
+        // Beside the hull's narrow end near the light: out.
+        assert!(!sweep_meets(region, &light, cube([3, 8, 0], 1)));
+        // Beside the region, level with it: out; overlapping it: in.
+        assert!(!sweep_meets(region, &light, cube([4, 0, 0], 1)));
+        assert!(sweep_meets(region, &light, cube([2, 0, 0], 1)));
+        // Beyond the light: out.
+        assert!(!sweep_meets(region, &light, cube([0, 13, 0], 1)));
+        // Near the wide end, just inside the slanted side (x ≤ 1 − y/10 at y = 2: 0.8).
+        let thin = |x0: f64| {
+            let f = |v: f64| (v * 65536.0) as i32;
+            ([f(x0), f(1.9), f(-0.1)], [f(x0 + 0.1), f(2.1), f(0.1)])
+        };
+        assert!(sweep_meets(region, &light, thin(0.75)));
+        assert!(!sweep_meets(region, &light, thin(0.95)));
+    }
+
+    #[test]
+    fn the_sweep_along_a_directional_light_is_unbounded() {
+        let region = cube([0, 0, 0], 1);
+        let up = LightKind::Directional(Vec3::from_bits(0, 1 << 16, 0));
+        assert!(sweep_meets(region, &up, cube([0, 1000, 0], 1)));
+        assert!(!sweep_meets(region, &up, cube([0, -5, 0], 1)));
+        assert!(!sweep_meets(region, &up, cube([5, 50, 0], 1)));
+    }
+}
