@@ -16,7 +16,7 @@
 //! list gives the hierarchy's answer. Planar objects sharing one plane (the checkered floor's
 //! polygons) are grouped: a shadow ray that does not meet the plane within its window skips
 //! the whole group, since every planar test starts by meeting its plane
-//! ([`meets_plane`]). Unbounded objects (planes) are candidates for every light.
+//! (`intersect::meets_plane`). Unbounded objects (planes) are candidates for every light.
 
 use crate::trace::bvh::{self, heap_sort_by_key, PAD};
 use crate::trace::intersect::{meets_plane, Ray};

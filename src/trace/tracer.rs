@@ -497,6 +497,9 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
 
     /// Adds the local term at `hit` times the ray's weight to `sum`, pushes the reflected and
     /// refracted rays the rules allow, and returns the shadow mask at the hit.
+    // The per-pixel state a ray adds to (colour sum, ray stack, shadow cache, the row's
+    // shadow candidates, counts), each borrowed apart.
+    #[allow(clippy::too_many_arguments)]
     fn shade(
         &self,
         pending: &Pending,
