@@ -44,7 +44,7 @@ fn hybrid_mode_gives_the_pure_tracers_images_on_every_corpus_scene() {
                         || pure.depth[*i].to_bits() != hybrid.depth[*i].to_bits()
                 })
                 .collect();
-            fixed_scene
+            let unbounded = fixed_scene
                 .with_scene(fixed::Accel::None, |every| {
                     let tracer = Tracer::<32>::new(every, &camera, options);
                     for i in &differ {
@@ -54,6 +54,10 @@ fn hybrid_mode_gives_the_pure_tracers_images_on_every_corpus_scene() {
                         assert_eq!(id, hybrid.ids[*i], "{what} ({x}, {y})");
                         assert_ne!(id, pure.ids[*i], "{what} ({x}, {y}): unexplained");
                     }
+                    every
+                        .objects
+                        .iter()
+                        .any(|o| matches!(o.shape, scanline3d::trace::Shape::Plane(_)))
                 })
                 .unwrap();
             assert!(differ.len() <= 2, "{what}: {} pixels differ", differ.len());
@@ -63,6 +67,12 @@ fn hybrid_mode_gives_the_pure_tracers_images_on_every_corpus_scene() {
                 (p.primary_rays, 0),
                 "{what}"
             );
+            // Without an unbounded object every row's first hits are bounded, and the buffer
+            // (lights × objects) holds every row's shadow candidates: the shadow masks and
+            // colours compared above came from the lists (a directional light in `diamond`).
+            // With a plane in view every row's shadow rays walk the hierarchy.
+            let expected = if unbounded { SIZE as u16 } else { 0 };
+            assert_eq!(h.shadow_fallback_rows, expected, "{what}");
             let work = |s: &scanline3d::trace::TraceStats| s.intersection_tests + s.box_tests;
             eprintln!(
                 "{what}: {} pixels differ; tests + box tests per frame {} pure, {} hybrid",
