@@ -254,14 +254,15 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             let dropped_before = stats.dropped_rays;
             let mut changed = false;
             let scanned = scan.advance(y, &mut changed);
+            let live = scan.active.get(..scan.live).unwrap_or(&[]);
             if !scanned {
                 stats.fallback_rows += 1;
-            }
-            let live = scan.active.get(..scan.live).unwrap_or(&[]);
-            if scanned && with_lists && (changed || lists.is_none()) {
+                // The lists name the active set they were built for: rebuilt after a fallback.
+                lists = None;
+            } else if with_lists && (changed || lists.is_none()) {
                 lists = Some(row_shadows(scene, live.iter().map(|b| b.object), shadow));
             }
-            let row_lists = lists.as_ref().and_then(Option::as_ref).filter(|_| scanned);
+            let row_lists = lists.as_ref().and_then(Option::as_ref);
             if scanned && row_lists.is_none() {
                 stats.shadow_fallback_rows += 1;
             }

@@ -3,7 +3,8 @@
 //! shadow rays of those hits test a short list instead of walking the hierarchy.
 //!
 //! The row's first hits lie in the padded boxes of the objects active on the row (the hybrid
-//! mode's candidates), so in their union box `B`. A shadow ray from a point of `B` runs inside
+//! mode's candidates), so in their union box `B`; so may hits deeper in their ray trees, and
+//! every shadow ray that starts inside `B` uses the lists. A shadow ray from a point of `B` runs inside
 //! the hull of `B` and a point light `L` (points `L + s·(b − L)`, `b` in `B`, `s` in [0, 1]),
 //! or, for a directional light `D`, inside `B` swept along `D` (`b + s·D`, `s ≥ 0`). An
 //! object whose padded box misses that region cannot block such a ray: the ray's rounding
@@ -36,15 +37,23 @@ pub struct ShadowCandidate {
     pub plane_run: u32,
 }
 
-/// The candidate lists of one row: light `k`'s list is `candidates[ranges[k].0..ranges[k].1]`.
+/// The candidate lists of one row: light `k`'s list is `candidates[ranges[k].0..ranges[k].1]`,
+/// valid for shadow rays starting inside `region` (raw bits, inclusive; `None`: nowhere).
 pub(crate) struct RowShadows<'b> {
     candidates: &'b [ShadowCandidate],
     ranges: [(u16, u16); MAX_LIGHTS],
+    region: Option<([i32; 3], [i32; 3])>,
 }
 
 impl<'b> RowShadows<'b> {
-    /// Light `k`'s candidates.
-    pub(crate) fn for_light(&self, k: usize) -> Option<&'b [ShadowCandidate]> {
+    /// Light `k`'s candidates for a shadow ray from `point`, if `point` lies in the region they
+    /// were chosen for: every first hit of the row does, and so may a deeper hit.
+    pub(crate) fn for_ray(&self, k: usize, point: Vec3) -> Option<&'b [ShadowCandidate]> {
+        let (lo, hi) = self.region?;
+        let p = point.bits();
+        if (0..3).any(|i| p[i] < lo[i] || p[i] > hi[i]) {
+            return None;
+        }
         let (start, end) = *self.ranges.get(k)?;
         self.candidates.get(usize::from(start)..usize::from(end))
     }
@@ -105,6 +114,7 @@ pub(crate) fn row_shadows<'b>(
     Some(RowShadows {
         candidates: out.get(..used)?,
         ranges,
+        region,
     })
 }
 

@@ -86,7 +86,7 @@ pub struct TraceStats {
     pub fallback_rows: u16,
     /// Hybrid mode: rows whose primary hits' shadow rays walked the hierarchy instead of the
     /// row's candidate lists, because the candidate buffer was full or a visible object is
-    /// unbounded (same image, more work).
+    /// unbounded (same image, more work); rows counted in `fallback_rows` are not counted again.
     pub shadow_fallback_rows: u16,
     /// Most pending rays on the stack at once.
     pub peak_stack: u16,
@@ -312,8 +312,9 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
 
     /// Traces pixel (`column`, `row`) with `first_hit` finding the primary ray's nearest hit in
     /// `[t_min, t_max)`; everything after the primary hit is the same for every mode, except
-    /// that with `row_shadows` the shadow rays from the primary hit test the row's candidate
-    /// lists instead of walking the hierarchy (same answers).
+    /// that with `row_shadows` the shadow rays starting in the row's region (those from the
+    /// primary hit, and from deeper hits that lie there) test the row's candidate lists instead
+    /// of walking the hierarchy (same answers).
     pub(crate) fn trace_with(
         &self,
         column: u16,
@@ -366,9 +367,15 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             match hit {
                 None => add_weighted(&mut sum, &self.scene.background, ray.weight),
                 Some(hit) => {
-                    let lists = row_shadows.filter(|_| is_primary);
-                    let shadow =
-                        self.shade(&ray, hit, &mut sum, &mut stack, cache, lists, &mut stats);
+                    let shadow = self.shade(
+                        &ray,
+                        hit,
+                        &mut sum,
+                        &mut stack,
+                        cache,
+                        row_shadows,
+                        &mut stats,
+                    );
                     if is_primary {
                         out.id = Some(hit.object);
                         out.depth = hit.t.checked_div(len).unwrap_or(I16F16::MAX);
@@ -436,8 +443,8 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
 
     /// Whether any object lies along `ray` (which starts on object `from`) with `t` in
     /// `[EPSILON, t_max)`. `cached` is the light's entry in the shadow cache: tested first, and
-    /// set to the blocker found. With `candidates` (hybrid mode, a primary hit's shadow ray)
-    /// only those are tested, else the scene's structure is walked.
+    /// set to the blocker found. With `candidates` (hybrid mode, a shadow ray from the row's
+    /// region) only those are tested, else the scene's structure is walked.
     fn blocked(
         &self,
         ray: &Ray,
@@ -542,7 +549,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                     origin: point,
                     dir: towards,
                 };
-                let candidates = row_shadows.and_then(|r| r.for_light(k));
+                let candidates = row_shadows.and_then(|r| r.for_ray(k, point));
                 !self.blocked(&shadow_ray, hit.object, distance, cached, candidates, stats)
             };
             if lit {
