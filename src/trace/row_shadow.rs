@@ -1,15 +1,18 @@
 //! Hybrid mode's per-row shadow candidates: once a row's visible objects are known, per light
 //! the objects that can block a shadow ray from one of the row's first hits towards it, so the
-//! shadow rays of those hits test a short list instead of walking the hierarchy.
+//! shadow rays of those hits (and of deeper hits in the same region) test a short list instead
+//! of walking the hierarchy.
 //!
 //! The row's first hits lie in the padded boxes of the objects active on the row (the hybrid
 //! mode's candidates), so in their union box `B`; so may hits deeper in their ray trees, and
-//! every shadow ray that starts inside `B` uses the lists. A shadow ray from a point of `B` runs inside
-//! the hull of `B` and a point light `L` (points `L + s·(b − L)`, `b` in `B`, `s` in [0, 1]),
-//! or, for a directional light `D`, inside `B` swept along `D` (`b + s·D`, `s ≥ 0`). An
-//! object whose padded box misses that region cannot block such a ray: the ray's rounding
-//! (direction within 2^-14 rad, a drift below 2^-10 units over the envelope's rays, as for the
-//! hierarchy) stays far inside the padding [`PAD`]. The test is exact integer arithmetic on
+//! every shadow ray that starts inside `B` uses the lists. A shadow ray from a point of `B` runs
+//! inside the hull of `B` and a point light `L` (points `L + s·(b − L)`, `b` in `B`, `s` in
+//! [0, 1]), or, for a directional light `D`, inside `B` swept along `D` (`b + s·D`, `s ≥ 0`;
+//! the ray's direction is `D` itself). An object whose padded box misses that region cannot
+//! block such a ray: towards a point light the rounded direction (within 2^-14.2 rad) moves the
+//! ray off the segment by at most its length times that, below 2^-7.2 units for the rays up to
+//! [`POINT_LIGHT_REACH`] the lists serve, inside the padding [`PAD`] (2^-6) with the hit
+//! points' own error (about 2^-12) to spare. The test is exact integer arithmetic on
 //! raw I16F16 bits (per axis a range of `s`, intersected as fractions with 64-bit cross
 //! products: differences below 2^30 raw, so products below 2^60).
 //!
@@ -25,6 +28,10 @@ use crate::trace::scene::{LightKind, Scene, MAX_LIGHTS};
 use crate::trace::shape::Object;
 use crate::trace::vector::Vec3;
 use fixed::types::I16F16;
+
+/// Longest shadow ray towards a point light that the lists serve (world units); longer ones walk
+/// the hierarchy (see the module's text).
+pub const POINT_LIGHT_REACH: I16F16 = I16F16::from_bits(128 << 16);
 
 /// One entry of a light's candidate list (8 bytes; the caller's buffer holds the lists of all
 /// lights for one row).
@@ -46,9 +53,19 @@ pub(crate) struct RowShadows<'b> {
 }
 
 impl<'b> RowShadows<'b> {
-    /// Light `k`'s candidates for a shadow ray from `point`, if `point` lies in the region they
-    /// were chosen for: every first hit of the row does, and so may a deeper hit.
-    pub(crate) fn for_ray(&self, k: usize, point: Vec3) -> Option<&'b [ShadowCandidate]> {
+    /// Light `k`'s candidates for a shadow ray from `point` towards `light` over `distance`, if
+    /// `point` lies in the region they were chosen for (every first hit of the row does, and so
+    /// may a deeper hit) and a ray towards a point light is within [`POINT_LIGHT_REACH`].
+    pub(crate) fn for_ray(
+        &self,
+        k: usize,
+        light: &LightKind,
+        point: Vec3,
+        distance: I16F16,
+    ) -> Option<&'b [ShadowCandidate]> {
+        if matches!(light, LightKind::Point(_)) && distance >= POINT_LIGHT_REACH {
+            return None;
+        }
         let (lo, hi) = self.region?;
         let p = point.bits();
         if (0..3).any(|i| p[i] < lo[i] || p[i] > hi[i]) {
@@ -272,6 +289,29 @@ mod tests {
         };
         assert!(sweep_meets(region, &light, thin(0.75)));
         assert!(!sweep_meets(region, &light, thin(0.95)));
+    }
+
+    #[test]
+    fn lists_serve_rays_from_their_region_within_reach() {
+        let candidates = [ShadowCandidate::default(); 2];
+        let mut ranges = [(0, 0); MAX_LIGHTS];
+        ranges[0] = (0, 2);
+        let rows = RowShadows {
+            candidates: &candidates,
+            ranges,
+            region: Some(cube([0, 0, 0], 1)),
+        };
+        let point = LightKind::Point(Vec3::from_bits(0, 10 << 16, 0));
+        let up = LightKind::Directional(Vec3::from_bits(0, 1 << 16, 0));
+        let inside = Vec3::from_bits(1 << 15, 0, 0);
+        let near = I16F16::from_num(9);
+        assert_eq!(rows.for_ray(0, &point, inside, near).map(<[_]>::len), Some(2));
+        assert_eq!(rows.for_ray(0, &up, inside, I16F16::MAX).map(<[_]>::len), Some(2));
+        // Outside the region, beyond the reach of a point light's list, an unknown light.
+        let outside = Vec3::from_bits(3 << 16, 0, 0);
+        assert_eq!(rows.for_ray(0, &point, outside, near), None);
+        assert_eq!(rows.for_ray(0, &point, inside, POINT_LIGHT_REACH), None);
+        assert_eq!(rows.for_ray(MAX_LIGHTS, &up, inside, near), None);
     }
 
     #[test]

@@ -84,8 +84,8 @@ pub struct TraceStats {
     /// Hybrid mode: rows whose primary visibility fell back to the pure tracer's search because
     /// the screen-bound buffer or the active list was full (same image, more work).
     pub fallback_rows: u16,
-    /// Hybrid mode: rows whose primary hits' shadow rays walked the hierarchy instead of the
-    /// row's candidate lists, because the candidate buffer was full or a visible object is
+    /// Hybrid mode: rows whose shadow rays all walked the hierarchy instead of the row's
+    /// candidate lists, because the candidate buffer was full or a visible object is
     /// unbounded (same image, more work); rows counted in `fallback_rows` are not counted again.
     pub shadow_fallback_rows: u16,
     /// Most pending rays on the stack at once.
@@ -549,7 +549,8 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                     origin: point,
                     dir: towards,
                 };
-                let candidates = row_shadows.and_then(|r| r.for_ray(k, point));
+                let candidates =
+                    row_shadows.and_then(|r| r.for_ray(k, &light.kind, point, distance));
                 !self.blocked(&shadow_ray, hit.object, distance, cached, candidates, stats)
             };
             if lit {
