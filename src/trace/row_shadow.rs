@@ -305,8 +305,14 @@ mod tests {
         let up = LightKind::Directional(Vec3::from_bits(0, 1 << 16, 0));
         let inside = Vec3::from_bits(1 << 15, 0, 0);
         let near = I16F16::from_num(9);
-        assert_eq!(rows.for_ray(0, &point, inside, near).map(<[_]>::len), Some(2));
-        assert_eq!(rows.for_ray(0, &up, inside, I16F16::MAX).map(<[_]>::len), Some(2));
+        assert_eq!(
+            rows.for_ray(0, &point, inside, near).map(<[_]>::len),
+            Some(2)
+        );
+        assert_eq!(
+            rows.for_ray(0, &up, inside, I16F16::MAX).map(<[_]>::len),
+            Some(2)
+        );
         // Outside the region, beyond the reach of a point light's list, an unknown light.
         let outside = Vec3::from_bits(3 << 16, 0, 0);
         assert_eq!(rows.for_ray(0, &point, outside, near), None);
