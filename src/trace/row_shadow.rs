@@ -292,6 +292,68 @@ mod tests {
     }
 
     #[test]
+    fn coplanar_candidates_are_grouped_and_skipped_together() {
+        use crate::trace::scene::{Colour, Material};
+        use crate::trace::shape::{Shape, Sphere, Triangle};
+        let v = |x: i32, y: i32, z: i32| Vec3::from_bits(x << 16, y << 16, z << 16);
+        // Two floor triangles in y = 0 around a sphere, and a third triangle in y = 0 too.
+        let tri = |x: i32| Object {
+            shape: Shape::Triangle(
+                Triangle::new([v(x, 0, 0), v(x + 1, 0, 0), v(x, 0, -1)]).unwrap(),
+            ),
+            material: 0,
+        };
+        let objects = [
+            tri(0),
+            Object {
+                shape: Shape::Sphere(Sphere::new(v(0, 3, 0), I16F16::ONE).unwrap()),
+                material: 0,
+            },
+            tri(2),
+            tri(4),
+        ];
+        let grey = Colour::new([I16F16::ONE; 3]).unwrap();
+        let materials = [Material::new(grey, [I16F16::ONE; 4], I16F16::ONE).unwrap()];
+        let scene = Scene::new(&objects, &materials, &[], Colour::BLACK, I16F16::ZERO).unwrap();
+        let mut list: [ShadowCandidate; 4] = core::array::from_fn(|i| ShadowCandidate {
+            object: i as u32,
+            plane_run: 0,
+        });
+        group_planes(&scene, &mut list);
+        // The sphere first (no plane), then the three triangles as one group.
+        let order = list.map(|c| (c.object, c.plane_run));
+        assert_eq!(order, [(1, 0), (0, 3), (2, 0), (3, 0)]);
+        let tested = |ray: &Ray| {
+            let mut seen = [false; 4];
+            let blocked = any_blocks(
+                &scene,
+                &list,
+                ray,
+                I16F16::from_bits(64),
+                I16F16::MAX,
+                |id| {
+                    seen[id as usize] = true;
+                    false
+                },
+            );
+            assert!(!blocked);
+            seen
+        };
+        // Leaving the floor upwards: the group is skipped, the sphere tested.
+        let up = Ray {
+            origin: Vec3::from_bits(1 << 15, 0, -(1 << 14)),
+            dir: v(0, 1, 0),
+        };
+        assert_eq!(tested(&up), [false, true, false, false]);
+        // From above, down through the floor: every member is tested.
+        let down = Ray {
+            origin: v(3, 2, 0),
+            dir: Vec3::from_bits(0, -(1 << 16), 0),
+        };
+        assert_eq!(tested(&down), [true, true, true, true]);
+    }
+
+    #[test]
     fn lists_serve_rays_from_their_region_within_reach() {
         let candidates = [ShadowCandidate::default(); 2];
         let mut ranges = [(0, 0); MAX_LIGHTS];
