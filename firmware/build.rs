@@ -35,6 +35,9 @@ fn main() {
         "cargo::rustc-check-cfg=cfg(scanline3d_patch_tolerance, values(\"4\", \"2\", \"1\", \"0.5\", \"0.25\"))"
     );
     println!("cargo::rustc-check-cfg=cfg(scanline3d_patch_mesh)");
+    // `examples/trace.rs` with `--cfg scanline3d_trace_only="pure"` renders that frame alone
+    // (`cargo xtask profile trace` profiles each mode apart).
+    println!("cargo::rustc-check-cfg=cfg(scanline3d_trace_only, values(\"pure\", \"hybrid\"))");
     if std::env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
         return;
     }

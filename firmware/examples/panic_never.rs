@@ -168,14 +168,20 @@ mod firmware {
                     Tracer::<STACK>::new(&with_bvh, &camera, options).render(&mut row, sink);
                 black_box(&stats);
                 // Hybrid mode, with room for every object and with buffers that overflow.
-                use scanline3d::trace::ScreenBound;
+                // The shadow candidate lists with room for every object, with too little room
+                // and with none.
+                use scanline3d::trace::{ScreenBound, ShadowCandidate};
                 let mut bounds = [ScreenBound::default(); super::classic::OBJECTS.len()];
                 let mut active = [ScreenBound::default(); super::classic::OBJECTS.len()];
+                const LISTS: usize = super::classic::LIGHTS.len() * super::classic::OBJECTS.len();
+                let mut shadow = [ShadowCandidate::default(); LISTS];
                 let n = black_box(super::classic::OBJECTS.len());
-                for (b, a) in [(n, n), (n, 3), (2, n)] {
+                let l = black_box(LISTS);
+                for (b, a, c) in [(n, n, l), (n, 3, 5), (2, n, 0)] {
                     let stats = Tracer::<STACK>::new(&with_bvh, &camera, options).render_hybrid(
                         bounds.get_mut(..b).unwrap_or(&mut []),
                         active.get_mut(..a).unwrap_or(&mut []),
+                        shadow.get_mut(..c).unwrap_or(&mut []),
                         &mut row,
                         sink,
                     );

@@ -52,7 +52,9 @@ mod firmware {
     use super::{arch, classic, row_count::RowCounted, view};
     use embedded_graphics::pixelcolor::Rgb565;
     use scanline3d::sink::HashSink;
-    use scanline3d::trace::{Scene, ScreenBound, TraceCamera, TraceOptions, TraceStats, Tracer};
+    use scanline3d::trace::{
+        Scene, ScreenBound, ShadowCandidate, TraceCamera, TraceOptions, TraceStats, Tracer,
+    };
     use semihosting::println;
 
     use crate::measure::{self, _stack_start};
@@ -90,26 +92,37 @@ mod firmware {
         measure::paint_stack();
         let tracer = Tracer::<STACK>::new(&scene, &camera, options);
         let mut row = [Rgb565::new(0, 0, 0); view::CLASSIC.width as usize];
-        // Frame 0: the pure tracer.
-        let mut sink = RowCounted::new(HashSink::new());
-        let stats = tracer.render(&mut row, &mut sink).map_err(|_| "render")?;
-        report(0, "pure", &stats, sink.instructions, sink.sink.hash())?;
+        let mut peak_ray_stack = 0;
+        // Frame 0: the pure tracer (`--cfg scanline3d_trace_only="hybrid"` skips it).
+        #[cfg(not(scanline3d_trace_only = "hybrid"))]
+        {
+            let mut sink = RowCounted::new(HashSink::new());
+            let stats = tracer.render(&mut row, &mut sink).map_err(|_| "render")?;
+            report(0, "pure", &stats, sink.instructions, sink.sink.hash())?;
+            peak_ray_stack = peak_ray_stack.max(stats.peak_stack);
+        }
         // Frame 1: hybrid mode, room for every object in both buffers (the screen-bound set-up
         // is inside the count: it runs before the first row).
-        let mut bounds = [ScreenBound::default(); classic::OBJECTS.len()];
-        let mut active = [ScreenBound::default(); classic::OBJECTS.len()];
-        let mut sink = RowCounted::new(HashSink::new());
-        let stats = tracer
-            .render_hybrid(&mut bounds, &mut active, &mut row, &mut sink)
-            .map_err(|_| "hybrid render")?;
-        report(1, "hybrid", &stats, sink.instructions, sink.sink.hash())?;
+        #[cfg(not(scanline3d_trace_only = "pure"))]
+        {
+            let mut bounds = [ScreenBound::default(); classic::OBJECTS.len()];
+            let mut active = [ScreenBound::default(); classic::OBJECTS.len()];
+            let mut shadow =
+                [ShadowCandidate::default(); classic::LIGHTS.len() * classic::OBJECTS.len()];
+            let mut sink = RowCounted::new(HashSink::new());
+            let stats = tracer
+                .render_hybrid(&mut bounds, &mut active, &mut shadow, &mut row, &mut sink)
+                .map_err(|_| "hybrid render")?;
+            report(1, "hybrid", &stats, sink.instructions, sink.sink.hash())?;
+            peak_ray_stack = peak_ray_stack.max(stats.peak_stack);
+        }
         let peak_stack = stack_top - measure::stack_low_water();
         println!(
             "summary peak_stack {} static_ram {} ray_stack_entries {} peak_ray_stack {}",
             peak_stack,
             measure::static_ram(),
             STACK,
-            stats.peak_stack
+            peak_ray_stack
         );
         Ok(())
     }
@@ -130,7 +143,7 @@ mod firmware {
         let rays = u64::from(stats.rays());
         let tests = u64::from(stats.intersection_tests);
         println!(
-            "frame {} hash {:08x} mode {} instructions {} instr_per_pixel {} instr_per_ray {} instr_per_test {} rays {} primary {} secondary {} shadow {} shadow_cache_hits {} tests {} tests_per_ray_x100 {} box_tests_per_ray_x100 {} fallback_rows {}",
+            "frame {} hash {:08x} mode {} instructions {} instr_per_pixel {} instr_per_ray {} instr_per_test {} rays {} primary {} secondary {} shadow {} shadow_cache_hits {} tests {} tests_per_ray_x100 {} box_tests_per_ray_x100 {} fallback_rows {} shadow_fallback_rows {}",
             frame,
             hash,
             mode,
@@ -146,7 +159,8 @@ mod firmware {
             tests,
             tests * 100 / rays.max(1),
             u64::from(stats.box_tests) * 100 / rays.max(1),
-            stats.fallback_rows
+            stats.fallback_rows,
+            stats.shadow_fallback_rows
         );
         Ok(())
     }

@@ -456,7 +456,9 @@ pub mod traced {
     ) -> Result<TraceStats, TraceError<K::Error>> {
         let mut row = [background; WIDTH];
         match hybrid {
-            Some((bounds, active)) => tracer.render_hybrid(bounds, active, &mut row, sink),
+            // No shadow candidate buffer: the table's scenes are lit by one light and measured
+            // with the hierarchy's shadow rays.
+            Some((bounds, active)) => tracer.render_hybrid(bounds, active, &mut [], &mut row, sink),
             None => tracer.render(&mut row, sink),
         }
     }

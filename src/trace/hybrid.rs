@@ -22,6 +22,7 @@
 use crate::depth::DepthRow;
 use crate::sink::{Row, RowPixel, RowSink};
 use crate::trace::bvh::{self, heap_sort_by_key, PAD};
+use crate::trace::row_shadow::{row_shadows, RowShadows, ShadowCandidate};
 use crate::trace::tracer::{Nearest, PixelTrace, ShadowCache, TraceError, TraceStats, Tracer};
 use crate::trace::vector::Vec3;
 use fixed::types::I8F24;
@@ -57,7 +58,9 @@ struct Scan<'b> {
 
 impl Scan<'_> {
     /// Brings the active list to row `y`; false when it overflowed (the row must fall back).
-    fn advance(&mut self, y: u16) -> bool {
+    /// `changed` is set when the list changed.
+    fn advance(&mut self, y: u16, changed: &mut bool) -> bool {
+        let before = (self.live, self.next);
         // Drop the rectangles that ended above this row, keeping the rest packed.
         let mut kept = 0;
         for i in 0..self.live {
@@ -78,11 +81,16 @@ impl Scan<'_> {
             match self.active.get_mut(self.live) {
                 Some(slot) => *slot = *b,
                 // Left for a later row; this one falls back.
-                None => return false,
+                None => {
+                    *changed = true;
+                    return false;
+                }
             }
             self.live += 1;
             self.next += 1;
         }
+        // Rectangles only leave (fewer live) or enter (a later next).
+        *changed = (self.live, self.next) != before;
         self.complete
     }
 }
@@ -179,11 +187,14 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     /// Renders the frame in hybrid mode into `row` (length = the camera's width), handing each
     /// row to `sink`: the same rows as [`render`](Self::render). `bounds` holds the screen
     /// bounds (one per visible object), `active` the rectangles spanning a row; rows they cannot
-    /// serve fall back to the pure search ([`TraceStats::fallback_rows`]).
+    /// serve fall back to the pure search ([`TraceStats::fallback_rows`]). `shadow` holds a
+    /// row's shadow candidates (at most lights × objects entries); rows it cannot hold walk the
+    /// hierarchy for their shadow rays ([`TraceStats::shadow_fallback_rows`]).
     pub fn render_hybrid<P: RowPixel, S: RowSink<P>>(
         &self,
         bounds: &mut [ScreenBound],
         active: &mut [ScreenBound],
+        shadow: &mut [ShadowCandidate],
         row: &mut [P],
         sink: &mut S,
     ) -> Result<TraceStats, TraceError<S::Error>> {
@@ -193,6 +204,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         self.hybrid_frame(
             bounds,
             active,
+            shadow,
             &mut (row, sink),
             |(row, _), x, p| {
                 if let Some(pixel) = row.get_mut(usize::from(x)) {
@@ -218,6 +230,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         &self,
         bounds: &mut [ScreenBound],
         active: &mut [ScreenBound],
+        shadow: &mut [ShadowCandidate],
         context: &mut C,
         mut pixel: impl FnMut(&mut C, u16, &PixelTrace),
         mut row_done: impl FnMut(&mut C, u16, bool) -> Result<(), E>,
@@ -233,16 +246,29 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         let scene = self.scene();
         let mut cache = ShadowCache::new();
         let mut stats = TraceStats::default();
+        // The shadow lists are rebuilt only when the active list changes (`Some(None)`: this
+        // row's could not be built).
+        let mut lists: Option<Option<RowShadows<'_>>> = None;
+        let with_lists = !shadow.is_empty();
         for y in 0..self.camera().height {
             let dropped_before = stats.dropped_rays;
-            let scanned = scan.advance(y);
+            let mut changed = false;
+            let scanned = scan.advance(y, &mut changed);
+            let live = scan.active.get(..scan.live).unwrap_or(&[]);
             if !scanned {
                 stats.fallback_rows += 1;
+                // The lists name the active set they were built for: rebuilt after a fallback.
+                lists = None;
+            } else if with_lists && (changed || lists.is_none()) {
+                lists = Some(row_shadows(scene, live.iter().map(|b| b.object), shadow));
             }
-            let live = scan.active.get(..scan.live).unwrap_or(&[]);
+            let row_lists = lists.as_ref().and_then(Option::as_ref);
+            if scanned && row_lists.is_none() {
+                stats.shadow_fallback_rows += 1;
+            }
             for x in 0..self.camera().width {
                 let (p, s) = if scanned {
-                    self.trace_with(x, y, &mut cache, |ray, t_min, t_max, stats| {
+                    self.trace_with(x, y, &mut cache, row_lists, |ray, t_min, t_max, stats| {
                         let mut search = Nearest::new(u32::MAX, t_min, t_max);
                         for b in live {
                             if b.x0 <= x && x <= b.x1 {

@@ -368,6 +368,26 @@ impl Shape<'_> {
             Shape::Frustum(f) => frustum_normal(f, point),
         }
     }
+
+    /// The plane a planar primitive (plane, polygon, triangle) lies in, as its unit normal and
+    /// offset; `None` for the others.
+    #[inline]
+    pub(crate) fn plane(&self) -> Option<(Vec3, I16F16)> {
+        match self {
+            Shape::Plane(p) => Some((p.normal, p.offset)),
+            Shape::Polygon(p) => Some((p.facet.normal, p.facet.offset)),
+            Shape::Triangle(t) => Some((t.facet.normal, t.facet.offset)),
+            Shape::Box(_) | Shape::Sphere(_) | Shape::Ellipsoid(_) | Shape::Frustum(_) => None,
+        }
+    }
+}
+
+/// Whether `ray` meets the plane (unit normal, offset) at some `t` in `[t_min, t_max)`: the
+/// first step of every planar primitive's test, so a ray that does not meet a plane meets no
+/// plane, polygon or triangle lying in it (same normal and offset, bit for bit).
+#[inline]
+pub(crate) fn meets_plane(plane: (Vec3, I16F16), ray: &Ray, t_min: I16F16, t_max: I16F16) -> bool {
+    plane_t_in(plane.0, plane.1, ray, t_min, t_max).is_some()
 }
 
 /// The outward normal of the box face nearest `p`.

@@ -27,6 +27,7 @@
 use crate::depth::DepthRow;
 use crate::sink::{Row, RowPixel, RowSink};
 use crate::trace::intersect::{reflect, Ray};
+use crate::trace::row_shadow::{any_blocks, RowShadows, ShadowCandidate};
 use crate::trace::scene::{Colour, LightKind, Scene, TraceCamera, MAX_LIGHTS};
 use crate::trace::vector::{mul, narrow_bits, sqrt, Vec3};
 use embedded_graphics::pixelcolor::Rgb888;
@@ -83,6 +84,10 @@ pub struct TraceStats {
     /// Hybrid mode: rows whose primary visibility fell back to the pure tracer's search because
     /// the screen-bound buffer or the active list was full (same image, more work).
     pub fallback_rows: u16,
+    /// Hybrid mode: rows whose shadow rays all walked the hierarchy instead of the row's
+    /// candidate lists, because the candidate buffer was full or a visible object is
+    /// unbounded (same image, more work); rows counted in `fallback_rows` are not counted again.
+    pub shadow_fallback_rows: u16,
     /// Most pending rays on the stack at once.
     pub peak_stack: u16,
     /// Rows handed to the sink.
@@ -106,6 +111,7 @@ impl TraceStats {
         self.dropped_rays += o.dropped_rays;
         self.shadow_cache_hits += o.shadow_cache_hits;
         self.fallback_rows += o.fallback_rows;
+        self.shadow_fallback_rows += o.shadow_fallback_rows;
         self.peak_stack = self.peak_stack.max(o.peak_stack);
     }
 }
@@ -289,7 +295,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         row: u16,
         cache: &mut ShadowCache,
     ) -> (PixelTrace, TraceStats) {
-        self.trace_with(column, row, cache, |ray, t_min, t_max, stats| {
+        self.trace_with(column, row, cache, None, |ray, t_min, t_max, stats| {
             self.nearest(ray, u32::MAX, t_min, t_max, stats)
         })
     }
@@ -305,12 +311,16 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     }
 
     /// Traces pixel (`column`, `row`) with `first_hit` finding the primary ray's nearest hit in
-    /// `[t_min, t_max)`; everything after the primary hit is the same for every mode.
+    /// `[t_min, t_max)`; everything after the primary hit is the same for every mode, except
+    /// that with `row_shadows` the shadow rays starting in the row's region (those from the
+    /// primary hit, and from deeper hits that lie there) test the row's candidate lists instead
+    /// of walking the hierarchy (same answers).
     pub(crate) fn trace_with(
         &self,
         column: u16,
         row: u16,
         cache: &mut ShadowCache,
+        row_shadows: Option<&RowShadows<'_>>,
         mut first_hit: impl FnMut(&Ray, I16F16, I16F16, &mut TraceStats) -> Option<Hit>,
     ) -> (PixelTrace, TraceStats) {
         let mut stats = TraceStats {
@@ -357,7 +367,15 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             match hit {
                 None => add_weighted(&mut sum, &self.scene.background, ray.weight),
                 Some(hit) => {
-                    let shadow = self.shade(&ray, hit, &mut sum, &mut stack, cache, &mut stats);
+                    let shadow = self.shade(
+                        &ray,
+                        hit,
+                        &mut sum,
+                        &mut stack,
+                        cache,
+                        row_shadows,
+                        &mut stats,
+                    );
                     if is_primary {
                         out.id = Some(hit.object);
                         out.depth = hit.t.checked_div(len).unwrap_or(I16F16::MAX);
@@ -425,13 +443,15 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
 
     /// Whether any object lies along `ray` (which starts on object `from`) with `t` in
     /// `[EPSILON, t_max)`. `cached` is the light's entry in the shadow cache: tested first, and
-    /// set to the blocker found.
+    /// set to the blocker found. With `candidates` (hybrid mode, a shadow ray from the row's
+    /// region) only those are tested, else the scene's structure is walked.
     fn blocked(
         &self,
         ray: &Ray,
         from: u32,
         t_max: I16F16,
         cached: &mut u32,
+        candidates: Option<&[ShadowCandidate]>,
         stats: &mut TraceStats,
     ) -> bool {
         let mut tests = 1;
@@ -449,18 +469,21 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             }
             hit
         };
-        match (&self.scene.grid, &self.scene.bvh) {
-            (Some(grid), _) => {
+        match (candidates, &self.scene.grid, &self.scene.bvh) {
+            (Some(list), _, _) => {
+                let _ = any_blocks(self.scene, list, ray, EPSILON, t_max, &mut blocks);
+            }
+            (None, Some(grid), _) => {
                 if !grid.unbounded().iter().any(|id| blocks(*id)) {
                     stats.grid_cells += grid.walk(ray, EPSILON, t_max, |id, limit| {
                         (!blocks(id)).then_some(limit)
                     });
                 }
             }
-            (None, None) => {
+            (None, None, None) => {
                 let _ = (0..self.scene.objects.len() as u32).any(&mut blocks);
             }
-            (None, Some(bvh)) => {
+            (None, None, Some(bvh)) => {
                 if !bvh.unbounded().iter().any(|id| blocks(*id)) {
                     stats.box_tests += bvh.walk(ray, EPSILON, t_max, |id, limit| {
                         (!blocks(id)).then_some(limit)
@@ -481,6 +504,9 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
 
     /// Adds the local term at `hit` times the ray's weight to `sum`, pushes the reflected and
     /// refracted rays the rules allow, and returns the shadow mask at the hit.
+    // The per-pixel state a ray adds to (colour sum, ray stack, shadow cache, the row's
+    // shadow candidates, counts), each borrowed apart.
+    #[allow(clippy::too_many_arguments)]
     fn shade(
         &self,
         pending: &Pending,
@@ -488,6 +514,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         sum: &mut Colour,
         stack: &mut heapless::Vec<Pending, STACK>,
         cache: &mut ShadowCache,
+        row_shadows: Option<&RowShadows<'_>>,
         stats: &mut TraceStats,
     ) -> u8 {
         let scene = self.scene;
@@ -522,7 +549,9 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                     origin: point,
                     dir: towards,
                 };
-                !self.blocked(&shadow_ray, hit.object, distance, cached, stats)
+                let candidates =
+                    row_shadows.and_then(|r| r.for_ray(k, &light.kind, point, distance));
+                !self.blocked(&shadow_ray, hit.object, distance, cached, candidates, stats)
             };
             if lit {
                 diffuse = diffuse.saturating_add(mul(nl, light.intensity));

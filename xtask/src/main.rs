@@ -108,7 +108,7 @@ fn main() -> ExitCode {
             Some(result) => result,
             None => {
                 eprintln!(
-                    "usage: cargo xtask test | package | firmware | trace | metaball | metaball-trade | patch | patch-trade | lean | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | speed [before|after|doc] | fuzz [SECONDS]"
+                    "usage: cargo xtask test | package | firmware | trace | metaball | metaball-trade | patch | patch-trade | lean | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | profile trace [pure|hybrid] [TARGET] | speed [before|after|doc] | fuzz [SECONDS]"
                 );
                 return ExitCode::from(2);
             }
@@ -153,6 +153,18 @@ fn host_task(task: &str) -> Option<Result<(), String>> {
         "speed" => {
             let label = std::env::args().nth(2).unwrap_or_else(|| "after".into());
             install().and_then(|_| speed::speed(&label))
+        }
+        "profile" if std::env::args().nth(2).as_deref() == Some("trace") => {
+            let rest: Vec<String> = std::env::args().skip(3).collect();
+            let target = rest
+                .iter()
+                .find(|a| a.contains("-none-") || a.contains("-unknown-"))
+                .map_or("thumbv7em-none-eabihf", String::as_str);
+            let mode = rest
+                .iter()
+                .find(|a| a.as_str() != target)
+                .map_or("pure", String::as_str);
+            install().and_then(|_| profile::profile_trace(mode, target))
         }
         "profile" => {
             let variant = std::env::args().nth(2).unwrap_or_else(|| "balanced".into());

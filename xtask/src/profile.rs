@@ -6,7 +6,10 @@
 //! instructions per block. Prints the share of compiler built-ins (64-bit multiply and divide,
 //! memcpy), the top functions, and the top source lines of this repository, with the
 //! built-ins charged to the call site that entered them (`llvm-addr2line`; the release profile
-//! keeps debug info).
+//! keeps debug info). `cargo xtask profile trace [pure|hybrid] [TARGET]` does the same for the
+//! traced firmware's frame in one mode (thumbv7em unless a TARGET is named), and also prints per
+//! symbol the functions inlined into it (which separates, say, the shadow rays' walk in `shade`
+//! from the nearest-hit walk in `nearest`). The log goes through a named pipe, never to disk.
 
 use crate::tradeoff::{build_example_with_cfgs, run_on_qemu_with, CORPUS};
 use crate::{root, step};
@@ -73,28 +76,51 @@ fn is_builtin(name: &str) -> bool {
     name.starts_with("__") || name.contains("compiler_builtins")
 }
 
-/// The innermost frame of each address that lies in this repository's `src/` or `firmware/examples/`,
-/// as `path:line` (`llvm-addr2line -a -i`: an address line, then its inline chain, innermost
-/// first).
-fn source_lines(elf: &std::path::Path, addrs: &[u64]) -> Result<HashMap<u64, String>, String> {
+/// Per address, the innermost frame that lies in this repository's `src/` or
+/// `firmware/examples/`, as `path:line`, and the outermost function inlined at it (the one called
+/// in the symbol's own body; the symbol itself when nothing is inlined there)
+/// (`llvm-addr2line -a -f -i -C`: an address line, then function and `path:line` lines for its
+/// inline chain, innermost first).
+fn source_lines(
+    elf: &std::path::Path,
+    addrs: &[u64],
+) -> Result<HashMap<u64, (String, String)>, String> {
     let repo = root().to_string_lossy().into_owned() + "/";
-    let mut out = HashMap::new();
+    let mut out: HashMap<u64, (String, String)> = HashMap::new();
     for chunk in addrs.chunks(2000) {
         let text = Command::new("llvm-addr2line")
-            .args(["-a", "-i", "-e"])
+            .args(["-a", "-f", "-i", "-C", "-e"])
             .arg(elf)
             .args(chunk.iter().map(|a| format!("{a:#x}")))
             .output()
             .map_err(|e| format!("llvm-addr2line (install llvm): {e}"))?
             .stdout;
-        let mut current: Option<u64> = None;
-        for line in String::from_utf8_lossy(&text).lines() {
-            if let Some(hex) = line.strip_prefix("0x") {
-                current = u64::from_str_radix(hex, 16).ok();
-            } else if let (Some(a), Some(path)) = (current, line.strip_prefix(&repo)) {
-                if path.starts_with("src/") || path.starts_with("firmware/examples/") {
-                    out.entry(a).or_insert_with(|| path.to_string());
-                }
+        let text = String::from_utf8_lossy(&text);
+        let mut lines = text.lines().peekable();
+        while let Some(line) = lines.next() {
+            let Some(a) = line
+                .strip_prefix("0x")
+                .and_then(|hex| u64::from_str_radix(hex, 16).ok())
+            else {
+                continue;
+            };
+            // (function, path:line) pairs up to the next address line.
+            let mut chain: Vec<(&str, &str)> = Vec::new();
+            while lines.peek().is_some_and(|l| !l.starts_with("0x")) {
+                let function = lines.next().unwrap_or_default();
+                chain.push((function, lines.next().unwrap_or_default()));
+            }
+            let line = chain.iter().find_map(|(_, place)| {
+                place
+                    .strip_prefix(&repo)
+                    .filter(|p| p.starts_with("src/") || p.starts_with("firmware/examples/"))
+            });
+            let outermost = chain.len().checked_sub(2).or(chain.len().checked_sub(1));
+            let inlined = outermost.and_then(|i| chain.get(i)).map_or("?", |c| c.0);
+            if let Some(line) = line {
+                out.insert(a, (line.to_string(), inlined.to_string()));
+            } else {
+                out.insert(a, (String::new(), inlined.to_string()));
             }
         }
     }
@@ -133,39 +159,46 @@ pub fn profile(
     }
     let generated = scene.map(|_| (CORPUS, corpus_file.as_path()));
     let elf = build_example_with_cfgs("tradeoff", Some(target), &cfgs, generated)?;
-    let log = root().join("target/profile-trace.log");
-    step("run on QEMU, logging every executed block (a few GB, removed afterwards)");
-    let out = run_on_qemu_with(
-        target,
-        &elf,
-        &[
-            "-d".as_ref(),
-            "in_asm,exec,nochain".as_ref(),
-            "-D".as_ref(),
-            log.as_os_str(),
-        ],
-    )?;
-    let frame_lines: Vec<&str> = out
-        .lines()
-        .filter(|l| l.starts_with("variant ") || l.starts_with("corpus "))
-        .collect();
-    // Each frame's own count (SysTick or minstret, as `cargo xtask speed` reads it).
-    for line in &frame_lines {
-        println!("{line}");
+    profile_elf(target, &elf, variant, |l| {
+        l.starts_with("variant ") || l.starts_with("corpus ")
+    })
+}
+
+/// `cargo xtask profile trace [pure|hybrid] [TARGET]`: the traced firmware's frame in one mode
+/// alone (`--cfg scanline3d_trace_only`), profiled like a trade-off variant.
+pub fn profile_trace(mode: &str, target: &str) -> Result<(), String> {
+    if !["pure", "hybrid"].contains(&mode) {
+        return Err(format!("trace mode {mode:?}: pure or hybrid"));
     }
-    let frames = frame_lines.len();
-    step("count instructions per block, charging built-ins to the call site that entered them");
-    let syms = symbols(&elf)?;
-    let file = std::fs::File::open(&log).map_err(|e| format!("{}: {e}", log.display()))?;
-    // Block start -> (instructions, address of its last instruction); QEMU lists a block when it
-    // translates it, before it first runs.
-    let mut blocks: HashMap<u64, (u64, u64)> = HashMap::new();
+    step(&format!(
+        "traced firmware, {mode} frame alone, for {target}"
+    ));
+    let cfgs = [format!("scanline3d_trace_only=\"{mode}\"")];
+    let elf = build_example_with_cfgs("trace", Some(target), &cfgs, None)?;
+    profile_elf(target, &elf, &format!("trace {mode}"), |l| {
+        l.starts_with("frame ")
+    })
+}
+
+/// Per block start, its instruction count and last instruction; per executed block, its count.
+#[derive(Default)]
+struct Counts {
+    blocks: HashMap<u64, (u64, u64)>,
+    per_function: HashMap<u64, u64>,
+    per_site: HashMap<u64, u64>,
+    total: u64,
+    builtin: u64,
+}
+
+/// Reads QEMU's `-d in_asm,exec,nochain` log: each executed block's instructions, with the
+/// built-ins charged to the call site that entered them.
+fn count_blocks(log: impl BufRead, syms: &[(u64, u64, String)]) -> Result<Counts, String> {
+    // QEMU lists a block when it translates it, before it first runs.
+    let mut c = Counts::default();
     let mut builtin_of: HashMap<u64, bool> = HashMap::new();
-    let mut per_function: HashMap<u64, u64> = HashMap::new();
-    let mut per_site: HashMap<u64, u64> = HashMap::new();
-    let (mut total, mut builtin, mut caller) = (0u64, 0u64, 0u64);
+    let mut caller = 0u64;
     let mut listing: Option<u64> = None;
-    for line in std::io::BufReader::new(file).lines() {
+    for line in log.lines() {
         let line = line.map_err(|e| e.to_string())?;
         if let Some(rest) = line.strip_prefix("Trace ") {
             let Some(pc) = rest
@@ -175,18 +208,18 @@ pub fn profile(
             else {
                 continue;
             };
-            let (len, last) = blocks.get(&pc).copied().unwrap_or((1, pc));
+            let (len, last) = c.blocks.get(&pc).copied().unwrap_or((1, pc));
             let is_builtin = *builtin_of
                 .entry(pc)
-                .or_insert_with(|| is_builtin(name_of(&syms, pc)));
-            total += len;
-            *per_function.entry(pc).or_default() += len;
+                .or_insert_with(|| is_builtin(name_of(syms, pc)));
+            c.total += len;
+            *c.per_function.entry(pc).or_default() += len;
             if is_builtin {
-                builtin += len;
+                c.builtin += len;
             } else {
                 caller = last;
             }
-            *per_site.entry(caller).or_default() += len;
+            *c.per_site.entry(caller).or_default() += len;
         } else if line.starts_with("IN:") || line.trim().is_empty() {
             listing = None;
         } else if let Some(addr) = line
@@ -195,18 +228,70 @@ pub fn profile(
             .and_then(|a| u64::from_str_radix(a, 16).ok())
         {
             let start = *listing.get_or_insert(addr);
-            let b = blocks.entry(start).or_insert((0, addr));
+            let b = c.blocks.entry(start).or_insert((0, addr));
             *b = (b.0 + 1, addr);
         }
     }
-    std::fs::remove_file(&log).map_err(|e| e.to_string())?;
+    Ok(c)
+}
+
+/// Runs `elf` on QEMU with every executed block logged into a named pipe that is read as QEMU
+/// writes it (no multi-gigabyte file), and prints the output lines `frame_line` picks, the share
+/// of compiler built-ins, the top functions, the top source lines and the functions inlined
+/// into each symbol.
+fn profile_elf(
+    target: &str,
+    elf: &std::path::Path,
+    what: &str,
+    frame_line: impl Fn(&str) -> bool,
+) -> Result<(), String> {
+    let fifo = root().join("target/profile-trace.fifo");
+    let _ = std::fs::remove_file(&fifo);
+    let made = Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .map_err(|e| format!("mkfifo: {e}"))?;
+    if !made.success() {
+        return Err(format!("mkfifo {} failed", fifo.display()));
+    }
+    let syms = symbols(elf)?;
+    step("run on QEMU, counting every executed block as QEMU logs it");
+    let counts = std::thread::scope(|scope| {
+        let reader = scope.spawn(|| {
+            let file = std::fs::File::open(&fifo).map_err(|e| format!("{}: {e}", fifo.display()))?;
+            count_blocks(std::io::BufReader::with_capacity(1 << 20, file), &syms)
+        });
+        let out = run_on_qemu_with(
+            target,
+            elf,
+            &[
+                "-d".as_ref(),
+                "in_asm,exec,nochain".as_ref(),
+                "-D".as_ref(),
+                fifo.as_os_str(),
+            ],
+        );
+        let counts = reader
+            .join()
+            .map_err(|_| "the log reader panicked".to_string())?;
+        Ok::<_, String>((out?, counts?))
+    });
+    std::fs::remove_file(&fifo).map_err(|e| e.to_string())?;
+    let (out, c) = counts?;
+    let frame_lines: Vec<&str> = out.lines().filter(|l| frame_line(l)).collect();
+    // Each frame's own count (SysTick or minstret, as the firmware reads it).
+    for line in &frame_lines {
+        println!("{line}");
+    }
+    let frames = frame_lines.len();
+    let total = c.total;
     println!(
-        "\n{frames} frames of `{variant}` on {target}: {total} instructions ({} a frame, set-up and output included), {:.1} % of them in compiler built-ins (software 64-bit multiply and divide, memcpy, ...)",
+        "\n{frames} frames of `{what}` on {target}: {total} instructions ({} a frame, set-up and output included), {:.1} % of them in compiler built-ins (software 64-bit multiply and divide, memcpy, ...)",
         total / frames.max(1) as u64,
-        percent(builtin, total)
+        percent(c.builtin, total)
     );
     let mut functions: HashMap<&str, u64> = HashMap::new();
-    for (pc, n) in &per_function {
+    for (pc, n) in &c.per_function {
         *functions.entry(name_of(&syms, *pc)).or_default() += n;
     }
     let mut functions: Vec<_> = functions.into_iter().collect();
@@ -219,14 +304,22 @@ pub fn profile(
             &name[..name.len().min(100)]
         );
     }
-    let sites: Vec<u64> = per_site.keys().copied().collect();
-    let lines = source_lines(&elf, &sites)?;
+    let sites: Vec<u64> = c.per_site.keys().copied().collect();
+    let lines = source_lines(elf, &sites)?;
     let mut by_line: HashMap<&str, u64> = HashMap::new();
-    for (site, n) in &per_site {
-        let line = lines
-            .get(site)
-            .map_or("(no line in src/ or firmware/examples/)", String::as_str);
+    let mut by_inlined: HashMap<String, u64> = HashMap::new();
+    for (site, n) in &c.per_site {
+        let (line, inlined) = lines.get(site).map_or(("", "?"), |(l, f)| (l.as_str(), f.as_str()));
+        let line = if line.is_empty() {
+            "(no line in src/ or firmware/examples/)"
+        } else {
+            line
+        };
         *by_line.entry(line).or_default() += n;
+        let symbol = short_name(name_of(&syms, *site));
+        *by_inlined
+            .entry(format!("{symbol} > {}", short_name(inlined)))
+            .or_default() += n;
     }
     let mut by_line: Vec<_> = by_line.into_iter().collect();
     by_line.sort_by_key(|l| std::cmp::Reverse(l.1));
@@ -234,5 +327,29 @@ pub fn profile(
     for (line, n) in by_line.iter().take(40) {
         println!("{:6.2} %  {line}", percent(*n, total));
     }
+    let mut by_inlined: Vec<_> = by_inlined.into_iter().collect();
+    by_inlined.sort_by_key(|l| std::cmp::Reverse(l.1));
+    println!("\nsymbol > the function inlined into it that the instruction comes from (the outermost inlined call), with the built-ins they call:");
+    for (name, n) in by_inlined.iter().take(30) {
+        println!("{:6.2} %  {name}", percent(*n, total));
+    }
     Ok(())
+}
+
+/// A symbol without its hash and crate path: `Tracer<_>::shade`.
+fn short_name(name: &str) -> String {
+    let name = name.rsplit_once("::h").map_or(name, |(n, h)| {
+        if h.len() == 16 && h.chars().all(|c| c.is_ascii_hexdigit()) {
+            n
+        } else {
+            name
+        }
+    });
+    name.replace("scanline3d::trace::", "")
+        .replace("_$LT$", "<")
+        .replace("$LT$", "<")
+        .replace("$GT$", ">")
+        .replace("$u20$", " ")
+        .replace("$u7b$", "{")
+        .replace("$u7d$", "}")
 }

@@ -15,7 +15,8 @@ use scanline3d::trace::grid::{self, GridShape};
 use scanline3d::trace::shape::{AaBox, Ellipsoid, Facet, Frustum};
 use scanline3d::trace::{
     Colour, Light, LightKind, Material, Object, PixelTrace, Plane, Polygon, Scene, ScreenBound,
-    ShadowCache, Shape, Sphere, TraceCamera, TraceOptions, TraceStats, Tracer, Triangle, Vec3,
+    ShadowCache, ShadowCandidate, Shape, Sphere, TraceCamera, TraceOptions, TraceStats, Tracer,
+    Triangle, Vec3,
 };
 
 /// Ray-stack capacity of the host's fixed tracer: room for `--max-depth` up to 31.
@@ -380,9 +381,11 @@ pub fn render(
         if hybrid {
             let mut bounds = vec![ScreenBound::default(); count];
             let mut active = vec![ScreenBound::default(); count];
+            let mut shadow = vec![ShadowCandidate::default(); scene.lights.len() * count];
             let stats = tracer.hybrid_frame(
                 &mut bounds,
                 &mut active,
+                &mut shadow,
                 &mut frame,
                 |frame, _, p| push(frame, p),
                 |_, _, _| Ok::<(), std::convert::Infallible>(()),
@@ -428,7 +431,8 @@ pub fn frame_hash(
         let stats = if hybrid {
             let mut bounds = vec![ScreenBound::default(); count];
             let mut active = vec![ScreenBound::default(); count];
-            tracer.render_hybrid(&mut bounds, &mut active, &mut row, &mut sink)
+            let mut shadow = vec![ShadowCandidate::default(); scene.lights.len() * count];
+            tracer.render_hybrid(&mut bounds, &mut active, &mut shadow, &mut row, &mut sink)
         } else {
             tracer.render(&mut row, &mut sink)
         };

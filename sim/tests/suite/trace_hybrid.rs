@@ -5,7 +5,7 @@
 use crate::run::{scratch, sim};
 use embedded_graphics::pixelcolor::Rgb565;
 use scanline3d::sink::HashSink;
-use scanline3d::trace::{ScreenBound, TraceOptions, Tracer};
+use scanline3d::trace::{ScreenBound, ShadowCandidate, TraceOptions, Tracer};
 use scanline3d_sim::trace::{corpus, fixed};
 
 const SIZE: usize = 64;
@@ -44,7 +44,7 @@ fn hybrid_mode_gives_the_pure_tracers_images_on_every_corpus_scene() {
                         || pure.depth[*i].to_bits() != hybrid.depth[*i].to_bits()
                 })
                 .collect();
-            fixed_scene
+            let unbounded = fixed_scene
                 .with_scene(fixed::Accel::None, |every| {
                     let tracer = Tracer::<32>::new(every, &camera, options);
                     for i in &differ {
@@ -54,6 +54,10 @@ fn hybrid_mode_gives_the_pure_tracers_images_on_every_corpus_scene() {
                         assert_eq!(id, hybrid.ids[*i], "{what} ({x}, {y})");
                         assert_ne!(id, pure.ids[*i], "{what} ({x}, {y}): unexplained");
                     }
+                    every
+                        .objects
+                        .iter()
+                        .any(|o| matches!(o.shape, scanline3d::trace::Shape::Plane(_)))
                 })
                 .unwrap();
             assert!(differ.len() <= 2, "{what}: {} pixels differ", differ.len());
@@ -63,6 +67,12 @@ fn hybrid_mode_gives_the_pure_tracers_images_on_every_corpus_scene() {
                 (p.primary_rays, 0),
                 "{what}"
             );
+            // Without an unbounded object every row's first hits are bounded, and the buffer
+            // (lights × objects) holds every row's shadow candidates: the shadow masks and
+            // colours compared above came from the lists (a directional light in `diamond`).
+            // With a plane in view every row's shadow rays walk the hierarchy.
+            let expected = if unbounded { SIZE as u16 } else { 0 };
+            assert_eq!(h.shadow_fallback_rows, expected, "{what}");
             let work = |s: &scanline3d::trace::TraceStats| s.intersection_tests + s.box_tests;
             eprintln!(
                 "{what}: {} pixels differ; tests + box tests per frame {} pure, {} hybrid",
@@ -121,28 +131,42 @@ fn full_hybrid_buffers_are_reported_and_change_no_pixel() {
     fixed_scene
         .with_scene(fixed::Accel::Bvh, |scene| {
             let tracer = Tracer::<8>::new(scene, &camera, TraceOptions::default());
-            let hash = |bounds: usize, active: usize| {
+            let lists = scene.lights.len() * scene.objects.len();
+            let hash = |bounds: usize, active: usize, shadow: usize| {
                 let mut row = vec![Rgb565::new(0, 0, 0); w.into()];
                 let mut sink = HashSink::new();
                 let mut b = vec![ScreenBound::default(); bounds];
                 let mut a = vec![ScreenBound::default(); active];
+                let mut c = vec![ShadowCandidate::default(); shadow];
                 let stats = tracer
-                    .render_hybrid(&mut b, &mut a, &mut row, &mut sink)
+                    .render_hybrid(&mut b, &mut a, &mut c, &mut row, &mut sink)
                     .unwrap();
-                (sink.hash(), stats.fallback_rows)
+                (sink.hash(), stats.fallback_rows, stats.shadow_fallback_rows)
             };
             let mut pure = HashSink::new();
             let mut row = vec![Rgb565::new(0, 0, 0); w.into()];
             tracer.render(&mut row, &mut pure).unwrap();
             let n = scene.objects.len();
-            assert_eq!(hash(n, n), (pure.hash(), 0));
-            assert_eq!(hash(1, n), (pure.hash(), h), "no room for every bound");
-            let (same, fallback) = hash(n, 4);
+            assert_eq!(hash(n, n, lists), (pure.hash(), 0, 0));
+            assert_eq!(
+                hash(1, n, lists),
+                (pure.hash(), h, 0),
+                "no room for every bound"
+            );
+            let (same, fallback, _) = hash(n, 4, lists);
             assert_eq!(same, pure.hash());
             assert!(fallback > 0 && fallback < h, "{fallback} rows fell back");
+            // Shadow candidate lists: none, and too short for the rows that see many objects.
+            assert_eq!(hash(n, n, 0), (pure.hash(), 0, h), "no candidate buffer");
+            let (same, _, shadow_fallback) = hash(n, n, 8);
+            assert_eq!(same, pure.hash());
+            assert!(
+                shadow_fallback > 0 && shadow_fallback < h,
+                "{shadow_fallback} rows walked the hierarchy for their shadow rays"
+            );
             let mut short = vec![Rgb565::new(0, 0, 0); usize::from(w) - 1];
             assert!(tracer
-                .render_hybrid(&mut [], &mut [], &mut short, &mut HashSink::new())
+                .render_hybrid(&mut [], &mut [], &mut [], &mut short, &mut HashSink::new())
                 .is_err());
         })
         .unwrap();
