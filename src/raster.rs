@@ -453,11 +453,6 @@ fn round_div(n: i128, d: i64) -> i128 {
 pub struct DepthPlane {
     origin: PixelOrigin,
     q: Plane,
-    /// The plane at column 0 of the row a walk is on ([`Self::on_row`], [`Self::next_row`]):
-    /// `q` there, wrapping like [`PixelOrigin::at`], so a span's start takes one multiply.
-    row_q: i64,
-    /// The per-pixel step in [`Depth`] bits, as [`Self::span_start`] gives it.
-    dq: i32,
 }
 
 /// Extra fractional bits of the depth plane over [`Depth`].
@@ -470,43 +465,24 @@ impl DepthPlane {
             v.each_ref().map(|s| s.q.to_bits() as i64),
             DEPTH_PLANE_EXTRA_BITS,
         );
-        Self::from_plane(solver.origin(), q)
-    }
-
-    fn from_plane(origin: PixelOrigin, q: Plane) -> Self {
-        let dq = q.dx >> DEPTH_PLANE_EXTRA_BITS;
         DepthPlane {
-            origin,
+            origin: solver.origin(),
             q,
-            row_q: 0,
-            dq: dq.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
         }
     }
 
-    /// The plane set on row `r` for [`Self::walk_span_start`].
-    ///
-    /// `row_q = value − dx·c_ref + dy·(r − r_ref)` in wrapping (mod 2^64) arithmetic, so
-    /// `row_q + dx·c` is [`PixelOrigin::at`]'s `value + dx·(c − c_ref) + dy·(r − r_ref)` to the
-    /// bit, and adding `dy` moves it one row down.
+    /// The plane walked down the rows from row `r` ([`WalkDepth`]).
     #[inline]
-    pub fn on_row(mut self, r: i32) -> Self {
-        self.row_q = self.origin.at(&self.q, 0, r);
-        self
-    }
-
-    /// Moves [`Self::walk_span_start`] one row down.
-    #[inline]
-    pub fn next_row(&mut self) {
-        self.row_q = self.row_q.wrapping_add(self.q.dy);
-    }
-
-    /// [`Self::span_start`] for the span starting at column `c` of the row the walk is on
-    /// (set by [`Self::on_row`], then [`Self::next_row`] once a row): the same values, with one
-    /// multiply instead of two.
-    #[inline]
-    pub fn walk_span_start(&self, c: i32) -> (i32, i32) {
-        let q = self.row_q.wrapping_add(self.q.dx.wrapping_mul(c as i64)) >> DEPTH_PLANE_EXTRA_BITS;
-        (q.clamp(0, i32::MAX as i64) as i32, self.dq)
+    pub fn walk_from(&self, r: i32) -> WalkDepth {
+        WalkDepth {
+            origin: self.origin,
+            // `row_q = value − dx·c_ref + dy·(r − r_ref)`, wrapping (mod 2^64) as
+            // `PixelOrigin::at` does, so `row_q + dx·c` is its value at `(c, r)` to the bit.
+            q: Plane {
+                value: self.origin.at(&self.q, 0, r),
+                ..self.q
+            },
+        }
     }
 
     /// Start value and per-pixel step, in [`Depth`] bits, for the span starting at `(c, r)`.
@@ -516,7 +492,7 @@ impl DepthPlane {
     #[inline]
     pub fn span_start(&self, c: i32, r: i32) -> (i32, i32) {
         let q = self.origin.at(&self.q, c, r) >> DEPTH_PLANE_EXTRA_BITS;
-        (q.clamp(0, i32::MAX as i64) as i32, self.dq)
+        (q.clamp(0, i32::MAX as i64) as i32, depth_step(&self.q))
     }
 
     /// The reference pixel, shared with the triangle's colour planes.
@@ -529,6 +505,51 @@ impl DepthPlane {
     pub fn depth_at(&self, c: i32, r: i32) -> Depth {
         let q = self.origin.at(&self.q, c, r) >> DEPTH_PLANE_EXTRA_BITS;
         Depth::from_bits(q.clamp(i32::MIN as i64, i32::MAX as i64) as i32)
+    }
+}
+
+/// The per-pixel step of depth plane `q` in [`Depth`] bits, saturated at ±2^31.
+#[inline]
+fn depth_step(q: &Plane) -> i32 {
+    let dq = q.dx >> DEPTH_PLANE_EXTRA_BITS;
+    dq.clamp(i32::MIN as i64, i32::MAX as i64) as i32
+}
+
+/// A [`DepthPlane`] walked down a triangle's rows: the plane's value is kept at column 0 of
+/// the walk's current row, so a span's start takes one multiply instead of two, with the same
+/// result as [`DepthPlane::span_start`] to the bit.
+#[derive(Clone, Copy, Debug)]
+pub struct WalkDepth {
+    origin: PixelOrigin,
+    /// `value`: the plane at column 0 of the current row.
+    q: Plane,
+}
+
+impl WalkDepth {
+    /// Moves one row down.
+    #[inline]
+    pub fn next_row(&mut self) {
+        self.q.value = self.q.value.wrapping_add(self.q.dy);
+    }
+
+    /// [`DepthPlane::span_start`]'s start for the span starting at column `c` of the current
+    /// row.
+    #[inline]
+    pub fn span_start(&self, c: i32) -> i32 {
+        let q = self.q.value.wrapping_add(self.q.dx.wrapping_mul(c as i64));
+        (q >> DEPTH_PLANE_EXTRA_BITS).clamp(0, i32::MAX as i64) as i32
+    }
+
+    /// [`DepthPlane::span_start`]'s per-pixel step (the same on every row: callers keep it).
+    #[inline]
+    pub fn step(&self) -> i32 {
+        depth_step(&self.q)
+    }
+
+    /// The reference pixel, shared with the triangle's colour planes.
+    #[inline]
+    pub fn origin(&self) -> &PixelOrigin {
+        &self.origin
     }
 }
 
@@ -996,7 +1017,8 @@ mod tests {
         // Vertices on pixel centres so the plane is sampled exactly there.
         let v = [sv(8, 8, 0.5), sv(8 + 160, 8, 0.25), sv(8, 8 + 160, 1.0)];
         let p = DepthPlane::new(&PlaneSolver::new(&v).unwrap(), &v);
-        assert_eq!(p.on_row(3).walk_span_start(2), p.span_start(2, 3));
+        let walk = p.walk_from(3);
+        assert_eq!((walk.span_start(2), walk.step()), p.span_start(2, 3));
         assert_eq!(p.depth_at(0, 0), Depth::from_num(0.5));
         assert!((p.depth_at(10, 0).to_num::<f64>() - 0.25).abs() < 1e-8);
         assert!((p.depth_at(0, 10).to_num::<f64>() - 1.0).abs() < 1e-8);
@@ -1007,7 +1029,7 @@ mod tests {
     }
 
     #[test]
-    fn walk_span_start_equals_span_start() {
+    fn walked_span_start_equals_span_start() {
         // Planes of any value and gradients (wrapping included), stepped down 40 rows from a
         // random first row, against the direct evaluation at every column tried.
         let mut x = 0x2545_f491_4f6c_dd1du64;
@@ -1029,13 +1051,14 @@ mod tests {
             let origin =
                 PixelOrigin::new((next() % 4096) as i32 - 2048, (next() % 4096) as i32 - 2048);
             let first = (next() % 2048) as i32;
-            let mut walk = DepthPlane::from_plane(origin, q).on_row(first);
+            let plane = DepthPlane { origin, q };
+            let mut walk = plane.walk_from(first);
             for row in first..first + 40 {
                 for _ in 0..4 {
                     let c = (next() % 2048) as i32;
                     assert_eq!(
-                        walk.walk_span_start(c),
-                        walk.span_start(c, row),
+                        (walk.span_start(c), walk.step()),
+                        plane.span_start(c, row),
                         "case {case} row {row} column {c}"
                     );
                 }

@@ -22,6 +22,7 @@ use crate::options::RenderOptions;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{
     color_channels, first_row_xy, signed_area_xy, xy, DepthPlane, PlaneSolver, TriangleWalk,
+    WalkDepth,
 };
 use crate::scene::{Instance, MeshColors, Scene, MAX_SCENE_TRIANGLES};
 use crate::shading::{Shading, SpanDepth};
@@ -37,7 +38,10 @@ use heapless::{Vec, VecView};
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct ActiveTri<T, K = ()> {
     pub(crate) walk: TriangleWalk,
-    pub(crate) depth: DepthPlane,
+    pub(crate) depth: WalkDepth,
+    /// `depth`'s per-pixel step ([`WalkDepth::step`]), kept here rather than in `depth`, whose
+    /// 8-byte alignment would pad it to 8 bytes.
+    pub(crate) depth_step: i32,
     pub(crate) payload: T,
     pub(crate) key: K,
     /// The slot of the next triangle in drawing order, or of the next free slot
@@ -230,7 +234,7 @@ pub(crate) fn fill_span<P: RowPixel, S: Shading, Z: DepthFormat, K>(
 ) -> u32 {
     // The walk keeps the plane on row `y` (`ActiveTri::advance`).
     debug_assert_eq!(y, t.walk.row(), "internal error: span off the walk's row");
-    let (q, dq) = t.depth.walk_span_start(l);
+    let (q, dq) = (t.depth.span_start(l), t.depth_step);
     let span = SpanDepth { x0: l, y, q, dq };
     let (l, r) = (l as usize, r as usize);
     // One test for both rows (which then need none of their own), and slices of one length,
@@ -916,9 +920,11 @@ pub(crate) fn walk_rows<
                         debug_assert!(false, "internal error: piece of {id} not walkable");
                         return;
                     };
+                    let depth = DepthPlane::new(&solver, &s).walk_from(walk.row());
                     let mut tri_state = ActiveTri {
                         walk,
-                        depth: DepthPlane::new(&solver, &s).on_row(walk.row()),
+                        depth,
+                        depth_step: depth.step(),
                         payload: S::payload::<P, SUB>(face, id, &solver, &s),
                         key: R::Key::from_raw(key),
                         link: NO_LINK,
