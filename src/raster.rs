@@ -196,12 +196,6 @@ impl TriangleWalk {
         self.end_row as i32
     }
 
-    /// Whether the walk is past its last row (after [`Self::advance`] returned `false`).
-    #[inline]
-    pub fn is_done(&self) -> bool {
-        self.row >= self.end_row
-    }
-
     /// Moves to the next row; `false` when the triangle is finished.
     #[inline]
     pub fn advance<const S: u32>(&mut self) -> bool {
