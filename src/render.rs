@@ -22,6 +22,7 @@ use crate::options::RenderOptions;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{
     color_channels, first_row_xy, signed_area_xy, xy, DepthPlane, PlaneSolver, TriangleWalk,
+    WalkDepth,
 };
 use crate::scene::{Instance, MeshColors, Scene, MAX_SCENE_TRIANGLES};
 use crate::shading::{Shading, SpanDepth};
@@ -37,9 +38,130 @@ use heapless::{Vec, VecView};
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct ActiveTri<T, K = ()> {
     pub(crate) walk: TriangleWalk,
-    pub(crate) depth: DepthPlane,
+    pub(crate) depth: WalkDepth,
+    /// `depth`'s per-pixel step ([`WalkDepth::step`]), kept here rather than in `depth`, whose
+    /// 8-byte alignment would pad it to 8 bytes.
+    pub(crate) depth_step: i32,
     pub(crate) payload: T,
     pub(crate) key: K,
+    /// The slot of the next triangle in drawing order, or of the next free slot
+    /// ([`ActiveList`]); [`NO_LINK`] at the end.
+    link: u16,
+}
+
+impl<T, K> ActiveTri<T, K> {
+    /// Moves the walk and the depth plane's row to the next row; `false` when the triangle is
+    /// finished.
+    #[inline(always)]
+    fn advance<const SUB: u32>(&mut self) -> bool {
+        let more = self.walk.advance::<SUB>();
+        self.depth.next_row();
+        more
+    }
+}
+
+/// End of an [`ActiveList`] chain.
+const NO_LINK: u16 = u16::MAX;
+
+/// The active triangles in drawing order, as a chain through their slots: a triangle stays in
+/// its slot from activation to its last row, and a finished one is unlinked and its slot
+/// reused, so none is ever moved (a record is about 100 bytes). The order decides exact depth
+/// ties (the triangle drawn first keeps the pixel): activation order, or the sort key's.
+struct ActiveList<'a, T, K> {
+    slots: &'a mut VecView<ActiveTri<T, K>>,
+    head: u16,
+    tail: u16,
+    /// Slots of finished triangles, chained by their links.
+    free: u16,
+    live: usize,
+}
+
+impl<'a, T, K: SortKey> ActiveList<'a, T, K> {
+    fn new(slots: &'a mut VecView<ActiveTri<T, K>>) -> Self {
+        slots.clear();
+        ActiveList {
+            slots,
+            head: NO_LINK,
+            tail: NO_LINK,
+            free: NO_LINK,
+            live: 0,
+        }
+    }
+
+    /// Sets slot `slot`'s link (slots on a chain exist).
+    #[inline(always)]
+    fn set_link(&mut self, slot: u16, link: u16) {
+        match self.slots.get_mut(slot as usize) {
+            Some(t) => t.link = link,
+            None => debug_assert!(false, "internal error: no active slot {slot}"),
+        }
+    }
+
+    /// Adds `t` after every triangle on the list (with `K::SORTED`, before the first whose
+    /// key is not below its own); `false` if the list is full.
+    fn insert(&mut self, mut t: ActiveTri<T, K>) -> bool {
+        let (mut prev, mut next) = (self.tail, NO_LINK);
+        if K::SORTED {
+            // Far to near; among equal keys the one activated first is drawn last.
+            (prev, next) = (NO_LINK, self.head);
+            while let Some(a) = self.slots.get(next as usize) {
+                if a.key >= t.key {
+                    break;
+                }
+                (prev, next) = (next, a.link);
+            }
+        }
+        t.link = next;
+        let slot = match self.slots.get_mut(self.free as usize) {
+            Some(free) => {
+                let slot = self.free;
+                self.free = free.link;
+                *free = t;
+                slot
+            }
+            None => match u16::try_from(self.slots.len()) {
+                Ok(slot) if slot != NO_LINK && self.slots.push(t).is_ok() => slot,
+                _ => return false,
+            },
+        };
+        if prev == NO_LINK {
+            self.head = slot;
+        } else {
+            self.set_link(prev, slot);
+        }
+        if next == NO_LINK {
+            self.tail = slot;
+        }
+        self.live += 1;
+        true
+    }
+
+    /// Calls `f(triangle, order)` for each triangle in drawing order (`order` counting from 0)
+    /// and takes off the list those for which it returns `false`.
+    #[inline(always)]
+    fn retain(&mut self, mut f: impl FnMut(&mut ActiveTri<T, K>, usize) -> bool) {
+        let (mut prev, mut slot, mut order) = (NO_LINK, self.head, 0);
+        while let Some(t) = self.slots.get_mut(slot as usize) {
+            let next = t.link;
+            if f(t, order) {
+                order += 1;
+                prev = slot;
+            } else {
+                t.link = self.free;
+                self.free = slot;
+                self.live -= 1;
+                if prev == NO_LINK {
+                    self.head = next;
+                } else {
+                    self.set_link(prev, next);
+                }
+                if next == NO_LINK {
+                    self.tail = prev;
+                }
+            }
+            slot = next;
+        }
+    }
 }
 
 /// A per-triangle sort key: `u32` for depth sorting, `()` where the order is activation order.
@@ -110,7 +232,9 @@ pub(crate) fn fill_span<P: RowPixel, S: Shading, Z: DepthFormat, K>(
     depth: &mut [Z],
     pixels: &mut [P],
 ) -> u32 {
-    let (q, dq) = t.depth.span_start(l, y);
+    // The walk keeps the plane on row `y` (`ActiveTri::advance`).
+    debug_assert_eq!(y, t.walk.row(), "internal error: span off the walk's row");
+    let (q, dq) = (t.depth.span_start(l), t.depth_step);
     let span = SpanDepth { x0: l, y, q, dq };
     let (l, r) = (l as usize, r as usize);
     // One test for both rows (which then need none of their own), and slices of one length,
@@ -769,23 +893,17 @@ pub(crate) fn walk_rows<
     mut stats: FrameStats,
 ) -> Result<FrameStats, RenderError<K::Error>> {
     let band = resolve.band_rows().max(1);
-    active.clear();
+    let mut active = ActiveList::new(active);
     // Last row covered by any dropped piece so far: rows up to it are incomplete.
     let mut lost_until = -1i32;
-    // One row at a time, finished triangles stay in the list, marked done, until they are as
-    // many as the rest (or room is needed): removing each at once would move every triangle
-    // behind it, about 100 bytes each, on every row where one ends.
-    let mut done = 0usize;
     let mut y0 = 0usize;
     while y0 < height {
         let y1 = (y0 + band).min(height);
         resolve.begin_band(y0 as i32, y1 - y0);
         if band > 1 {
             // Triangles carried over from earlier bands come first, in activation order.
-            let mut order = 0;
-            active.retain_mut(|t| {
-                order += 1;
-                walk_band::<P, S, SUB, R>(t, order - 1, y1 as i32, width, resolve, &mut stats)
+            active.retain(|t, order| {
+                walk_band::<P, S, SUB, R>(t, order, y1 as i32, width, resolve, &mut stats)
             });
         }
         for row in y0..y1 {
@@ -802,22 +920,21 @@ pub(crate) fn walk_rows<
                         debug_assert!(false, "internal error: piece of {id} not walkable");
                         return;
                     };
+                    let depth = DepthPlane::new(&solver, &s).walk_from(walk.row());
                     let mut tri_state = ActiveTri {
                         walk,
-                        depth: DepthPlane::new(&solver, &s),
+                        depth,
+                        depth_step: depth.step(),
                         payload: S::payload::<P, SUB>(face, id, &solver, &s),
                         key: R::Key::from_raw(key),
+                        link: NO_LINK,
                     };
                     let (first_row, last_row) =
                         (tri_state.walk.row(), tri_state.walk.end_row() - 1);
-                    if band == 1 && active.is_full() && done > 0 {
-                        active.retain(|t| !t.walk.is_done());
-                        done = 0;
-                    }
                     let kept = if R::BANDED && band > 1 {
                         // Band z-buffer: draw it into the band now; keep it only if it reaches
                         // the next band (so a full z-buffer keeps nothing).
-                        let order = active.len();
+                        let order = active.live;
                         !walk_band::<P, S, SUB, R>(
                             &mut tri_state,
                             order,
@@ -825,11 +942,9 @@ pub(crate) fn walk_rows<
                             width,
                             resolve,
                             &mut stats,
-                        ) || active.push(tri_state).is_ok()
-                    } else if <R::Key as SortKey>::SORTED {
-                        insert_sorted(active, tri_state)
+                        ) || active.insert(tri_state)
                     } else {
-                        active.push(tri_state).is_ok()
+                        active.insert(tri_state)
                     };
                     if kept {
                         stats.activated += 1;
@@ -850,25 +965,14 @@ pub(crate) fn walk_rows<
                 });
             }
             if band == 1 {
-                let live = active.len() - done;
-                stats.peak_active = stats.peak_active.max(live as u16);
-                // `order` is the place in the list: it grows with activation order, done
-                // triangles only leave gaps.
-                for (order, t) in active.iter_mut().enumerate() {
-                    if !t.walk.is_done()
-                        && !walk_band::<P, S, SUB, R>(t, order, y + 1, width, resolve, &mut stats)
-                    {
-                        done += 1;
-                    }
-                }
-                if done > 0 && done >= active.len() - done {
-                    active.retain(|t| !t.walk.is_done());
-                    done = 0;
-                }
+                stats.peak_active = stats.peak_active.max(active.live as u16);
+                active.retain(|t, order| {
+                    walk_band::<P, S, SUB, R>(t, order, y + 1, width, resolve, &mut stats)
+                });
             }
         }
         if band > 1 {
-            stats.peak_active = stats.peak_active.max(active.len() as u16);
+            stats.peak_active = stats.peak_active.max(active.live as u16);
         }
 
         for row in y0..y1 {
@@ -896,14 +1000,6 @@ pub(crate) fn walk_rows<
     Ok(stats)
 }
 
-/// Puts a newly set-up triangle on a depth-sorted active list, before the first nearer one,
-/// so the list stays sorted far to near and, among equal keys, the triangle activated first is
-/// drawn last and keeps the pixel (the same tie rule as the z-buffers). `false` if it is full.
-fn insert_sorted<T, K: SortKey>(active: &mut VecView<ActiveTri<T, K>>, t: ActiveTri<T, K>) -> bool {
-    let at = active.partition_point(|a| a.key < t.key);
-    active.insert(at, t).is_ok()
-}
-
 /// Walks triangle `t` down to row `y1` (exclusive), handing each on-screen span to `resolve`.
 /// Returns whether the triangle continues below `y1`.
 #[inline(always)]
@@ -926,7 +1022,7 @@ fn walk_band<P: RowPixel, S: Shading, const SUB: u32, R: Resolve<P, S>>(
             stats.fragments += (r - l) as u32;
             stats.pixels_written += resolve.span(t, order, y, l, r);
         }
-        if !t.walk.advance::<SUB>() {
+        if !t.advance::<SUB>() {
             return false;
         }
     }

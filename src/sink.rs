@@ -254,10 +254,19 @@ impl<P, E, F: FnMut(Row<'_, P>) -> Result<(), E>> RowSink<P> for FnSink<F> {
     }
 }
 
-/// A frame-buffer-less panel model: hashes the row stream (32-bit FNV-1a over each pixel's raw
-/// value as 4 little-endian bytes, rows in order). Two renders give the same hash exactly when
-/// they sent the same pixels in the same order, which is how firmware and host prove
-/// bit-identical output.
+/// A frame-buffer-less panel model: hashes the row stream (each pixel's raw value as one 32-bit
+/// word, rows in order). Two renders give the same hash when they sent the same pixels in the
+/// same order, which is how firmware and host prove bit-identical output.
+///
+/// Per pixel `h ← (rotl(h, 5) ⊕ raw) · 16777619 (mod 2^32)`, from the FNV-1a offset basis. For a
+/// given pixel each step is a bijection of `h` (a rotation, an exclusive or with a constant and
+/// a multiplication by an odd number are each invertible), and for a given `h` it is injective
+/// in `raw`. So changing any one pixel of a frame changes the state right after that pixel, and
+/// the later steps, bijections for the unchanged pixels that follow, carry the difference to
+/// the end: **any single-pixel change changes the frame hash** (test
+/// `one_changed_pixel_changes_the_hash`). Larger changes collide with a chance of about 2^-32,
+/// as for any 32-bit hash. One multiply a pixel, not four as a byte-wise hash: the hash is the
+/// measurement's cost, in every instruction count of the firmware.
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
@@ -281,7 +290,7 @@ impl Default for HashSink {
 }
 
 impl HashSink {
-    /// FNV-1a offset basis.
+    /// An empty stream (the hash starts at FNV-1a's offset basis).
     pub const fn new() -> Self {
         HashSink {
             hash: 0x811c_9dc5,
@@ -298,6 +307,13 @@ impl HashSink {
     }
 }
 
+/// One pixel's step of [`HashSink`]: a bijection of `h` for each `raw`, injective in `raw` for
+/// each `h`.
+#[inline(always)]
+const fn hash_step(h: u32, raw: u32) -> u32 {
+    (h.rotate_left(5) ^ raw).wrapping_mul(0x0100_0193)
+}
+
 impl<P> RowSink<P> for HashSink
 where
     P: PixelColor + Into<P::Raw>,
@@ -308,9 +324,7 @@ where
         let mut h = self.hash;
         for &p in row.pixels {
             let raw: u32 = p.into().into_inner().into();
-            for byte in raw.to_le_bytes() {
-                h = (h ^ byte as u32).wrapping_mul(0x0100_0193);
-            }
+            h = hash_step(h, raw);
         }
         self.hash = h;
         self.rows += 1;
@@ -321,6 +335,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use embedded_graphics::pixelcolor::raw::RawU16;
 
     #[test]
     fn pixel_conversions() {
@@ -344,6 +359,61 @@ mod tests {
                 .count();
             assert_eq!(on, (level as usize * 16 + 128) / 256, "level {level}");
         }
+    }
+
+    /// The inverse of [`hash_step`] for a given pixel: the step is a bijection of the state.
+    fn unstep(h: u32, raw: u32) -> u32 {
+        // 0x0100_0193 · 0x359c_449b ≡ 1 (mod 2^32).
+        (h.wrapping_mul(0x359c_449b) ^ raw).rotate_right(5)
+    }
+
+    #[test]
+    fn each_step_is_a_bijection_of_the_state() {
+        assert_eq!(0x0100_0193u32.wrapping_mul(0x359c_449b), 1);
+        let mut x = 0x1234_5678u32;
+        for _ in 0..100_000 {
+            x = x.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            let (h, raw) = (x, x.rotate_left(13) ^ 0x9e37_79b9);
+            assert_eq!(unstep(hash_step(h, raw), raw), h);
+            assert_eq!(hash_step(unstep(h, raw), raw), h);
+        }
+    }
+
+    fn hash_rows(rows: &[&[Rgb565]]) -> u32 {
+        let mut sink = HashSink::new();
+        for (y, pixels) in rows.iter().enumerate() {
+            let row = Row {
+                y: y as u16,
+                pixels,
+                depth: DepthRow::NONE,
+                complete: true,
+            };
+            let Ok(()) = sink.write_row(row);
+        }
+        assert_eq!(sink.rows(), rows.len() as u32);
+        sink.hash()
+    }
+
+    #[test]
+    fn one_changed_pixel_changes_the_hash() {
+        // Two rows of 6; every pixel of the first row in turn takes each of the 65,536 Rgb565
+        // values, and the frame's hash differs exactly when the pixel does.
+        let px = |raw: u16| Rgb565::from(RawU16::new(raw));
+        let base = [0, 1, 0xffff, 0x8000, 0x1234, 0].map(px);
+        let second = [0x0f0f, 0xf0f0, 7].map(px);
+        let h0 = hash_rows(&[&base, &second]);
+        for i in 0..base.len() {
+            let mut row = base;
+            for raw in 0..=u16::MAX {
+                row[i] = px(raw);
+                let h = hash_rows(&[&row, &second]);
+                assert_eq!(h == h0, row == base, "pixel {i} = {raw:#06x}");
+            }
+        }
+        // A change in the last pixel of the frame.
+        let mut last = second;
+        last[2] = px(8);
+        assert_ne!(hash_rows(&[&base, &last]), h0);
     }
 
     #[test]

@@ -33,6 +33,7 @@ const fn c(bits: i32) -> I16F16 {
 
 include!(concat!(env!("OUT_DIR"), "/demo_meshes.rs"));
 
+pub mod byte_hash;
 pub mod metaballs;
 pub mod patches;
 

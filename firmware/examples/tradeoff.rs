@@ -12,6 +12,9 @@
 //! cargo run --release --example tradeoff --target thumbv6m-none-eabi   # QEMU mps2-an385
 //! cargo run --release --example tradeoff                               # host: hashes only
 //! ```
+//!
+//! The host also prints each frame's byte-wise hash (`bytes`, `scanline3d_demo::byte_hash`),
+//! the hash the firmware printed before `HashSink` hashed one word a pixel.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -26,6 +29,8 @@ use scanline3d::shading::{Affine, Gouraud, Interpolation, PerPixel, PerSegment};
 use scanline3d::sink::HashSink;
 use scanline3d::{Depth, Flat, RenderOptions, Shading, Workspace};
 use scanline3d_demo as demo;
+#[cfg(not(target_os = "none"))]
+use scanline3d_demo::byte_hash::{ByteHashSink, Tee};
 
 /// The demo's panel workspace with room to spare: the approximate set-up of some variants moves
 /// the camera slightly, so the exact capacities `sim analyze --demo` measured may not cover it.
@@ -53,6 +58,11 @@ fn fresh<T>(make: impl FnOnce() -> T) -> T {
 /// One frame's result.
 struct Frame {
     hash: u32,
+    /// Host only: the same frame's byte-wise hash (`scanline3d_demo::byte_hash`), the one the
+    /// firmware printed before the word hash, so `cargo xtask speed` can compare the pixels
+    /// with figures saved before it.
+    #[cfg(not(target_os = "none"))]
+    bytes: u32,
     /// Target only: the host has no instruction counter.
     #[cfg_attr(not(target_os = "none"), allow(dead_code))]
     instructions: u64,
@@ -80,12 +90,21 @@ fn frame<
     options: &RenderOptions<S, FrustumClip, A>,
     count: &impl Fn() -> Counter,
 ) -> Result<Frame, &'static str> {
+    #[cfg(target_os = "none")]
     let mut sink = HashSink::new();
+    #[cfg(not(target_os = "none"))]
+    let mut sink = Tee(HashSink::new(), ByteHashSink::new());
     let counter = count();
     let stats = ws.render(scene, options, &mut sink).map_err(|_| "render")?;
     let instructions = counter.stop();
+    #[cfg(target_os = "none")]
+    let hash = sink.hash();
+    #[cfg(not(target_os = "none"))]
+    let hash = sink.0.hash();
     Ok(Frame {
-        hash: sink.hash(),
+        hash,
+        #[cfg(not(target_os = "none"))]
+        bytes: sink.1.hash(),
         instructions,
         complete: stats.is_complete(),
         activated: stats.activated,
@@ -345,8 +364,8 @@ fn main() -> Result<(), &'static str> {
         count: &|| Counter,
         report: |name: &str, frame, f: Frame| {
             println!(
-                "variant {name} frame {frame} hash {:08x} complete {}",
-                f.hash, f.complete
+                "variant {name} frame {frame} hash {:08x} complete {} bytes {:08x}",
+                f.hash, f.complete, f.bytes
             )
         },
     })?;
@@ -356,8 +375,8 @@ fn main() -> Result<(), &'static str> {
             count: &|| Counter,
             report: |name: &str, scene: &str, view, f: Frame| {
                 println!(
-                    "corpus {name} scene {scene} view {view} hash {:08x} complete {}",
-                    f.hash, f.complete
+                    "corpus {name} scene {scene} view {view} hash {:08x} complete {} bytes {:08x}",
+                    f.hash, f.complete, f.bytes
                 )
             },
         })?;

@@ -107,7 +107,7 @@
 //!   (4: its activation rank while sorting, then its position), a mark (1), a bucket link (2),
 //!   a split-tree link (4) and a split-tree cut (24: two points and two links);
 //! * `2·H` bucket heads, `size_of::<P>()·W + 4·W` for one row of pixels and their positions,
-//!   and `ACTIVE` active triangles (about 104 bytes each for flat shading).
+//!   and `ACTIVE` active triangles (about 112 bytes each for flat shading, with the sort key).
 //!
 //! [`NewellWorkspace::BYTES`] gives the total.
 

@@ -94,7 +94,9 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanSort<'_, P, S::Payload<P>> {
     }
     #[inline]
     fn span(&mut self, t: &ActiveTri<S::Payload<P>>, order: usize, y: i32, l: i32, r: i32) -> u32 {
-        let (q, dq) = t.depth.span_start(l, y);
+        // Spans come from the walk, on its current row.
+        debug_assert_eq!(y, t.walk.row(), "internal error: span off the walk's row");
+        let (q, dq) = (t.depth.span_start(l), t.depth_step);
         // At most one span per active triangle, and the list holds as many as the active list.
         let pushed = self.spans.push(SortSpan {
             l,

@@ -4,21 +4,25 @@
 //! `teapot.bpt`.
 
 use scanline3d::sink::HashSink;
+use scanline3d_demo::byte_hash::{ByteHashSink, Tee};
 use scanline3d_demo::patches::{self, PanelPatches};
 
 /// Printed by `cargo run --profile firmware --example patch --target thumbv7em-none-eabihf`
 /// for frames 0, 8 and 16; a change here means the drawn pixels changed.
-const FIRMWARE_HASHES: [u32; 3] = [0xc5b127dc, 0xee52dd0c, 0xec00b30f];
+const FIRMWARE_HASHES: [u32; 3] = [0x9b21794b, 0x6e277685, 0x16aabed3];
+/// Their byte-wise hashes ([`ByteHashSink`]), which the firmware printed before the sink hashed
+/// one word a pixel: equal here means the pixels did not change with the hash.
+const BYTE_HASHES: [u32; 3] = [0xc5b127dc, 0xee52dd0c, 0xec00b30f];
 
 #[test]
 fn host_reproduces_firmware_patch_hashes() {
     let mut ws = Box::new(PanelPatches::new(
         embedded_graphics::pixelcolor::Rgb565::new(0, 0, 0),
     ));
-    let hashes: Vec<u32> = [0, 8, 16]
+    let (hashes, bytes): (Vec<u32>, Vec<u32>) = [0, 8, 16]
         .iter()
         .map(|&frame| {
-            let mut sink = HashSink::new();
+            let mut sink = Tee(HashSink::new(), ByteHashSink::new());
             let stats = patches::render_frame(&mut ws, frame, &mut sink).unwrap();
             eprintln!("frame {frame}: {stats:?}");
             assert!(
@@ -30,9 +34,10 @@ fn host_reproduces_firmware_patch_hashes() {
                 (0, 0, 0),
                 "frame {frame}: {stats:?}"
             );
-            sink.hash()
+            (sink.0.hash(), sink.1.hash())
         })
-        .collect();
+        .unzip();
+    assert_eq!(bytes, BYTE_HASHES, "{bytes:08x?}");
     assert_eq!(hashes, FIRMWARE_HASHES, "{hashes:08x?}");
 }
 

@@ -214,17 +214,18 @@ macro_rules! check_bytes {
 
 #[test]
 fn workspace_bytes_follow_the_documented_formula() {
-    // Active triangles (host sizes): 104 bytes with flat shading (as documented), 136 with
-    // affine Gouraud, 200 with perspective-correct Gouraud.
+    // Active triangles (host sizes): 104 bytes with flat shading (as documented) and pixels of
+    // up to 2 bytes, 112 with 3- and 4-byte pixels (`Rgb888`, `TriangleId`), 144 with affine
+    // Gouraud, 208 with perspective-correct Gouraud.
     check_bytes! { Rgb565, Flat, Depth, 4, 104, [(240, 240, 1280, 64), (1, 1, 1, 1), (17, 3, 5, 2)] }
     check_bytes! { Rgb565, Flat, Depth, 4, 104, [(7, 9, 0, 0)] }
-    check_bytes! { Rgb888, Flat, Depth, 4, 104, [(320, 240, 1536, 96), (3, 5, 7, 1)] }
+    check_bytes! { Rgb888, Flat, Depth, 4, 112, [(320, 240, 1536, 96), (3, 5, 7, 1)] }
     check_bytes! { Gray8, Flat, Depth16, 2, 104, [(240, 240, 1280, 64), (13, 1, 3, 3)] }
     check_bytes! { BinaryColor, Flat, Depth, 4, 104, [(128, 64, 256, 16), (1, 2048, 1, 5)] }
-    check_bytes! { TriangleId, Flat, Depth, 4, 104, [(64, 64, 4096, 512), (2048, 1, 9, 1)] }
-    check_bytes! { Rgb565, Gouraud, Depth, 4, 136, [(240, 240, 1280, 64), (5, 5, 5, 5)] }
-    check_bytes! { Rgb888, Gouraud, Depth16, 2, 136, [(31, 17, 100, 3)] }
-    check_bytes! { Rgb565, Gouraud<PerPixel>, Depth, 4, 200, [(240, 240, 1280, 64), (9, 3, 1, 7)] }
+    check_bytes! { TriangleId, Flat, Depth, 4, 112, [(64, 64, 4096, 512), (2048, 1, 9, 1)] }
+    check_bytes! { Rgb565, Gouraud, Depth, 4, 144, [(240, 240, 1280, 64), (5, 5, 5, 5)] }
+    check_bytes! { Rgb888, Gouraud, Depth16, 2, 144, [(31, 17, 100, 3)] }
+    check_bytes! { Rgb565, Gouraud<PerPixel>, Depth, 4, 208, [(240, 240, 1280, 64), (9, 3, 1, 7)] }
 
     // The vertex cache adds 8 bytes a vertex (README), `vertex_cache_bytes` of them: exactly
     // when that is a multiple of 8, else the total pads once where the sum pads twice.

@@ -7,6 +7,11 @@
 //! `docs/speed/LABEL.tsv` and `docs/speed/LABEL-cache.tsv` and rewrites `docs/speed.md` from
 //! the saved labels (`before`: the code before issue 19's set-up rework, `after`: the current
 //! code). `cargo xtask speed doc` only rewrites `docs/speed.md` from the saved figures.
+//!
+//! Labels compare their pixels by the byte-wise frame hash (`scanline3d_demo::byte_hash`), the
+//! one the firmware printed until `HashSink` hashed one word a pixel: labels saved before that
+//! hold it in their `hash` column; later labels hold the firmware's word hash there (equal to
+//! the host's) and add `bytes_hash`, the host's byte-wise hash of the same frame.
 
 use crate::tradeoff::{build_example_with_cfgs, run_on_qemu_with};
 use crate::{first_line, root, step, thousands};
@@ -22,9 +27,9 @@ const SIZE: usize = 240;
 const MARGIN_PERCENT: u32 = 10;
 const VARIANT: &str = "default";
 
-/// One frame: (scene, view) -> (hash, instructions, activated, fragments). The demo orbit is
-/// scene `demo`, its frames the views.
-type Frames = BTreeMap<(String, usize), (u32, u64, u64, u64)>;
+/// One frame: (scene, view) -> (hash, instructions, activated, fragments, byte-wise hash (host
+/// only)). The demo orbit is scene `demo`, its frames the views.
+type Frames = BTreeMap<(String, usize), (u32, u64, u64, u64, Option<u32>)>;
 
 /// The `variant`/`corpus` lines of the trade-off firmware's output for [`VARIANT`].
 fn parse(output: &str) -> Frames {
@@ -36,10 +41,12 @@ fn parse(output: &str) -> Frames {
                 .find(|p| p[0] == name)
                 .and_then(|p| p[1].parse::<u64>().ok())
         };
-        let hash = w
-            .windows(2)
-            .find(|p| p[0] == "hash")
-            .and_then(|p| u32::from_str_radix(p[1], 16).ok());
+        let hex = |name: &str| {
+            w.windows(2)
+                .find(|p| p[0] == name)
+                .and_then(|p| u32::from_str_radix(p[1], 16).ok())
+        };
+        let hash = hex("hash");
         let key = match w.first() {
             Some(&"variant") if w.get(1) == Some(&VARIANT) => {
                 field("frame").map(|f| ("demo".to_string(), f as usize))
@@ -54,7 +61,7 @@ fn parse(output: &str) -> Frames {
             let n = field("instructions").unwrap_or(0);
             let a = field("activated").unwrap_or(0);
             let f = field("fragments").unwrap_or(0);
-            frames.insert(key, (hash, n, a, f));
+            frames.insert(key, (hash, n, a, f, hex("bytes")));
         }
     }
     frames
@@ -108,7 +115,9 @@ fn measure(
     corpus_file: &std::path::Path,
     host: &Frames,
 ) -> Result<(), String> {
-    let mut tsv = String::from("target\tscene\tview\thash\tinstructions\tactivated\tfragments\n");
+    let mut tsv = String::from(
+        "target\tscene\tview\thash\tinstructions\tactivated\tfragments\tbytes_hash\n",
+    );
     for target in TARGETS {
         step(&format!(
             "{label}: variant {VARIANT}, {cfgs:?}, with the corpus on {target}"
@@ -125,15 +134,23 @@ fn measure(
             return Err(format!("{target}: no frames in the output:\n{out}"));
         }
         for (key, f) in &frames {
-            let h = host.get(key).map(|h| h.0);
-            if h != Some(f.0) {
+            let h = host.get(key);
+            if h.map(|h| h.0) != Some(f.0) {
                 return Err(format!(
-                    "{target} {} view {}: hash {:08x}, host {h:08x?}",
-                    key.0, key.1, f.0
+                    "{target} {} view {}: hash {:08x}, host {:08x?}",
+                    key.0,
+                    key.1,
+                    f.0,
+                    h.map(|h| h.0)
                 ));
             }
+            // The firmware's frame is the host's (equal word hashes), whose byte-wise hash
+            // compares it with labels saved before the word hash.
+            let bytes = h
+                .and_then(|h| h.4)
+                .ok_or(format!("host: no byte-wise hash for {key:?}"))?;
             tsv += &format!(
-                "{target}\t{}\t{}\t{:08x}\t{}\t{}\t{}\n",
+                "{target}\t{}\t{}\t{:08x}\t{}\t{}\t{}\t{bytes:08x}\n",
                 key.0, key.1, f.0, f.1, f.2, f.3
             );
         }
@@ -149,22 +166,32 @@ fn measure(
 /// (target, scene, view) -> (instructions, activated, fragments) of a saved label.
 type Saved = BTreeMap<(String, String, usize), (u64, u64, u64)>;
 
-/// (target, scene, view) -> frame hash of a saved label.
-fn hashes(label: &str) -> BTreeMap<(String, String, usize), String> {
+/// (target, scene, view) -> byte-wise frame hash of a saved label, and whether the label's
+/// firmware printed the word hash (then the byte-wise one is the host's, in `bytes_hash`).
+fn hashes(label: &str) -> (BTreeMap<(String, String, usize), String>, bool) {
     let text = std::fs::read_to_string(data_dir().join(format!("{label}.tsv"))).unwrap_or_default();
-    text.lines()
+    let word = text
+        .lines()
+        .next()
+        .is_some_and(|header| header.split('\t').any(|c| c == "bytes_hash"));
+    let map = text
+        .lines()
         .skip(1)
         .filter_map(|line| {
             let w: Vec<&str> = line.split('\t').collect();
-            let [t, s, v, h, ..] = w[..] else {
-                return None;
+            let (key, bytes) = match w[..] {
+                [t, s, v, _, _, _, _, b] if word => ((t, s, v), b),
+                [t, s, v, h, _, _, _] if !word => ((t, s, v), h),
+                _ => return None,
             };
+            let (t, s, v) = key;
             Some((
                 (t.to_string(), s.to_string(), v.parse().ok()?),
-                h.to_string(),
+                bytes.to_string(),
             ))
         })
-        .collect()
+        .collect();
+    (map, word)
 }
 
 fn load(label: &str) -> Option<Saved> {
@@ -172,7 +199,8 @@ fn load(label: &str) -> Option<Saved> {
     let mut out = Saved::new();
     for line in text.lines().skip(1) {
         let w: Vec<&str> = line.split('\t').collect();
-        let [t, s, v, _, n, a, f] = w[..] else {
+        // Labels saved with the word hash have one more column (`bytes_hash`).
+        let (&[t, s, v, _, n, a, f] | &[t, s, v, _, n, a, f, _]) = &w[..] else {
             continue;
         };
         out.insert(
@@ -200,12 +228,21 @@ fn sum(
     (s.3 > 0).then_some(s)
 }
 
+/// `"a", "b" and "c"`.
+fn list(items: &[String]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.clone(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
+    }
+}
+
 fn millions(n: f64) -> String {
     format!("{:.2}", n / 1e6)
 }
 
 /// The saved labels, in table order, with their column titles.
-const LABELS: [(&str, &str); 7] = [
+const LABELS: [(&str, &str); 8] = [
     ("before", "before"),
     ("before-cache", "before, cache"),
     // The first set-up rework with the 8-byte vertex cache (main at 717759d), kept to show
@@ -217,6 +254,9 @@ const LABELS: [(&str, &str); 7] = [
     // The third rework (pass 1's and pass 2's short ways, main at cfdca08), before the
     // exact 32-bit square root in lighting and one bounds test per span.
     ("rework3-cache", "third rework, cache"),
+    // The fourth rework (32-bit square root in lighting, one bounds test per span; main at
+    // 9c693b4), the last figures measured with the byte-wise frame hash.
+    ("rework4-cache", "fourth rework, cache"),
     ("after", "after"),
     ("after-cache", "after, cache"),
 ];
@@ -247,21 +287,42 @@ fn write_doc() -> Result<(), String> {
         "Generated by `cargo xtask speed after` (and once, on the code before issue 19's set-up rework, `cargo xtask speed before`); the figures are saved in `docs/speed/*.tsv`. Variant `default` of the trade-off firmware (`firmware/examples/tradeoff.rs`: `RenderOptions::default()`, flat shading, {SIZE}×{SIZE}, span z-buffer, back faces culled as each corpus scene says), built with the `firmware` profile and the corpus exported by `scanline3d_sim::export::corpus_source({SIZE}, {SIZE}, {MARGIN_PERCENT})`, with the default workspace and again with a vertex cache holding every vertex (`--cfg scanline3d_vertex_cache`, columns \"cache\"; the same pixels); run under QEMU with `-icount shift=0` (thumbv7em: mps2-an386 Cortex-M4, thumbv6m: mps2-an385, riscv32imc: virt). Figures are **instructions (QEMU), not cycles**; every frame hash equals the host's. {}.\n\n",
         first_line(Command::new("rustc").arg("--version"))
     );
-    let base = hashes("before");
-    for (label, title) in LABELS.iter().skip(1) {
-        let other = hashes(label);
+    let (base, _) = hashes("before");
+    let (mut byte_titles, mut word_titles) = (Vec::new(), Vec::new());
+    let mut lines = String::new();
+    for (label, title) in LABELS {
+        let (other, word) = hashes(label);
         if other.is_empty() {
+            continue;
+        }
+        match word {
+            true => word_titles.push(format!("\"{title}\"")),
+            false => byte_titles.push(format!("\"{title}\"")),
+        }
+        if label == "before" {
             continue;
         }
         let same = other
             .iter()
             .filter(|(k, h)| base.get(*k) == Some(*h))
             .count();
-        md += &format!(
-            "Frame hashes of \"{title}\" equal to \"before\": {same} of {} frames (demo orbit and every corpus view, three targets).\n\n",
+        lines += &format!(
+            "Byte-wise frame hashes of \"{title}\" equal to \"before\": {same} of {} frames (demo orbit and every corpus view, three targets).\n\n",
             other.len()
         );
     }
+    md += &format!(
+        "Frames are compared by their byte-wise hash (32-bit FNV-1a over each pixel's raw value as 4 bytes, `scanline3d_demo::byte_hash`), which the firmware printed for {}.",
+        list(&byte_titles)
+    );
+    if !word_titles.is_empty() {
+        md += &format!(
+            " For {} it printed the frame hash of `HashSink`, one 32-bit word a pixel (equal to the host's for every frame), and the host hashed the same frame byte-wise as well (`bytes` in the trade-off example's host output, column `bytes_hash` of the saved figures).",
+            list(&word_titles)
+        );
+    }
+    md += "\n\n";
+    md += &lines;
     md += "Per frame: mean over the views (demo: the 8 orbit frames), in millions. Per triangle: instructions divided by the triangles (and clipped pieces) set up for the walk (`FrameStats::activated`); per pixel: divided by the pixel centres covered by spans (`FrameStats::fragments`). Both divide the whole frame's count, so they are ratios, not the cost of one stage.\n\n";
     let titles: Vec<&str> = saved.iter().map(|s| s.0).collect();
     let header = |what: &str| {
