@@ -15,7 +15,7 @@
 
 use crate::arithmetic::Arithmetic;
 use crate::cache::CachedVertex;
-use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping};
+use crate::clip::{ClipVertex, Clipped, Clipping};
 use crate::depth::{DepthFormat, DepthRow};
 use crate::math::NormalPrecision;
 use crate::options::RenderOptions;
@@ -548,7 +548,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
             }
         };
         let project = |c: &ClipVertex| vp.project_as::<A::Projection>(&c.p, c.color, depth);
-        let mut polygon = ClipPolygon::new();
+        let mut polygon = C::Polygon::default();
         let clipped = 'pieces: {
             let cv = match self.cached(cache, idx) {
                 Some(c) => {
@@ -575,7 +575,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                 }
                 Clipped::Polygon => {
                     // Fan from the first vertex, projecting each vertex once as the fan reaches it.
-                    let mut fan = polygon.iter().filter_map(project);
+                    let mut fan = polygon.as_ref().iter().filter_map(project);
                     if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
                         for c in fan {
                             emit([a, b, c], false);

@@ -14,7 +14,7 @@ use super::trim::{self, Cut};
 use super::{PatchModel, Tolerance};
 use crate::arithmetic::Arithmetic;
 use crate::cache::CachedVertex;
-use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping};
+use crate::clip::{ClipVertex, Clipped, Clipping};
 use crate::depth::Depth;
 use crate::options::RenderOptions;
 use crate::project::{ScreenVertex, Viewport};
@@ -251,7 +251,7 @@ impl<
             free: 0,
             tolerance: ((tolerance.to_bits() as i64) << SUB >> 8).max(1),
             cull: options.cull_back_faces,
-            polygon: ClipPolygon::new(),
+            polygon: C::Polygon::default(),
             stats: PatchStats::default(),
             clipping: core::marker::PhantomData,
         };
@@ -290,7 +290,7 @@ enum Hull {
 }
 
 /// The frame's patch state: what pass 2 activates row by row.
-struct PatchRows<'a, 'm, const SUB: u32, C, A: Arithmetic, const TRIM: usize> {
+struct PatchRows<'a, 'm, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize> {
     model: &'m PatchModel<'m>,
     mv: <A::Transform as TransformPrecision>::Matrix,
     lighting: Lighting,
@@ -303,7 +303,7 @@ struct PatchRows<'a, 'm, const SUB: u32, C, A: Arithmetic, const TRIM: usize> {
     /// Flatness tolerance in sub-pixels.
     tolerance: i64,
     cull: bool,
-    polygon: ClipPolygon,
+    polygon: C::Polygon,
     stats: PatchStats,
     clipping: core::marker::PhantomData<C>,
 }
@@ -768,7 +768,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
             }
             Clipped::Polygon => {
                 stats.frame.clipped += 1;
-                let mut fan = self.polygon.iter().filter_map(project);
+                let mut fan = self.polygon.as_ref().iter().filter_map(project);
                 if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
                     for c in fan {
                         emit([a, b, c], &mut stats);
