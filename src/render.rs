@@ -251,6 +251,56 @@ pub(crate) fn fill_span<P: RowPixel, S: Shading, Z: DepthFormat, K>(
 
 pub(crate) const NO_ENTRY: u16 = u16::MAX;
 
+/// The integer type of a row bucket's head (one per row of the target): `u16`, for any
+/// triangle capacity, or `u8`, for workspaces that file at most 255 triangles a frame, whose
+/// heads then take one byte per row instead of two.
+pub trait BucketHead: Copy + core::fmt::Debug + sealed::Sealed + 'static {
+    /// An empty bucket.
+    const EMPTY: Self;
+    /// Most bucket entries (the workspace's `TRIS`) this type can point to.
+    const MAX_ENTRIES: usize;
+    /// The entry this head points to, [`NO_ENTRY`] for an empty bucket.
+    fn entry(self) -> u16;
+    /// The head pointing to `entry` (below [`Self::MAX_ENTRIES`], or [`NO_ENTRY`]).
+    fn to(entry: u16) -> Self;
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for u8 {}
+    impl Sealed for u16 {}
+}
+
+impl BucketHead for u16 {
+    const EMPTY: u16 = NO_ENTRY;
+    const MAX_ENTRIES: usize = MAX_SCENE_TRIANGLES;
+    #[inline(always)]
+    fn entry(self) -> u16 {
+        self
+    }
+    #[inline(always)]
+    fn to(entry: u16) -> u16 {
+        entry
+    }
+}
+
+impl BucketHead for u8 {
+    const EMPTY: u8 = u8::MAX;
+    const MAX_ENTRIES: usize = u8::MAX as usize;
+    #[inline(always)]
+    fn entry(self) -> u16 {
+        match self {
+            u8::MAX => NO_ENTRY,
+            e => e as u16,
+        }
+    }
+    #[inline(always)]
+    fn to(entry: u16) -> u8 {
+        // Entries stay below MAX_ENTRIES (the workspace's capacity check); NO_ENTRY is EMPTY.
+        u8::try_from(entry).unwrap_or(u8::MAX)
+    }
+}
+
 /// `value`, or `fallback` if it is `None`: for look-ups that validation (of meshes, trees and
 /// capacities) or the frame's own set-up make infallible, so that `None` is an internal error.
 /// Debug builds, the tests among them, stop there; release builds, whose render path must not
@@ -268,8 +318,8 @@ pub(crate) fn internal<T>(value: Option<T>, fallback: T) -> T {
 }
 
 /// Buckets and active list as slices, so the driver is not generic over the capacities.
-pub(crate) struct Frame<'a, T, K> {
-    pub(crate) heads: &'a mut [u16],
+pub(crate) struct Frame<'a, T, K, H = u16> {
+    pub(crate) heads: &'a mut [H],
     pub(crate) next: &'a mut [u16],
     pub(crate) refs: &'a mut [u16],
     /// One sort key per bucket entry; empty unless `K::SORTED`.
@@ -647,8 +697,9 @@ pub(crate) fn drive<
     K: RowSink<P>,
     const INSTANCES: usize,
     R: Resolve<P, S>,
+    H: BucketHead,
 >(
-    ws: Frame<'_, S::Payload<P>, R::Key>,
+    ws: Frame<'_, S::Payload<P>, R::Key, H>,
     resolve: &mut R,
     order: &mut impl TriangleOrder,
     scene: &Scene<'_>,
@@ -682,7 +733,7 @@ pub(crate) fn drive<
     // (reverse id order, which leaves each row's list in ascending id order, as pushing is at
     // the head). Depth sorting also keeps a key per triangle: its rank in `order` if that is a
     // drawing order (BSP), else the mean depth of its (clipped) vertices, larger = nearer.
-    ws.heads.fill(NO_ENTRY);
+    ws.heads.fill(H::EMPTY);
     let mut filed = 0usize;
     for setup in &setups {
         stats.triangles_in += setup.instance.mesh.triangles().len() as u32;
@@ -725,8 +776,8 @@ pub(crate) fn drive<
                         u16::try_from(filed),
                     ) {
                         *r = id;
-                        *next = *head;
-                        *head = entry;
+                        *next = head.entry();
+                        *head = H::to(entry);
                     } else {
                         debug_assert!(false, "internal error: triangle {id} not filed");
                     }
@@ -781,13 +832,13 @@ pub(crate) trait RowPieces<const SUB: u32> {
 }
 
 /// Row buckets (heads and links of entry lists) over pieces looked up by entry.
-pub(crate) struct Buckets<'a, A> {
-    pub(crate) heads: &'a [u16],
+pub(crate) struct Buckets<'a, A, H = u16> {
+    pub(crate) heads: &'a [H],
     pub(crate) next: &'a [u16],
     pub(crate) pieces: &'a A,
 }
 
-impl<const SUB: u32, A: ActivePieces<SUB>> RowPieces<SUB> for Buckets<'_, A> {
+impl<const SUB: u32, A: ActivePieces<SUB>, H: BucketHead> RowPieces<SUB> for Buckets<'_, A, H> {
     #[inline(always)]
     fn each_row_piece<S: Shading>(
         &mut self,
@@ -795,7 +846,7 @@ impl<const SUB: u32, A: ActivePieces<SUB>> RowPieces<SUB> for Buckets<'_, A> {
         mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         // Rows are below `height`, entries below the bucket capacity.
-        let mut entry = internal(self.heads.get(row).copied(), NO_ENTRY);
+        let mut entry = internal(self.heads.get(row).map(|h| h.entry()), NO_ENTRY);
         while entry != NO_ENTRY {
             let e = entry as usize;
             entry = internal(self.next.get(e).copied(), NO_ENTRY);

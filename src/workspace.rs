@@ -13,6 +13,7 @@ use crate::clip::Clipping;
 use crate::depth::Depth;
 use crate::depth::DepthFormat;
 use crate::options::{RenderOptions, MAX_INSTANCES};
+pub use crate::render::BucketHead;
 use crate::render::{
     drive, fill_span, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve, NO_ENTRY,
 };
@@ -96,6 +97,8 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for SpanZBuffer<'_, 
 /// * `VERTS`: vertex cache entries ([`crate::cache`], default 0: none). When the scene's
 ///   vertices fit, each is transformed and projected once per frame instead of once per
 ///   triangle and pass: RAM for speed, with the same pixels.
+/// * `B`: the type of the row bucket heads ([`BucketHead`]): `u16` (the default) or `u8`,
+///   one byte per row instead of two for workspaces with `TRIS` at most 255.
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
@@ -116,11 +119,12 @@ pub struct Workspace<
     const INSTANCES: usize = MAX_INSTANCES,
     Z: DepthFormat = Depth,
     const VERTS: usize = 0,
+    B: BucketHead = u16,
 > {
     depth: [Z; W],
     pixels: [P; W],
     background: P,
-    heads: [u16; H],
+    heads: [B; H],
     next: [u16; TRIS],
     refs: [u16; TRIS],
     active: Vec<ActiveTri<S::Payload<P>>, ACTIVE>,
@@ -179,7 +183,8 @@ impl<
         const INSTANCES: usize,
         Z: DepthFormat,
         const VERTS: usize,
-    > Workspace<P, S, W, H, TRIS, ACTIVE, INSTANCES, Z, VERTS>
+        B: BucketHead,
+    > Workspace<P, S, W, H, TRIS, ACTIVE, INSTANCES, Z, VERTS, B>
 {
     /// Size of this workspace in bytes.
     pub const BYTES: usize = core::mem::size_of::<Self>();
@@ -194,6 +199,10 @@ impl<
             "height must be 1..=2048"
         );
         assert!(TRIS <= MAX_SCENE_TRIANGLES, "TRIS must be at most 65535");
+        assert!(
+            TRIS <= B::MAX_ENTRIES,
+            "TRIS must fit the bucket heads: at most 255 with u8 heads"
+        );
     };
 
     /// An empty workspace whose background pixels are `background`.
@@ -204,7 +213,7 @@ impl<
             depth: [Z::FAR; W],
             pixels: [background; W],
             background,
-            heads: [NO_ENTRY; H],
+            heads: [B::EMPTY; H],
             next: [NO_ENTRY; TRIS],
             refs: [0; TRIS],
             active: Vec::new(),
@@ -289,7 +298,7 @@ impl<
     }
 
     /// The workspace as slices, so code that renders through it is not generic over the sizes.
-    pub(crate) fn span_view(&mut self) -> SpanView<'_, P, S, Z, INSTANCES> {
+    pub(crate) fn span_view(&mut self) -> SpanView<'_, P, S, Z, INSTANCES, B> {
         SpanView {
             depth: &mut self.depth,
             pixels: &mut self.pixels,
@@ -305,19 +314,19 @@ impl<
 
 /// A span z-buffer workspace borrowed as slices: its width and height are the lengths of its
 /// rows and bucket heads, so nothing here is generic over the sizes.
-pub(crate) struct SpanView<'a, P: RowPixel, S: Shading, Z, const INSTANCES: usize> {
+pub(crate) struct SpanView<'a, P: RowPixel, S: Shading, Z, const INSTANCES: usize, B = u16> {
     depth: &'a mut [Z],
     pixels: &'a mut [P],
     background: P,
-    heads: &'a mut [u16],
+    heads: &'a mut [B],
     next: &'a mut [u16],
     refs: &'a mut [u16],
     active: &'a mut VecView<ActiveTri<S::Payload<P>>>,
     vertices: &'a mut [CachedVertex],
 }
 
-impl<P: RowPixel, S: Shading, Z: DepthFormat, const INSTANCES: usize>
-    SpanView<'_, P, S, Z, INSTANCES>
+impl<P: RowPixel, S: Shading, Z: DepthFormat, const INSTANCES: usize, B: BucketHead>
+    SpanView<'_, P, S, Z, INSTANCES, B>
 {
     /// Renders a `width × height` target (at most the workspace's size).
     pub(crate) fn render_sized<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
@@ -351,7 +360,7 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat, const INSTANCES: usize>
             vertices: self.vertices,
         };
         let mut resolve = SpanZBuffer::new(depth, pixels, self.background);
-        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _>(
             frame,
             &mut resolve,
             &mut IdOrder,

@@ -149,7 +149,7 @@ impl<
             background: self.background,
             spans: 0,
         };
-        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _>(
             frame,
             &mut resolve,
             &mut IdOrder,

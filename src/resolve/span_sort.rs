@@ -280,7 +280,7 @@ impl<
             background: self.background,
             spans: self.spans.as_mut_view(),
         };
-        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _>(
             frame,
             &mut resolve,
             &mut IdOrder,
