@@ -572,7 +572,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         lit: bool,
         depth: bool,
         filed: bool,
-        mut f: impl FnMut([ScreenVertex<S>; 3]),
+        mut f: impl FnMut(&[ScreenVertex<S>; 3]),
     ) -> Fate {
         let Some(&idx) = self.instance.mesh.triangles().get(tri) else {
             // Callers pass the mesh's own triangles (a BSP tree's ranges are checked against it).
@@ -593,7 +593,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                 Placement::Back => culled = true,
                 Placement::FirstRow(r) => {
                     first = Some(first.map_or(r, |f| f.min(r)));
-                    f(s);
+                    f(&s);
                 }
             }
         };
@@ -827,7 +827,7 @@ pub(crate) trait RowPieces<const SUB: u32> {
     fn each_row_piece<S: Shading>(
         &mut self,
         row: usize,
-        f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     );
 }
 
@@ -843,7 +843,7 @@ impl<const SUB: u32, A: ActivePieces<SUB>, H: BucketHead> RowPieces<SUB> for Buc
     fn each_row_piece<S: Shading>(
         &mut self,
         row: usize,
-        mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        mut f: impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         // Rows are below `height`, entries below the bucket capacity.
         let mut entry = internal(self.heads.get(row).map(|h| h.entry()), NO_ENTRY);
@@ -862,7 +862,7 @@ pub(crate) trait ActivePieces<const SUB: u32> {
     fn each_piece<S: Shading>(
         &self,
         entry: usize,
-        f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     );
 }
 
@@ -884,7 +884,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> ActivePieces<SUB>
     fn each_piece<S: Shading>(
         &self,
         e: usize,
-        mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        mut f: impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         // Entries, ids and triangles all come from pass 1 of this frame.
         let Some(&id) = self.refs.get(e) else {
@@ -964,19 +964,19 @@ pub(crate) fn walk_rows<
                 pieces.each_row_piece::<S>(row, |s, face, id, key| {
                     let (Some(walk), Some(solver)) = (
                         TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32),
-                        PlaneSolver::new(&s),
+                        PlaneSolver::new(s),
                     ) else {
                         // Pieces have screen area and rows from this one on (their bucket is
                         // their first row, or the first of their triangle's pieces).
                         debug_assert!(false, "internal error: piece of {id} not walkable");
                         return;
                     };
-                    let depth = DepthPlane::new(&solver, &s).walk_from(walk.row());
+                    let depth = DepthPlane::new(&solver, s).walk_from(walk.row());
                     let mut tri_state = ActiveTri {
                         walk,
                         depth,
                         depth_step: depth.step(),
-                        payload: S::payload::<P, SUB>(face, id, &solver, &s),
+                        payload: S::payload::<P, SUB>(face, id, &solver, s),
                         key: R::Key::from_raw(key),
                         link: NO_LINK,
                     };
@@ -1115,7 +1115,7 @@ pub(crate) fn for_each_screen_piece<
                 S::PER_VERTEX,
                 true,
                 false,
-                |s| f(s, face, id),
+                |s| f(*s, face, id),
             );
             match fate {
                 Fate::Culled => stats.culled += 1,

@@ -527,7 +527,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         levels: &Levels,
         side: usize,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         self.stats.pieces += 1;
         let mut recent: [Option<(Uv, Vertex)>; 4] = [None; 4];
@@ -557,7 +557,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         uv: [Uv; 3],
         cv: [Vertex; 3],
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         let trims = self.trims(patch);
         let cut = trim::classify(&trims, uv);
@@ -584,7 +584,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         uv: [Uv; 3],
         face: Sides<Rgb888>,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         self.stats.trim_cut += 1;
         let trims = self.trims(patch);
@@ -615,7 +615,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         net: &Net,
         piece: Piece,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         let Piece { levels, is, js } = piece;
         let mut first = is[0];
@@ -638,7 +638,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         is: [u8; 2],
         js: [u8; 2],
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         let u = |i: u8| tessellate::grid(i as u32, levels.u);
         let v = |j: u8| tessellate::grid(j as u32, levels.v);
@@ -712,7 +712,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         t: [Vertex; 3],
         face: Sides<Rgb888>,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         let back = shows_back(&t);
         let face = if back { face.back } else { face.front };
@@ -744,7 +744,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                 }
             }
             stats.frame.bucketed += 1;
-            f(s, face, patch as u32, 0);
+            f(&s, face, patch as u32, 0);
         };
         let mut stats = self.stats;
         // Inside every clip plane: the screen positions projected once per vertex, as the
@@ -788,7 +788,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         patch: u16,
         net: &Net,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         let levels = tessellate::levels(&self.screen_net(net), self.tolerance);
         self.stats.capped += levels.capped as u32;
@@ -812,7 +812,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         net: &Net,
         piece: Piece,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         self.stats.pieces += 1;
         let Piece { levels, is, js } = piece;
@@ -847,7 +847,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         sub: Net,
         work: Work,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         let first = match self.hull(&sub) {
             Hull::Culled => {
@@ -869,7 +869,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         net: &Net,
         work: Work,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         match work {
             Work::Patch => self.patch::<S>(patch, net, row, f),
@@ -886,7 +886,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize> RowPieces<SU
     fn each_row_piece<S: Shading>(
         &mut self,
         row: usize,
-        mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        mut f: impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         // Pieces filed under this row while it is processed are taken in the same loop.
         while let Some(Entry { patch, work }) = self.take(row) {
