@@ -816,7 +816,10 @@ pub(crate) fn drive<
         pieces: &pieces,
     };
     let height = ws.heads.len();
-    walk_rows::<P, S, SUB, K, R>(height, ws.active, &mut rows, resolve, width, sink, stats)
+    walk_rows::<P, S, SUB, K, R>(
+        height, ws.active, &mut rows, resolve, width, sink, &mut stats,
+    )?;
+    Ok(stats)
 }
 
 /// What pass 2 activates on each row: the pieces that start there (in any order that is the
@@ -941,8 +944,8 @@ pub(crate) fn walk_rows<
     resolve: &mut R,
     width: i32,
     sink: &mut K,
-    mut stats: FrameStats,
-) -> Result<FrameStats, RenderError<K::Error>> {
+    stats: &mut FrameStats,
+) -> Result<(), RenderError<K::Error>> {
     let band = resolve.band_rows().max(1);
     let mut active = ActiveList::new(active);
     // Last row covered by any dropped piece so far: rows up to it are incomplete.
@@ -954,7 +957,7 @@ pub(crate) fn walk_rows<
         if band > 1 {
             // Triangles carried over from earlier bands come first, in activation order.
             active.retain(|t, order| {
-                walk_band::<P, S, SUB, R>(t, order, y1 as i32, width, resolve, &mut stats)
+                walk_band::<P, S, SUB, R>(t, order, y1 as i32, width, resolve, stats)
             });
         }
         for row in y0..y1 {
@@ -992,7 +995,7 @@ pub(crate) fn walk_rows<
                             y1 as i32,
                             width,
                             resolve,
-                            &mut stats,
+                            stats,
                         ) || active.insert(tri_state)
                     } else {
                         active.insert(tri_state)
@@ -1018,7 +1021,7 @@ pub(crate) fn walk_rows<
             if band == 1 {
                 stats.peak_active = stats.peak_active.max(active.live as u16);
                 active.retain(|t, order| {
-                    walk_band::<P, S, SUB, R>(t, order, y + 1, width, resolve, &mut stats)
+                    walk_band::<P, S, SUB, R>(t, order, y + 1, width, resolve, stats)
                 });
             }
         }
@@ -1048,7 +1051,7 @@ pub(crate) fn walk_rows<
         }
         y0 = y1;
     }
-    Ok(stats)
+    Ok(())
 }
 
 /// Walks triangle `t` down to row `y1` (exclusive), handing each on-screen span to `resolve`.

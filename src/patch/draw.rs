@@ -257,14 +257,15 @@ impl<
         };
         rows.file_patches()?;
         let mut resolve = SpanZBuffer::new(depth, pixels, self.background);
-        let frame = walk_rows::<P, S, SUB, K, _>(
+        let mut frame = FrameStats::default();
+        walk_rows::<P, S, SUB, K, _>(
             height,
             self.active.as_mut_view(),
             &mut rows,
             &mut resolve,
             width as i32,
             sink,
-            FrameStats::default(),
+            &mut frame,
         )?;
         let mut stats = rows.stats;
         let counts = stats.frame;

@@ -309,7 +309,7 @@ impl<
         ) else {
             return Err(RenderError::InvalidTarget);
         };
-        let (n, stats) = store::collect::<S, SUB_BITS, C, A, K::Error, INSTANCES>(
+        let (n, mut stats) = store::collect::<S, SUB_BITS, C, A, K::Error, INSTANCES>(
             scene,
             options,
             &vp,
@@ -385,8 +385,9 @@ impl<
             &mut painter,
             width as i32,
             sink,
-            stats,
-        )
+            &mut stats,
+        )?;
+        Ok(stats)
     }
 }
 
