@@ -241,7 +241,7 @@ pub(crate) fn fill_span<P: RowPixel, S: Shading, Z: DepthFormat, K>(
     // so the fill's loop counts one of them.
     if l < r && r <= depth.len() && r <= pixels.len() {
         if let (Some(d), Some(p)) = (depth.get_mut(l..r), pixels.get_mut(l..r)) {
-            return S::fill(&t.payload, t.depth.origin(), span, d, p);
+            return S::fill(&t.payload, span, d, p);
         }
     }
     // walk_band clamps spans to the row and passes only non-empty ones.

@@ -1093,7 +1093,7 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Resolve<P, S> for OrderPainter<'_,
                 if let (Some(run), Some(o)) = (pixels.get_mut(start..i), order.get_mut(start..i)) {
                     if !run.is_empty() {
                         o.fill(key);
-                        S::paint(&t.payload, t.depth.origin(), x + start as i32, y, run);
+                        S::paint(&t.payload, x + start as i32, y, run);
                         written += run.len() as u32;
                     }
                 }
