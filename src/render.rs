@@ -583,7 +583,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         let mut first: Option<i32> = None;
         let mut culled = false;
         // `placed`: pass 1 placed `s` from these same cached positions and filed it.
-        let mut emit = |s: [ScreenVertex<S>; 3], placed: bool| {
+        let mut emit = |s: &[ScreenVertex<S>; 3], placed: bool| {
             let placement = match placed {
                 true => Placement::FirstRow(0),
                 false => Placement::of(&s.each_ref().map(xy), vp, cull),
@@ -593,7 +593,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                 Placement::Back => culled = true,
                 Placement::FirstRow(r) => {
                     first = Some(first.map_or(r, |f| f.min(r)));
-                    f(&s);
+                    f(s);
                 }
             }
         };
@@ -606,7 +606,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                         return Fate::Rejected;
                     }
                     if let Some(s) = CachedVertex::triangle::<S>(c, colors) {
-                        emit(s, filed);
+                        emit(&s, filed);
                         break 'pieces false;
                     }
                     // The cache keeps no eye-space points: transform again (same result).
@@ -619,7 +619,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                 Clipped::Skipped => return Fate::Unclipped,
                 Clipped::Inside => {
                     if let [Some(a), Some(b), Some(c)] = cv.each_ref().map(project) {
-                        emit([a, b, c], false);
+                        emit(&[a, b, c], false);
                     }
                     false
                 }
@@ -628,7 +628,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                     let mut fan = polygon.as_ref().iter().filter_map(project);
                     if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
                         for c in fan {
-                            emit([a, b, c], false);
+                            emit(&[a, b, c], false);
                             b = c;
                         }
                     }
