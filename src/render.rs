@@ -502,12 +502,15 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         [0, 1, 2].map(|k| color_channels(shade(base[k], intensity[k])))
     }
 
-    /// Transforms the three vertices `idx` to eye space, with colour attributes `colors`.
+    /// Transforms the three vertices `idx` of triangle `tri` to eye space, with their colour
+    /// attributes ([`Self::vertex_attributes`]; computed here, so that callers keep no copy).
     fn clip_vertices<A: Arithmetic<Transform = T>>(
         &self,
+        tri: usize,
         idx: [u16; 3],
-        colors: [[I16F16; 3]; 3],
+        lit: bool,
     ) -> [ClipVertex; 3] {
+        let colors = self.vertex_attributes::<A>(tri, idx, lit);
         let verts = self.instance.mesh.vertices();
         let zero = [I16F16::ZERO; 3];
         let v = idx.map(|i| internal(verts.get(i as usize), &zero));
@@ -579,7 +582,6 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
             debug_assert!(false, "internal error: no triangle {tri}");
             return Fate::Rejected;
         };
-        let colors = self.vertex_attributes::<A>(tri, idx, lit);
         let mut first: Option<i32> = None;
         let mut culled = false;
         // `placed`: pass 1 placed `s` from these same cached positions and filed it.
@@ -605,14 +607,16 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                     if CachedVertex::all_outside_one_plane(c) {
                         return Fate::Rejected;
                     }
-                    if let Some(s) = CachedVertex::triangle::<S>(c, colors) {
+                    if let Some(s) =
+                        CachedVertex::triangle::<S>(c, self.vertex_attributes::<A>(tri, idx, lit))
+                    {
                         emit(&s, filed);
                         break 'pieces false;
                     }
                     // The cache keeps no eye-space points: transform again (same result).
-                    self.clip_vertices::<A>(idx, colors)
+                    self.clip_vertices::<A>(tri, idx, lit)
                 }
-                None => self.clip_vertices::<A>(idx, colors),
+                None => self.clip_vertices::<A>(tri, idx, lit),
             };
             match C::clip(vp, &cv, &mut polygon) {
                 Clipped::Outside => return Fate::Rejected,
