@@ -488,11 +488,6 @@ impl DepthPlane {
         (q.clamp(0, i32::MAX as i64) as i32, depth_step(&self.q))
     }
 
-    /// The reference pixel, shared with the triangle's colour planes.
-    pub fn origin(&self) -> &PixelOrigin {
-        &self.origin
-    }
-
     /// Depth at pixel centre `(c, r)` in I2F30, unclamped (for tests).
     #[cfg_attr(not(feature = "internals"), allow(dead_code))] // used by the tests and tools
     pub fn depth_at(&self, c: i32, r: i32) -> Depth {

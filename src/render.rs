@@ -320,7 +320,7 @@ pub(crate) fn internal<T>(value: Option<T>, fallback: T) -> T {
 /// Buckets and active list as slices, so the driver is not generic over the capacities.
 pub(crate) struct Frame<'a, T, K, H = u16> {
     pub(crate) heads: &'a mut [H],
-    pub(crate) next: &'a mut [u16],
+    pub(crate) next: &'a mut [H],
     pub(crate) refs: &'a mut [u16],
     /// One sort key per bucket entry; empty unless `K::SORTED`.
     pub(crate) keys: &'a mut [u32],
@@ -780,7 +780,7 @@ pub(crate) fn drive<
                         u16::try_from(filed),
                     ) {
                         *r = id;
-                        *next = head.entry();
+                        *next = *head;
                         *head = H::to(entry);
                     } else {
                         debug_assert!(false, "internal error: triangle {id} not filed");
@@ -841,7 +841,7 @@ pub(crate) trait RowPieces<const SUB: u32> {
 /// Row buckets (heads and links of entry lists) over pieces looked up by entry.
 pub(crate) struct Buckets<'a, A, H = u16> {
     pub(crate) heads: &'a [H],
-    pub(crate) next: &'a [u16],
+    pub(crate) next: &'a [H],
     pub(crate) pieces: &'a A,
 }
 
@@ -856,7 +856,7 @@ impl<const SUB: u32, A: ActivePieces<SUB>, H: BucketHead> RowPieces<SUB> for Buc
         let mut entry = internal(self.heads.get(row).map(|h| h.entry()), NO_ENTRY);
         while entry != NO_ENTRY {
             let e = entry as usize;
-            entry = internal(self.next.get(e).copied(), NO_ENTRY);
+            entry = internal(self.next.get(e).map(|n| n.entry()), NO_ENTRY);
             self.pieces.each_piece::<S>(e, &mut f);
         }
     }

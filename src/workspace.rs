@@ -14,9 +14,7 @@ use crate::depth::Depth;
 use crate::depth::DepthFormat;
 use crate::options::{RenderOptions, MAX_INSTANCES};
 pub use crate::render::BucketHead;
-use crate::render::{
-    drive, fill_span, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve, NO_ENTRY,
-};
+use crate::render::{drive, fill_span, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve};
 use crate::scene::{Scene, MAX_SCENE_TRIANGLES};
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
@@ -125,7 +123,7 @@ pub struct Workspace<
     pixels: [P; W],
     background: P,
     heads: [B; H],
-    next: [u16; TRIS],
+    next: [B; TRIS],
     refs: [u16; TRIS],
     active: Vec<ActiveTri<S::Payload<P>>, ACTIVE>,
     vertices: [CachedVertex; VERTS],
@@ -214,7 +212,7 @@ impl<
             pixels: [background; W],
             background,
             heads: [B::EMPTY; H],
-            next: [NO_ENTRY; TRIS],
+            next: [B::EMPTY; TRIS],
             refs: [0; TRIS],
             active: Vec::new(),
             vertices: [CachedVertex::EMPTY; VERTS],
@@ -319,7 +317,7 @@ pub(crate) struct SpanView<'a, P: RowPixel, S: Shading, Z, const INSTANCES: usiz
     pixels: &'a mut [P],
     background: P,
     heads: &'a mut [B],
-    next: &'a mut [u16],
+    next: &'a mut [B],
     refs: &'a mut [u16],
     active: &'a mut VecView<ActiveTri<S::Payload<P>>>,
     vertices: &'a mut [CachedVertex],
