@@ -3,9 +3,14 @@
 //!
 //! # Memory (sizes in bytes)
 //!
-//! `4·W` depth row + `size_of::<P>()·W` pixel row + `2·H` bucket heads + `4·TRIS` bucket lists +
-//! `ACTIVE · size_of` of an active triangle (about 104 for flat shading) + `VERTS ·`
-//! [`CachedVertex::BYTES`]. See [`Workspace::BYTES`].
+//! `4·W` depth row + `size_of::<P>()·W` pixel row + `b·H` bucket heads + `(b + 2)·TRIS` bucket
+//! lists (`b` = 2, or 1 with `u8` heads: [`BucketHead`]) + `ACTIVE · size_of` of an active
+//! triangle (96 for flat shading with pixels of up to 2 bytes, 104 with larger ones) + `VERTS ·`
+//! [`CachedVertex::BYTES`]. See [`Workspace::BYTES`] and [`workspace_bytes_with`].
+//!
+//! The lean minimal build (240×240, `TRIS` = 29, `ACTIVE` = 11, `u8` heads, flat `Rgb565`):
+//! 960 + 480 + 240 + 87 + 11 · 96 bytes, 2,840 with the background pixel and the active list's
+//! length (padded to 8 bytes on 32-bit targets).
 
 use crate::arithmetic::Arithmetic;
 use crate::cache::CachedVertex;
@@ -132,7 +137,8 @@ pub struct Workspace<
 /// Bytes of a [`Workspace`] for pixel type `P`, shading `S` and depth format `Z` with the given
 /// size and capacities: what `Workspace::<P, S, W, H, TRIS, ACTIVE, INSTANCES, Z>::BYTES` is,
 /// computed at run time (for tools such as `sim analyze` that choose the capacities). A vertex
-/// cache adds [`crate::cache::vertex_cache_bytes`].
+/// cache adds [`crate::cache::vertex_cache_bytes`]; for one-byte bucket heads see
+/// [`workspace_bytes_with`].
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
@@ -152,6 +158,23 @@ pub const fn workspace_bytes<P: RowPixel, S: Shading, Z: DepthFormat>(
     triangles: usize,
     active: usize,
 ) -> usize {
+    workspace_bytes_with::<P, S, Z, u16>(width, height, triangles, active)
+}
+
+/// [`workspace_bytes`] for a workspace whose bucket heads and links are `B` ([`BucketHead`]).
+///
+/// ```
+/// use embedded_graphics::pixelcolor::Rgb565;
+/// use scanline3d::{workspace::workspace_bytes_with, Depth, Flat, Workspace};
+/// type Lean = Workspace<Rgb565, Flat, 240, 240, 29, 11, 1, Depth, 0, u8>;
+/// assert_eq!(workspace_bytes_with::<Rgb565, Flat, Depth, u8>(240, 240, 29, 11), Lean::BYTES);
+/// ```
+pub const fn workspace_bytes_with<P: RowPixel, S: Shading, Z: DepthFormat, B: BucketHead>(
+    width: usize,
+    height: usize,
+    triangles: usize,
+    active: usize,
+) -> usize {
     use core::mem::{align_of, size_of};
     let entry = size_of::<ActiveTri<S::Payload<P>>>();
     let align = {
@@ -162,10 +185,11 @@ pub const fn workspace_bytes<P: RowPixel, S: Shading, Z: DepthFormat>(
             align_of::<usize>()
         }
     };
+    // Heads (one per row) and links (one per entry) are `B`; each entry's triangle id is `u16`.
     let unpadded = width * (size_of::<Z>() + size_of::<P>())
         + size_of::<P>()
-        + height * size_of::<u16>()
-        + triangles * 2 * size_of::<u16>()
+        + height * size_of::<B>()
+        + triangles * (size_of::<B>() + size_of::<u16>())
         + active * entry
         + size_of::<usize>();
     unpadded.div_ceil(align) * align
