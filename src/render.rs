@@ -502,15 +502,12 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         [0, 1, 2].map(|k| color_channels(shade(base[k], intensity[k])))
     }
 
-    /// Transforms the three vertices `idx` of triangle `tri` to eye space, with their colour
-    /// attributes ([`Self::vertex_attributes`]; computed here, so that callers keep no copy).
+    /// Transforms the three vertices `idx` to eye space, with colour attributes `colors`.
     fn clip_vertices<A: Arithmetic<Transform = T>>(
         &self,
-        tri: usize,
         idx: [u16; 3],
-        lit: bool,
+        colors: [[I16F16; 3]; 3],
     ) -> [ClipVertex; 3] {
-        let colors = self.vertex_attributes::<A>(tri, idx, lit);
         let verts = self.instance.mesh.vertices();
         let zero = [I16F16::ZERO; 3];
         let v = idx.map(|i| internal(verts.get(i as usize), &zero));
@@ -582,6 +579,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
             debug_assert!(false, "internal error: no triangle {tri}");
             return Fate::Rejected;
         };
+        let colors = self.vertex_attributes::<A>(tri, idx, lit);
         let mut first: Option<i32> = None;
         let mut culled = false;
         // `placed`: pass 1 placed `s` from these same cached positions and filed it.
@@ -607,16 +605,14 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                     if CachedVertex::all_outside_one_plane(c) {
                         return Fate::Rejected;
                     }
-                    if let Some(s) =
-                        CachedVertex::triangle::<S>(c, self.vertex_attributes::<A>(tri, idx, lit))
-                    {
+                    if let Some(s) = CachedVertex::triangle::<S>(c, colors) {
                         emit(&s, filed);
                         break 'pieces false;
                     }
                     // The cache keeps no eye-space points: transform again (same result).
-                    self.clip_vertices::<A>(tri, idx, lit)
+                    self.clip_vertices::<A>(idx, colors)
                 }
-                None => self.clip_vertices::<A>(tri, idx, lit),
+                None => self.clip_vertices::<A>(idx, colors),
             };
             match C::clip(vp, &cv, &mut polygon) {
                 Clipped::Outside => return Fate::Rejected,
