@@ -579,7 +579,9 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
             debug_assert!(false, "internal error: no triangle {tri}");
             return Fate::Rejected;
         };
-        let colors = self.vertex_attributes::<A>(tri, idx, lit);
+        // The colour attributes are made where they are used, so no copy of them stays in this
+        // frame (flat shading's are zeros).
+        let colors = || self.vertex_attributes::<A>(tri, idx, lit);
         let mut first: Option<i32> = None;
         let mut culled = false;
         // `placed`: pass 1 placed `s` from these same cached positions and filed it.
@@ -605,14 +607,14 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                     if CachedVertex::all_outside_one_plane(c) {
                         return Fate::Rejected;
                     }
-                    if let Some(s) = CachedVertex::triangle::<S>(c, colors) {
+                    if let Some(s) = CachedVertex::triangle::<S>(c, colors()) {
                         emit(&s, filed);
                         break 'pieces false;
                     }
                     // The cache keeps no eye-space points: transform again (same result).
-                    self.clip_vertices::<A>(idx, colors)
+                    self.clip_vertices::<A>(idx, colors())
                 }
-                None => self.clip_vertices::<A>(idx, colors),
+                None => self.clip_vertices::<A>(idx, colors()),
             };
             match C::clip(vp, &cv, &mut polygon) {
                 Clipped::Outside => return Fate::Rejected,

@@ -649,7 +649,10 @@ fn workspace_bytes_matches_the_compiled_layout() {
     // One-byte bucket heads and links: one byte per row and per entry less.
     use scanline3d::workspace::workspace_bytes_with;
     type Lean = Workspace<Rgb565, Flat, 240, 240, 29, 11, 1, Depth, 0, u8>;
-    assert_eq!(workspace_bytes_with::<Rgb565, Flat, Depth, u8>(240, 240, 29, 11), Lean::BYTES);
+    assert_eq!(
+        workspace_bytes_with::<Rgb565, Flat, Depth, u8>(240, 240, 29, 11),
+        Lean::BYTES
+    );
     assert_eq!(
         workspace_bytes::<Rgb565, Flat, Depth>(240, 240, 29, 11) - Lean::BYTES,
         (240 + 29) / 8 * 8
