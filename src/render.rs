@@ -259,9 +259,9 @@ pub trait BucketHead: Copy + core::fmt::Debug + sealed::Sealed + 'static {
     const EMPTY: Self;
     /// Most bucket entries (the workspace's `TRIS`) this type can point to.
     const MAX_ENTRIES: usize;
-    /// The entry this head points to, [`NO_ENTRY`] for an empty bucket.
+    /// The entry this head points to, `u16::MAX` for an empty bucket.
     fn entry(self) -> u16;
-    /// The head pointing to `entry` (below [`Self::MAX_ENTRIES`], or [`NO_ENTRY`]).
+    /// The head pointing to `entry` (below [`Self::MAX_ENTRIES`], or `u16::MAX` for none).
     fn to(entry: u16) -> Self;
 }
 
