@@ -50,11 +50,14 @@ pub enum Clipped {
 pub trait Clipping: Copy + Default + core::fmt::Debug + PartialEq + Eq + sealed::Sealed {
     /// Whether this stage can cut triangles.
     const CLIPS: bool;
+    /// The buffer a cut triangle's polygon is left in: a [`ClipPolygon`] where triangles are
+    /// cut, nothing (no bytes on the stack) for [`NoClip`], which never leaves one.
+    type Polygon: Default + AsRef<[ClipVertex]>;
     /// Classifies `tri` and, if it is cut, leaves the remaining polygon in `out`.
     fn clip<const S: u32>(
         vp: &Viewport<S>,
         tri: &[ClipVertex; 3],
-        out: &mut ClipPolygon,
+        out: &mut Self::Polygon,
     ) -> Clipped;
 }
 
@@ -76,6 +79,7 @@ pub struct NoClip;
 
 impl Clipping for FrustumClip {
     const CLIPS: bool = true;
+    type Polygon = ClipPolygon;
     fn clip<const S: u32>(
         vp: &Viewport<S>,
         tri: &[ClipVertex; 3],
@@ -87,7 +91,12 @@ impl Clipping for FrustumClip {
 
 impl Clipping for NoClip {
     const CLIPS: bool = false;
-    fn clip<const S: u32>(vp: &Viewport<S>, tri: &[ClipVertex; 3], _: &mut ClipPolygon) -> Clipped {
+    type Polygon = [ClipVertex; 0];
+    fn clip<const S: u32>(
+        vp: &Viewport<S>,
+        tri: &[ClipVertex; 3],
+        _: &mut [ClipVertex; 0],
+    ) -> Clipped {
         match classify(vp, tri) {
             Clipped::Polygon => Clipped::Skipped,
             other => other,

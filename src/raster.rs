@@ -469,7 +469,6 @@ impl DepthPlane {
     #[inline]
     pub fn walk_from(&self, r: i32) -> WalkDepth {
         WalkDepth {
-            origin: self.origin,
             // `row_q = value − dx·c_ref + dy·(r − r_ref)`, wrapping (mod 2^64) as
             // `PixelOrigin::at` does, so `row_q + dx·c` is its value at `(c, r)` to the bit.
             q: Plane {
@@ -487,11 +486,6 @@ impl DepthPlane {
     pub fn span_start(&self, c: i32, r: i32) -> (i32, i32) {
         let q = self.origin.at(&self.q, c, r) >> DEPTH_PLANE_EXTRA_BITS;
         (q.clamp(0, i32::MAX as i64) as i32, depth_step(&self.q))
-    }
-
-    /// The reference pixel, shared with the triangle's colour planes.
-    pub fn origin(&self) -> &PixelOrigin {
-        &self.origin
     }
 
     /// Depth at pixel centre `(c, r)` in I2F30, unclamped (for tests).
@@ -514,7 +508,6 @@ fn depth_step(q: &Plane) -> i32 {
 /// result as [`DepthPlane::span_start`] to the bit.
 #[derive(Clone, Copy, Debug)]
 pub struct WalkDepth {
-    origin: PixelOrigin,
     /// `value`: the plane at column 0 of the current row.
     q: Plane,
 }
@@ -538,12 +531,6 @@ impl WalkDepth {
     #[inline]
     pub fn step(&self) -> i32 {
         depth_step(&self.q)
-    }
-
-    /// The reference pixel, shared with the triangle's colour planes.
-    #[inline]
-    pub fn origin(&self) -> &PixelOrigin {
-        &self.origin
     }
 }
 

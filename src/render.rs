@@ -15,7 +15,7 @@
 
 use crate::arithmetic::Arithmetic;
 use crate::cache::CachedVertex;
-use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping};
+use crate::clip::{ClipVertex, Clipped, Clipping};
 use crate::depth::{DepthFormat, DepthRow};
 use crate::math::NormalPrecision;
 use crate::options::RenderOptions;
@@ -241,7 +241,7 @@ pub(crate) fn fill_span<P: RowPixel, S: Shading, Z: DepthFormat, K>(
     // so the fill's loop counts one of them.
     if l < r && r <= depth.len() && r <= pixels.len() {
         if let (Some(d), Some(p)) = (depth.get_mut(l..r), pixels.get_mut(l..r)) {
-            return S::fill(&t.payload, t.depth.origin(), span, d, p);
+            return S::fill(&t.payload, span, d, p);
         }
     }
     // walk_band clamps spans to the row and passes only non-empty ones.
@@ -250,6 +250,56 @@ pub(crate) fn fill_span<P: RowPixel, S: Shading, Z: DepthFormat, K>(
 }
 
 pub(crate) const NO_ENTRY: u16 = u16::MAX;
+
+/// The integer type of a row bucket's head (one per row of the target): `u16`, for any
+/// triangle capacity, or `u8`, for workspaces that file at most 255 triangles a frame, whose
+/// heads then take one byte per row instead of two.
+pub trait BucketHead: Copy + core::fmt::Debug + sealed::Sealed + 'static {
+    /// An empty bucket.
+    const EMPTY: Self;
+    /// Most bucket entries (the workspace's `TRIS`) this type can point to.
+    const MAX_ENTRIES: usize;
+    /// The entry this head points to, `u16::MAX` for an empty bucket.
+    fn entry(self) -> u16;
+    /// The head pointing to `entry` (below [`Self::MAX_ENTRIES`], or `u16::MAX` for none).
+    fn to(entry: u16) -> Self;
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for u8 {}
+    impl Sealed for u16 {}
+}
+
+impl BucketHead for u16 {
+    const EMPTY: u16 = NO_ENTRY;
+    const MAX_ENTRIES: usize = MAX_SCENE_TRIANGLES;
+    #[inline(always)]
+    fn entry(self) -> u16 {
+        self
+    }
+    #[inline(always)]
+    fn to(entry: u16) -> u16 {
+        entry
+    }
+}
+
+impl BucketHead for u8 {
+    const EMPTY: u8 = u8::MAX;
+    const MAX_ENTRIES: usize = u8::MAX as usize;
+    #[inline(always)]
+    fn entry(self) -> u16 {
+        match self {
+            u8::MAX => NO_ENTRY,
+            e => e as u16,
+        }
+    }
+    #[inline(always)]
+    fn to(entry: u16) -> u8 {
+        // Entries stay below MAX_ENTRIES (the workspace's capacity check); NO_ENTRY is EMPTY.
+        u8::try_from(entry).unwrap_or(u8::MAX)
+    }
+}
 
 /// `value`, or `fallback` if it is `None`: for look-ups that validation (of meshes, trees and
 /// capacities) or the frame's own set-up make infallible, so that `None` is an internal error.
@@ -268,9 +318,9 @@ pub(crate) fn internal<T>(value: Option<T>, fallback: T) -> T {
 }
 
 /// Buckets and active list as slices, so the driver is not generic over the capacities.
-pub(crate) struct Frame<'a, T, K> {
-    pub(crate) heads: &'a mut [u16],
-    pub(crate) next: &'a mut [u16],
+pub(crate) struct Frame<'a, T, K, H = u16> {
+    pub(crate) heads: &'a mut [H],
+    pub(crate) next: &'a mut [H],
     pub(crate) refs: &'a mut [u16],
     /// One sort key per bucket entry; empty unless `K::SORTED`.
     pub(crate) keys: &'a mut [u32],
@@ -522,18 +572,20 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         lit: bool,
         depth: bool,
         filed: bool,
-        mut f: impl FnMut([ScreenVertex<S>; 3]),
+        mut f: impl FnMut(&[ScreenVertex<S>; 3]),
     ) -> Fate {
         let Some(&idx) = self.instance.mesh.triangles().get(tri) else {
             // Callers pass the mesh's own triangles (a BSP tree's ranges are checked against it).
             debug_assert!(false, "internal error: no triangle {tri}");
             return Fate::Rejected;
         };
-        let colors = self.vertex_attributes::<A>(tri, idx, lit);
+        // The colour attributes are made where they are used, so no copy of them stays in this
+        // frame (flat shading's are zeros).
+        let colors = || self.vertex_attributes::<A>(tri, idx, lit);
         let mut first: Option<i32> = None;
         let mut culled = false;
         // `placed`: pass 1 placed `s` from these same cached positions and filed it.
-        let mut emit = |s: [ScreenVertex<S>; 3], placed: bool| {
+        let mut emit = |s: &[ScreenVertex<S>; 3], placed: bool| {
             let placement = match placed {
                 true => Placement::FirstRow(0),
                 false => Placement::of(&s.each_ref().map(xy), vp, cull),
@@ -548,37 +600,37 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
             }
         };
         let project = |c: &ClipVertex| vp.project_as::<A::Projection>(&c.p, c.color, depth);
-        let mut polygon = ClipPolygon::new();
+        let mut polygon = C::Polygon::default();
         let clipped = 'pieces: {
             let cv = match self.cached(cache, idx) {
                 Some(c) => {
                     if CachedVertex::all_outside_one_plane(c) {
                         return Fate::Rejected;
                     }
-                    if let Some(s) = CachedVertex::triangle::<S>(c, colors) {
-                        emit(s, filed);
+                    if let Some(s) = CachedVertex::triangle::<S>(c, colors()) {
+                        emit(&s, filed);
                         break 'pieces false;
                     }
                     // The cache keeps no eye-space points: transform again (same result).
-                    self.clip_vertices::<A>(idx, colors)
+                    self.clip_vertices::<A>(idx, colors())
                 }
-                None => self.clip_vertices::<A>(idx, colors),
+                None => self.clip_vertices::<A>(idx, colors()),
             };
             match C::clip(vp, &cv, &mut polygon) {
                 Clipped::Outside => return Fate::Rejected,
                 Clipped::Skipped => return Fate::Unclipped,
                 Clipped::Inside => {
                     if let [Some(a), Some(b), Some(c)] = cv.each_ref().map(project) {
-                        emit([a, b, c], false);
+                        emit(&[a, b, c], false);
                     }
                     false
                 }
                 Clipped::Polygon => {
                     // Fan from the first vertex, projecting each vertex once as the fan reaches it.
-                    let mut fan = polygon.iter().filter_map(project);
+                    let mut fan = polygon.as_ref().iter().filter_map(project);
                     if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
                         for c in fan {
-                            emit([a, b, c], false);
+                            emit(&[a, b, c], false);
                             b = c;
                         }
                     }
@@ -647,8 +699,9 @@ pub(crate) fn drive<
     K: RowSink<P>,
     const INSTANCES: usize,
     R: Resolve<P, S>,
+    H: BucketHead,
 >(
-    ws: Frame<'_, S::Payload<P>, R::Key>,
+    ws: Frame<'_, S::Payload<P>, R::Key, H>,
     resolve: &mut R,
     order: &mut impl TriangleOrder,
     scene: &Scene<'_>,
@@ -682,7 +735,7 @@ pub(crate) fn drive<
     // (reverse id order, which leaves each row's list in ascending id order, as pushing is at
     // the head). Depth sorting also keeps a key per triangle: its rank in `order` if that is a
     // drawing order (BSP), else the mean depth of its (clipped) vertices, larger = nearer.
-    ws.heads.fill(NO_ENTRY);
+    ws.heads.fill(H::EMPTY);
     let mut filed = 0usize;
     for setup in &setups {
         stats.triangles_in += setup.instance.mesh.triangles().len() as u32;
@@ -726,7 +779,7 @@ pub(crate) fn drive<
                     ) {
                         *r = id;
                         *next = *head;
-                        *head = entry;
+                        *head = H::to(entry);
                     } else {
                         debug_assert!(false, "internal error: triangle {id} not filed");
                     }
@@ -765,7 +818,10 @@ pub(crate) fn drive<
         pieces: &pieces,
     };
     let height = ws.heads.len();
-    walk_rows::<P, S, SUB, K, R>(height, ws.active, &mut rows, resolve, width, sink, stats)
+    walk_rows::<P, S, SUB, K, R>(
+        height, ws.active, &mut rows, resolve, width, sink, &mut stats,
+    )?;
+    Ok(stats)
 }
 
 /// What pass 2 activates on each row: the pieces that start there (in any order that is the
@@ -776,29 +832,29 @@ pub(crate) trait RowPieces<const SUB: u32> {
     fn each_row_piece<S: Shading>(
         &mut self,
         row: usize,
-        f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     );
 }
 
 /// Row buckets (heads and links of entry lists) over pieces looked up by entry.
-pub(crate) struct Buckets<'a, A> {
-    pub(crate) heads: &'a [u16],
-    pub(crate) next: &'a [u16],
+pub(crate) struct Buckets<'a, A, H = u16> {
+    pub(crate) heads: &'a [H],
+    pub(crate) next: &'a [H],
     pub(crate) pieces: &'a A,
 }
 
-impl<const SUB: u32, A: ActivePieces<SUB>> RowPieces<SUB> for Buckets<'_, A> {
+impl<const SUB: u32, A: ActivePieces<SUB>, H: BucketHead> RowPieces<SUB> for Buckets<'_, A, H> {
     #[inline(always)]
     fn each_row_piece<S: Shading>(
         &mut self,
         row: usize,
-        mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        mut f: impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         // Rows are below `height`, entries below the bucket capacity.
-        let mut entry = internal(self.heads.get(row).copied(), NO_ENTRY);
+        let mut entry = internal(self.heads.get(row).map(|h| h.entry()), NO_ENTRY);
         while entry != NO_ENTRY {
             let e = entry as usize;
-            entry = internal(self.next.get(e).copied(), NO_ENTRY);
+            entry = internal(self.next.get(e).map(|n| n.entry()), NO_ENTRY);
             self.pieces.each_piece::<S>(e, &mut f);
         }
     }
@@ -811,7 +867,7 @@ pub(crate) trait ActivePieces<const SUB: u32> {
     fn each_piece<S: Shading>(
         &self,
         entry: usize,
-        f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     );
 }
 
@@ -833,7 +889,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic> ActivePieces<SUB>
     fn each_piece<S: Shading>(
         &self,
         e: usize,
-        mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        mut f: impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         // Entries, ids and triangles all come from pass 1 of this frame.
         let Some(&id) = self.refs.get(e) else {
@@ -890,8 +946,8 @@ pub(crate) fn walk_rows<
     resolve: &mut R,
     width: i32,
     sink: &mut K,
-    mut stats: FrameStats,
-) -> Result<FrameStats, RenderError<K::Error>> {
+    stats: &mut FrameStats,
+) -> Result<(), RenderError<K::Error>> {
     let band = resolve.band_rows().max(1);
     let mut active = ActiveList::new(active);
     // Last row covered by any dropped piece so far: rows up to it are incomplete.
@@ -903,7 +959,7 @@ pub(crate) fn walk_rows<
         if band > 1 {
             // Triangles carried over from earlier bands come first, in activation order.
             active.retain(|t, order| {
-                walk_band::<P, S, SUB, R>(t, order, y1 as i32, width, resolve, &mut stats)
+                walk_band::<P, S, SUB, R>(t, order, y1 as i32, width, resolve, stats)
             });
         }
         for row in y0..y1 {
@@ -913,19 +969,19 @@ pub(crate) fn walk_rows<
                 pieces.each_row_piece::<S>(row, |s, face, id, key| {
                     let (Some(walk), Some(solver)) = (
                         TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32),
-                        PlaneSolver::new(&s),
+                        PlaneSolver::new(s),
                     ) else {
                         // Pieces have screen area and rows from this one on (their bucket is
                         // their first row, or the first of their triangle's pieces).
                         debug_assert!(false, "internal error: piece of {id} not walkable");
                         return;
                     };
-                    let depth = DepthPlane::new(&solver, &s).walk_from(walk.row());
+                    let depth = DepthPlane::new(&solver, s).walk_from(walk.row());
                     let mut tri_state = ActiveTri {
                         walk,
                         depth,
                         depth_step: depth.step(),
-                        payload: S::payload::<P, SUB>(face, id, &solver, &s),
+                        payload: S::payload::<P, SUB>(face, id, &solver, s),
                         key: R::Key::from_raw(key),
                         link: NO_LINK,
                     };
@@ -941,7 +997,7 @@ pub(crate) fn walk_rows<
                             y1 as i32,
                             width,
                             resolve,
-                            &mut stats,
+                            stats,
                         ) || active.insert(tri_state)
                     } else {
                         active.insert(tri_state)
@@ -967,7 +1023,7 @@ pub(crate) fn walk_rows<
             if band == 1 {
                 stats.peak_active = stats.peak_active.max(active.live as u16);
                 active.retain(|t, order| {
-                    walk_band::<P, S, SUB, R>(t, order, y + 1, width, resolve, &mut stats)
+                    walk_band::<P, S, SUB, R>(t, order, y + 1, width, resolve, stats)
                 });
             }
         }
@@ -997,7 +1053,7 @@ pub(crate) fn walk_rows<
         }
         y0 = y1;
     }
-    Ok(stats)
+    Ok(())
 }
 
 /// Walks triangle `t` down to row `y1` (exclusive), handing each on-screen span to `resolve`.
@@ -1064,7 +1120,7 @@ pub(crate) fn for_each_screen_piece<
                 S::PER_VERTEX,
                 true,
                 false,
-                |s| f(s, face, id),
+                |s| f(*s, face, id),
             );
             match fate {
                 Fate::Culled => stats.culled += 1,

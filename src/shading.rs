@@ -57,7 +57,6 @@ pub trait Shading: sealed::Sealed + Copy + Default {
     /// span's columns. Returns the number of pixels written.
     fn fill<P: RowPixel, Z: DepthFormat>(
         payload: &Self::Payload<P>,
-        origin: &PixelOrigin,
         span: SpanDepth,
         depth: &mut [Z],
         pixels: &mut [P],
@@ -66,13 +65,7 @@ pub trait Shading: sealed::Sealed + Copy + Default {
     /// Writes the span starting at column `x0` of row `y` without a depth test, for methods
     /// that settle visibility before painting (span sorting, depth sorting); `pixels` is
     /// exactly the span's columns.
-    fn paint<P: RowPixel>(
-        payload: &Self::Payload<P>,
-        origin: &PixelOrigin,
-        x0: i32,
-        y: i32,
-        pixels: &mut [P],
-    );
+    fn paint<P: RowPixel>(payload: &Self::Payload<P>, x0: i32, y: i32, pixels: &mut [P]);
 }
 
 /// Flat shading: one Lambert + ambient colour per face.
@@ -299,7 +292,6 @@ impl Shading for Flat {
     #[inline]
     fn fill<P: RowPixel, Z: DepthFormat>(
         color: &P,
-        _: &PixelOrigin,
         span: SpanDepth,
         depth: &mut [Z],
         pixels: &mut [P],
@@ -320,15 +312,17 @@ impl Shading for Flat {
     }
 
     #[inline]
-    fn paint<P: RowPixel>(color: &P, _: &PixelOrigin, _: i32, _: i32, pixels: &mut [P]) {
+    fn paint<P: RowPixel>(color: &P, _: i32, _: i32, pixels: &mut [P]) {
         pixels.fill(*color);
     }
 }
 
-/// Per-triangle data for [`Gouraud`].
+/// Per-triangle data for [`Gouraud`]: the colour planes and the pixel they are relative to
+/// (kept here, not with the depth, so flat triangles do not carry it).
 #[derive(Clone, Copy, Debug)]
 pub struct GouraudPayload<T> {
     planes: T,
+    origin: PixelOrigin,
     id: u32,
 }
 
@@ -344,6 +338,7 @@ impl<I: Interpolation> Shading for Gouraud<I> {
     ) -> Self::Payload<P> {
         GouraudPayload {
             planes: I::planes(solver, v),
+            origin: solver.origin(),
             id,
         }
     }
@@ -351,12 +346,17 @@ impl<I: Interpolation> Shading for Gouraud<I> {
     #[inline]
     fn fill<P: RowPixel, Z: DepthFormat>(
         payload: &Self::Payload<P>,
-        origin: &PixelOrigin,
         span: SpanDepth,
         depth: &mut [Z],
         pixels: &mut [P],
     ) -> u32 {
-        let mut c = I::cursor(&payload.planes, origin, span.x0, span.y, depth.len());
+        let mut c = I::cursor(
+            &payload.planes,
+            &payload.origin,
+            span.x0,
+            span.y,
+            depth.len(),
+        );
         let mut q = span.q;
         let mut written = 0;
         for (z, p) in depth.iter_mut().zip(pixels.iter_mut()) {
@@ -373,14 +373,8 @@ impl<I: Interpolation> Shading for Gouraud<I> {
     }
 
     #[inline]
-    fn paint<P: RowPixel>(
-        payload: &Self::Payload<P>,
-        origin: &PixelOrigin,
-        x0: i32,
-        y: i32,
-        pixels: &mut [P],
-    ) {
-        let mut c = I::cursor(&payload.planes, origin, x0, y, pixels.len());
+    fn paint<P: RowPixel>(payload: &Self::Payload<P>, x0: i32, y: i32, pixels: &mut [P]) {
+        let mut c = I::cursor(&payload.planes, &payload.origin, x0, y, pixels.len());
         for p in pixels.iter_mut() {
             *p = P::from_shade(I::colour(&c), payload.id);
             I::advance(&mut c);
@@ -443,10 +437,10 @@ mod tests {
             q: 1,
             dq: 0,
         };
-        let written = Gouraud::<I>::fill(&payload, &solver.origin(), span, &mut depth, &mut pixels);
+        let written = Gouraud::<I>::fill(&payload, span, &mut depth, &mut pixels);
         assert_eq!(written, 180);
         let mut painted = [Rgb888::new(0, 0, 0); 180];
-        Gouraud::<I>::paint(&payload, &solver.origin(), 0, 32, &mut painted);
+        Gouraud::<I>::paint(&payload, 0, 32, &mut painted);
         assert_eq!(pixels, painted, "fill and paint interpolate alike");
         use embedded_graphics::pixelcolor::RgbColor;
         (0..180)
@@ -482,9 +476,8 @@ mod tests {
         for len in 1..=40usize {
             let mut seg = [Rgb888::new(0, 0, 0); 40];
             let mut one = [Rgb888::new(0, 0, 0); 40];
-            let o = solver.origin();
-            Gouraud::<PerSegment<16>>::paint(&payload, &o, 10, 30, &mut seg[..len]);
-            Gouraud::<PerPixel>::paint(&exact, &o, 10, 30, &mut one[..len]);
+            Gouraud::<PerSegment<16>>::paint(&payload, 10, 30, &mut seg[..len]);
+            Gouraud::<PerPixel>::paint(&exact, 10, 30, &mut one[..len]);
             assert_eq!(seg[0], one[0], "first pixel exact, length {len}");
             assert_eq!(seg[len - 1], one[len - 1], "last pixel exact, length {len}");
             if len > 16 {

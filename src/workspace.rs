@@ -3,9 +3,14 @@
 //!
 //! # Memory (sizes in bytes)
 //!
-//! `4·W` depth row + `size_of::<P>()·W` pixel row + `2·H` bucket heads + `4·TRIS` bucket lists +
-//! `ACTIVE · size_of` of an active triangle (about 104 for flat shading) + `VERTS ·`
-//! [`CachedVertex::BYTES`]. See [`Workspace::BYTES`].
+//! `4·W` depth row + `size_of::<P>()·W` pixel row + `b·H` bucket heads + `(b + 2)·TRIS` bucket
+//! lists (`b` = 2, or 1 with `u8` heads: [`BucketHead`]) + `ACTIVE · size_of` of an active
+//! triangle (96 for flat shading with pixels of up to 2 bytes, 104 with larger ones) + `VERTS ·`
+//! [`CachedVertex::BYTES`]. See [`Workspace::BYTES`] and [`workspace_bytes_with`].
+//!
+//! The lean minimal build (240×240, `TRIS` = 29, `ACTIVE` = 11, `u8` heads, flat `Rgb565`):
+//! 960 + 480 + 240 + 87 + 11 · 96 bytes, 2,840 with the background pixel and the active list's
+//! length (padded to 8 bytes on 32-bit targets).
 
 use crate::arithmetic::Arithmetic;
 use crate::cache::CachedVertex;
@@ -13,9 +18,8 @@ use crate::clip::Clipping;
 use crate::depth::Depth;
 use crate::depth::DepthFormat;
 use crate::options::{RenderOptions, MAX_INSTANCES};
-use crate::render::{
-    drive, fill_span, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve, NO_ENTRY,
-};
+pub use crate::render::BucketHead;
+use crate::render::{drive, fill_span, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve};
 use crate::scene::{Scene, MAX_SCENE_TRIANGLES};
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
@@ -96,6 +100,8 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for SpanZBuffer<'_, 
 /// * `VERTS`: vertex cache entries ([`crate::cache`], default 0: none). When the scene's
 ///   vertices fit, each is transformed and projected once per frame instead of once per
 ///   triangle and pass: RAM for speed, with the same pixels.
+/// * `B`: the type of the row bucket heads ([`BucketHead`]): `u16` (the default) or `u8`,
+///   one byte per row instead of two for workspaces with `TRIS` at most 255.
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
@@ -116,12 +122,13 @@ pub struct Workspace<
     const INSTANCES: usize = MAX_INSTANCES,
     Z: DepthFormat = Depth,
     const VERTS: usize = 0,
+    B: BucketHead = u16,
 > {
     depth: [Z; W],
     pixels: [P; W],
     background: P,
-    heads: [u16; H],
-    next: [u16; TRIS],
+    heads: [B; H],
+    next: [B; TRIS],
     refs: [u16; TRIS],
     active: Vec<ActiveTri<S::Payload<P>>, ACTIVE>,
     vertices: [CachedVertex; VERTS],
@@ -130,7 +137,8 @@ pub struct Workspace<
 /// Bytes of a [`Workspace`] for pixel type `P`, shading `S` and depth format `Z` with the given
 /// size and capacities: what `Workspace::<P, S, W, H, TRIS, ACTIVE, INSTANCES, Z>::BYTES` is,
 /// computed at run time (for tools such as `sim analyze` that choose the capacities). A vertex
-/// cache adds [`crate::cache::vertex_cache_bytes`].
+/// cache adds [`crate::cache::vertex_cache_bytes`]; for one-byte bucket heads see
+/// [`workspace_bytes_with`].
 ///
 /// ```
 /// use embedded_graphics::pixelcolor::Rgb565;
@@ -150,6 +158,23 @@ pub const fn workspace_bytes<P: RowPixel, S: Shading, Z: DepthFormat>(
     triangles: usize,
     active: usize,
 ) -> usize {
+    workspace_bytes_with::<P, S, Z, u16>(width, height, triangles, active)
+}
+
+/// [`workspace_bytes`] for a workspace whose bucket heads and links are `B` ([`BucketHead`]).
+///
+/// ```
+/// use embedded_graphics::pixelcolor::Rgb565;
+/// use scanline3d::{workspace::workspace_bytes_with, Depth, Flat, Workspace};
+/// type Lean = Workspace<Rgb565, Flat, 240, 240, 29, 11, 1, Depth, 0, u8>;
+/// assert_eq!(workspace_bytes_with::<Rgb565, Flat, Depth, u8>(240, 240, 29, 11), Lean::BYTES);
+/// ```
+pub const fn workspace_bytes_with<P: RowPixel, S: Shading, Z: DepthFormat, B: BucketHead>(
+    width: usize,
+    height: usize,
+    triangles: usize,
+    active: usize,
+) -> usize {
     use core::mem::{align_of, size_of};
     let entry = size_of::<ActiveTri<S::Payload<P>>>();
     let align = {
@@ -160,10 +185,11 @@ pub const fn workspace_bytes<P: RowPixel, S: Shading, Z: DepthFormat>(
             align_of::<usize>()
         }
     };
+    // Heads (one per row) and links (one per entry) are `B`; each entry's triangle id is `u16`.
     let unpadded = width * (size_of::<Z>() + size_of::<P>())
         + size_of::<P>()
-        + height * size_of::<u16>()
-        + triangles * 2 * size_of::<u16>()
+        + height * size_of::<B>()
+        + triangles * (size_of::<B>() + size_of::<u16>())
         + active * entry
         + size_of::<usize>();
     unpadded.div_ceil(align) * align
@@ -179,7 +205,8 @@ impl<
         const INSTANCES: usize,
         Z: DepthFormat,
         const VERTS: usize,
-    > Workspace<P, S, W, H, TRIS, ACTIVE, INSTANCES, Z, VERTS>
+        B: BucketHead,
+    > Workspace<P, S, W, H, TRIS, ACTIVE, INSTANCES, Z, VERTS, B>
 {
     /// Size of this workspace in bytes.
     pub const BYTES: usize = core::mem::size_of::<Self>();
@@ -194,6 +221,10 @@ impl<
             "height must be 1..=2048"
         );
         assert!(TRIS <= MAX_SCENE_TRIANGLES, "TRIS must be at most 65535");
+        assert!(
+            TRIS <= B::MAX_ENTRIES,
+            "TRIS must fit the bucket heads: at most 255 with u8 heads"
+        );
     };
 
     /// An empty workspace whose background pixels are `background`.
@@ -204,8 +235,8 @@ impl<
             depth: [Z::FAR; W],
             pixels: [background; W],
             background,
-            heads: [NO_ENTRY; H],
-            next: [NO_ENTRY; TRIS],
+            heads: [B::EMPTY; H],
+            next: [B::EMPTY; TRIS],
             refs: [0; TRIS],
             active: Vec::new(),
             vertices: [CachedVertex::EMPTY; VERTS],
@@ -289,7 +320,7 @@ impl<
     }
 
     /// The workspace as slices, so code that renders through it is not generic over the sizes.
-    pub(crate) fn span_view(&mut self) -> SpanView<'_, P, S, Z, INSTANCES> {
+    pub(crate) fn span_view(&mut self) -> SpanView<'_, P, S, Z, INSTANCES, B> {
         SpanView {
             depth: &mut self.depth,
             pixels: &mut self.pixels,
@@ -305,19 +336,19 @@ impl<
 
 /// A span z-buffer workspace borrowed as slices: its width and height are the lengths of its
 /// rows and bucket heads, so nothing here is generic over the sizes.
-pub(crate) struct SpanView<'a, P: RowPixel, S: Shading, Z, const INSTANCES: usize> {
+pub(crate) struct SpanView<'a, P: RowPixel, S: Shading, Z, const INSTANCES: usize, B = u16> {
     depth: &'a mut [Z],
     pixels: &'a mut [P],
     background: P,
-    heads: &'a mut [u16],
-    next: &'a mut [u16],
+    heads: &'a mut [B],
+    next: &'a mut [B],
     refs: &'a mut [u16],
     active: &'a mut VecView<ActiveTri<S::Payload<P>>>,
     vertices: &'a mut [CachedVertex],
 }
 
-impl<P: RowPixel, S: Shading, Z: DepthFormat, const INSTANCES: usize>
-    SpanView<'_, P, S, Z, INSTANCES>
+impl<P: RowPixel, S: Shading, Z: DepthFormat, const INSTANCES: usize, B: BucketHead>
+    SpanView<'_, P, S, Z, INSTANCES, B>
 {
     /// Renders a `width × height` target (at most the workspace's size).
     pub(crate) fn render_sized<const SUB_BITS: u32, C: Clipping, A: Arithmetic, K: RowSink<P>>(
@@ -351,7 +382,7 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat, const INSTANCES: usize>
             vertices: self.vertices,
         };
         let mut resolve = SpanZBuffer::new(depth, pixels, self.background);
-        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _>(
             frame,
             &mut resolve,
             &mut IdOrder,

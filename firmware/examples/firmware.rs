@@ -37,7 +37,6 @@ mod measure;
 mod firmware {
     use super::arch;
     use embedded_graphics::pixelcolor::Rgb565;
-    use scanline3d::raster::PixelOrigin;
     use scanline3d::shading::{Shading, SpanDepth};
     use scanline3d::{Depth, Flat};
     use scanline3d_demo as demo;
@@ -55,13 +54,7 @@ mod firmware {
     /// One flat span fill, called the way the renderer calls it: through row slices.
     #[inline(never)]
     fn fill_span(span: SpanDepth, depth: &mut [Depth], pixels: &mut [Rgb565]) -> u32 {
-        Flat::fill::<_, Depth>(
-            &Rgb565::new(31, 0, 0),
-            &PixelOrigin::new(0, 0),
-            span,
-            depth,
-            pixels,
-        )
+        Flat::fill::<_, Depth>(&Rgb565::new(31, 0, 0), span, depth, pixels)
     }
 
     /// The inner span loop alone: a 240-pixel flat span filled `REPS` times, every pixel passing

@@ -197,7 +197,13 @@ impl Export<'_> {
         let mut uses = vec!["embedded_graphics::pixelcolor::Rgb888"];
         uses.push("fixed::types::I16F16");
         uses.push("scanline3d::scene::{Mesh, MeshColors, SceneError, Vertex}");
-        uses.push("scanline3d::{Storage, Workspace}");
+        // Up to 255 filed triangles, one-byte bucket heads halve the heads' RAM.
+        let byte_heads = tris <= u8::MAX as usize;
+        uses.push(if byte_heads {
+            "scanline3d::{Depth, Storage, Workspace}"
+        } else {
+            "scanline3d::{Storage, Workspace}"
+        });
         if self.bsp.is_some() {
             uses.push("scanline3d::resolve::bsp::{BspNode, BspTree, BspWorkspace, NO_CHILD}");
         }
@@ -318,8 +324,16 @@ impl Export<'_> {
         );
         let _ = writeln!(s, "/// Mesh instances: this file holds one mesh.");
         let _ = writeln!(s, "pub const INSTANCES: usize = 1;");
-        let _ = writeln!(s, "/// The workspace this budget asks for.");
-        s += "pub type SceneWorkspace<P, S> =\n    Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE, INSTANCES>;\n";
+        if byte_heads {
+            let _ = writeln!(
+                s,
+                "/// The workspace this budget asks for, with one-byte row bucket heads (`MAX_TRIANGLES` <= 255)."
+            );
+            s += "pub type SceneWorkspace<P, S> =\n    Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE, INSTANCES, Depth, 0, u8>;\n";
+        } else {
+            let _ = writeln!(s, "/// The workspace this budget asks for.");
+            s += "pub type SceneWorkspace<P, S> =\n    Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE, INSTANCES>;\n";
+        }
         s += "/// The renderer this budget asks for, for configuration `C` (a `scanline3d::Config`).\n";
         s += "pub type SceneStorage<C> = Storage<C, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE>;\n\n";
         if self.bsp.is_some() {

@@ -14,7 +14,7 @@ use super::trim::{self, Cut};
 use super::{PatchModel, Tolerance};
 use crate::arithmetic::Arithmetic;
 use crate::cache::CachedVertex;
-use crate::clip::{ClipPolygon, ClipVertex, Clipped, Clipping};
+use crate::clip::{ClipVertex, Clipped, Clipping};
 use crate::depth::Depth;
 use crate::options::RenderOptions;
 use crate::project::{ScreenVertex, Viewport};
@@ -251,20 +251,21 @@ impl<
             free: 0,
             tolerance: ((tolerance.to_bits() as i64) << SUB >> 8).max(1),
             cull: options.cull_back_faces,
-            polygon: ClipPolygon::new(),
+            polygon: C::Polygon::default(),
             stats: PatchStats::default(),
             clipping: core::marker::PhantomData,
         };
         rows.file_patches()?;
         let mut resolve = SpanZBuffer::new(depth, pixels, self.background);
-        let frame = walk_rows::<P, S, SUB, K, _>(
+        let mut frame = FrameStats::default();
+        walk_rows::<P, S, SUB, K, _>(
             height,
             self.active.as_mut_view(),
             &mut rows,
             &mut resolve,
             width as i32,
             sink,
-            FrameStats::default(),
+            &mut frame,
         )?;
         let mut stats = rows.stats;
         let counts = stats.frame;
@@ -290,7 +291,7 @@ enum Hull {
 }
 
 /// The frame's patch state: what pass 2 activates row by row.
-struct PatchRows<'a, 'm, const SUB: u32, C, A: Arithmetic, const TRIM: usize> {
+struct PatchRows<'a, 'm, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize> {
     model: &'m PatchModel<'m>,
     mv: <A::Transform as TransformPrecision>::Matrix,
     lighting: Lighting,
@@ -303,7 +304,7 @@ struct PatchRows<'a, 'm, const SUB: u32, C, A: Arithmetic, const TRIM: usize> {
     /// Flatness tolerance in sub-pixels.
     tolerance: i64,
     cull: bool,
-    polygon: ClipPolygon,
+    polygon: C::Polygon,
     stats: PatchStats,
     clipping: core::marker::PhantomData<C>,
 }
@@ -527,7 +528,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         levels: &Levels,
         side: usize,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         self.stats.pieces += 1;
         let mut recent: [Option<(Uv, Vertex)>; 4] = [None; 4];
@@ -557,7 +558,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         uv: [Uv; 3],
         cv: [Vertex; 3],
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         let trims = self.trims(patch);
         let cut = trim::classify(&trims, uv);
@@ -584,7 +585,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         uv: [Uv; 3],
         face: Sides<Rgb888>,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         self.stats.trim_cut += 1;
         let trims = self.trims(patch);
@@ -615,7 +616,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         net: &Net,
         piece: Piece,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         let Piece { levels, is, js } = piece;
         let mut first = is[0];
@@ -638,7 +639,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         is: [u8; 2],
         js: [u8; 2],
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         let u = |i: u8| tessellate::grid(i as u32, levels.u);
         let v = |j: u8| tessellate::grid(j as u32, levels.v);
@@ -712,7 +713,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         t: [Vertex; 3],
         face: Sides<Rgb888>,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         let back = shows_back(&t);
         let face = if back { face.back } else { face.front };
@@ -744,7 +745,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                 }
             }
             stats.frame.bucketed += 1;
-            f(s, face, patch as u32, 0);
+            f(&s, face, patch as u32, 0);
         };
         let mut stats = self.stats;
         // Inside every clip plane: the screen positions projected once per vertex, as the
@@ -768,7 +769,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
             }
             Clipped::Polygon => {
                 stats.frame.clipped += 1;
-                let mut fan = self.polygon.iter().filter_map(project);
+                let mut fan = self.polygon.as_ref().iter().filter_map(project);
                 if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
                     for c in fan {
                         emit([a, b, c], &mut stats);
@@ -788,7 +789,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         patch: u16,
         net: &Net,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         let levels = tessellate::levels(&self.screen_net(net), self.tolerance);
         self.stats.capped += levels.capped as u32;
@@ -812,7 +813,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         net: &Net,
         piece: Piece,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         self.stats.pieces += 1;
         let Piece { levels, is, js } = piece;
@@ -847,7 +848,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         sub: Net,
         work: Work,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         let first = match self.hull(&sub) {
             Hull::Culled => {
@@ -869,7 +870,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         net: &Net,
         work: Work,
         row: usize,
-        f: &mut impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         match work {
             Work::Patch => self.patch::<S>(patch, net, row, f),
@@ -886,7 +887,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize> RowPieces<SU
     fn each_row_piece<S: Shading>(
         &mut self,
         row: usize,
-        mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        mut f: impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         // Pieces filed under this row while it is processed are taken in the same loop.
         while let Some(Entry { patch, work }) = self.take(row) {

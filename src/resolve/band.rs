@@ -202,7 +202,7 @@ impl<
             width,
             y0: 0,
         };
-        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _>(
             frame,
             &mut band,
             &mut IdOrder,

@@ -511,7 +511,7 @@ impl<
             eye,
             stack: &mut self.stack,
         };
-        drive::<P, S, SUB_BITS, C, A, K, 1, _>(
+        drive::<P, S, SUB_BITS, C, A, K, 1, _, _>(
             frame,
             &mut resolve,
             &mut order,

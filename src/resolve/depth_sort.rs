@@ -68,7 +68,7 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for Painter<'_, P> {
         self.spans += 1;
         match self.pixels.get_mut(l as usize..r as usize) {
             Some(out) => {
-                S::paint(&t.payload, t.depth.origin(), l, y, out);
+                S::paint(&t.payload, l, y, out);
                 (r - l) as u32
             }
             None => {
@@ -149,7 +149,7 @@ impl<
             background: self.background,
             spans: 0,
         };
-        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _>(
             frame,
             &mut resolve,
             &mut IdOrder,

@@ -309,7 +309,7 @@ impl<
         ) else {
             return Err(RenderError::InvalidTarget);
         };
-        let (n, stats) = store::collect::<S, SUB_BITS, C, A, K::Error, INSTANCES>(
+        let (n, mut stats) = store::collect::<S, SUB_BITS, C, A, K::Error, INSTANCES>(
             scene,
             options,
             &vp,
@@ -385,8 +385,9 @@ impl<
             &mut painter,
             width as i32,
             sink,
-            stats,
-        )
+            &mut stats,
+        )?;
+        Ok(stats)
     }
 }
 
@@ -1092,7 +1093,7 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Resolve<P, S> for OrderPainter<'_,
                 if let (Some(run), Some(o)) = (pixels.get_mut(start..i), order.get_mut(start..i)) {
                     if !run.is_empty() {
                         o.fill(key);
-                        S::paint(&t.payload, t.depth.origin(), x + start as i32, y, run);
+                        S::paint(&t.payload, x + start as i32, y, run);
                         written += run.len() as u32;
                     }
                 }

@@ -4,7 +4,6 @@ use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::depth::DepthRow;
 use crate::options::{RenderOptions, MAX_INSTANCES};
-use crate::raster::PixelOrigin;
 use crate::render::{
     drive, internal, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve, NO_ENTRY,
 };
@@ -28,7 +27,6 @@ struct SortSpan<T> {
     /// z-buffer does).
     order: i32,
     payload: T,
-    origin: PixelOrigin,
 }
 
 impl<T> SortSpan<T> {
@@ -105,7 +103,6 @@ impl<P: RowPixel, S: Shading> Resolve<P, S> for SpanSort<'_, P, S::Payload<P>> {
             dq: dq as i64,
             order: order as i32,
             payload: t.payload,
-            origin: *t.depth.origin(),
         });
         debug_assert!(
             pushed.is_ok(),
@@ -172,7 +169,7 @@ fn sweep<P: RowPixel, S: Shading>(
         let end = next_change(present, x, end, front);
         if let Some(f) = front.and_then(|f| present.get(f)) {
             if let Some(out) = pixels.get_mut(x as usize..end as usize) {
-                S::paint(&f.payload, &f.origin, x, y, out);
+                S::paint(&f.payload, x, y, out);
                 written += (end - x) as u32;
             } else {
                 // Spans are clamped to the row and segments end within it.
@@ -280,7 +277,7 @@ impl<
             background: self.background,
             spans: self.spans.as_mut_view(),
         };
-        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _>(
             frame,
             &mut resolve,
             &mut IdOrder,

@@ -167,12 +167,12 @@ impl<const SUB: u32> ActivePieces<SUB> for StoredPieces<'_> {
     fn each_piece<S: Shading>(
         &self,
         entry: usize,
-        mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32, u32),
+        mut f: impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
         // Entries index the store, which has a key per piece.
         if let Some(t) = self.store.get(entry) {
             let key = internal(self.keys.get(entry).copied(), 0);
-            f(t.screen::<SUB>(), t.face(), t.id, key);
+            f(&t.screen::<SUB>(), t.face(), t.id, key);
         } else {
             debug_assert!(false, "internal error: no kept piece {entry}");
         }

@@ -693,7 +693,7 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Subdivision<'_, P, S, SUB> {
     fn paint(&mut self, s: &Surface<S::Payload<P>>, y: i32, a: i32, b: i32) {
         let at = y as usize * self.stride;
         if let Some(out) = self.frame.get_mut(at + a as usize..at + b as usize) {
-            S::paint(&s.payload, s.plane.origin(), a, y, out);
+            S::paint(&s.payload, a, y, out);
             self.written += (b - a) as u32;
         } else {
             debug_assert!(

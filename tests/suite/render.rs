@@ -214,15 +214,15 @@ macro_rules! check_bytes {
 
 #[test]
 fn workspace_bytes_follow_the_documented_formula() {
-    // Active triangles (host sizes): 104 bytes with flat shading (as documented) and pixels of
-    // up to 2 bytes, 112 with 3- and 4-byte pixels (`Rgb888`, `TriangleId`), 144 with affine
+    // Active triangles (host sizes): 96 bytes with flat shading (as documented) and pixels of
+    // up to 2 bytes, 104 with 3- and 4-byte pixels (`Rgb888`, `TriangleId`), 144 with affine
     // Gouraud, 208 with perspective-correct Gouraud.
-    check_bytes! { Rgb565, Flat, Depth, 4, 104, [(240, 240, 1280, 64), (1, 1, 1, 1), (17, 3, 5, 2)] }
-    check_bytes! { Rgb565, Flat, Depth, 4, 104, [(7, 9, 0, 0)] }
-    check_bytes! { Rgb888, Flat, Depth, 4, 112, [(320, 240, 1536, 96), (3, 5, 7, 1)] }
-    check_bytes! { Gray8, Flat, Depth16, 2, 104, [(240, 240, 1280, 64), (13, 1, 3, 3)] }
-    check_bytes! { BinaryColor, Flat, Depth, 4, 104, [(128, 64, 256, 16), (1, 2048, 1, 5)] }
-    check_bytes! { TriangleId, Flat, Depth, 4, 112, [(64, 64, 4096, 512), (2048, 1, 9, 1)] }
+    check_bytes! { Rgb565, Flat, Depth, 4, 96, [(240, 240, 1280, 64), (1, 1, 1, 1), (17, 3, 5, 2)] }
+    check_bytes! { Rgb565, Flat, Depth, 4, 96, [(7, 9, 0, 0)] }
+    check_bytes! { Rgb888, Flat, Depth, 4, 104, [(320, 240, 1536, 96), (3, 5, 7, 1)] }
+    check_bytes! { Gray8, Flat, Depth16, 2, 96, [(240, 240, 1280, 64), (13, 1, 3, 3)] }
+    check_bytes! { BinaryColor, Flat, Depth, 4, 96, [(128, 64, 256, 16), (1, 2048, 1, 5)] }
+    check_bytes! { TriangleId, Flat, Depth, 4, 104, [(64, 64, 4096, 512), (2048, 1, 9, 1)] }
     check_bytes! { Rgb565, Gouraud, Depth, 4, 144, [(240, 240, 1280, 64), (5, 5, 5, 5)] }
     check_bytes! { Rgb888, Gouraud, Depth16, 2, 144, [(31, 17, 100, 3)] }
     check_bytes! { Rgb565, Gouraud<PerPixel>, Depth, 4, 208, [(240, 240, 1280, 64), (9, 3, 1, 7)] }
@@ -234,7 +234,7 @@ fn workspace_bytes_follow_the_documented_formula() {
     type Cached = Workspace<Rgb565, Flat, 240, 240, 1280, 64, 8, Depth, 700>;
     assert_eq!(Cached::BYTES, plain + vertex_cache_bytes(700));
     type Odd = Workspace<Rgb565, Flat, 240, 240, 1280, 64, 8, Depth, 701>;
-    let parts = documented_bytes::<Rgb565>(4, 240, 240, 1280, 64, 104) + 701 * 8;
+    let parts = documented_bytes::<Rgb565>(4, 240, 240, 1280, 64, 96) + 701 * 8;
     assert!((parts..parts + 8).contains(&Odd::BYTES), "{}", Odd::BYTES);
     assert!(Odd::BYTES <= plain + vertex_cache_bytes(701));
 }
@@ -253,10 +253,10 @@ fn icosphere_frame_fits_16_kib() {
         (Ws::BYTES - fixed_part) / 64
     );
     const { assert!(Ws::BYTES <= 16 * 1024) }
-    // The sum above with 104-byte active triangles is 13,706; padding to 8 bytes makes the
-    // README's 13,712.
-    assert_eq!(fixed_part + 2 + 64 * 104 + 8, 13_706);
-    assert_eq!(Ws::BYTES, 13_712);
+    // The sum above with 96-byte active triangles is 13,194; padding to 8 bytes makes
+    // docs/design.md's 13,200.
+    assert_eq!(fixed_part + 2 + 64 * 96 + 8, 13_194);
+    assert_eq!(Ws::BYTES, 13_200);
 
     let sphere = icosphere(3, 1.0);
     assert_eq!((sphere.vertices.len(), sphere.triangles.len()), (642, 1280));
@@ -646,6 +646,17 @@ fn workspace_bytes_matches_the_compiled_layout() {
     }
     check!(Rgb565, Flat, 240, 240, 100, 12);
     check!(Rgb565, Flat, 1, 1, 1, 1);
+    // One-byte bucket heads and links: one byte per row and per entry less.
+    use scanline3d::workspace::workspace_bytes_with;
+    type Lean = Workspace<Rgb565, Flat, 240, 240, 29, 11, 1, Depth, 0, u8>;
+    assert_eq!(
+        workspace_bytes_with::<Rgb565, Flat, Depth, u8>(240, 240, 29, 11),
+        Lean::BYTES
+    );
+    assert_eq!(
+        workspace_bytes::<Rgb565, Flat, Depth>(240, 240, 29, 11) - Lean::BYTES,
+        (240 + 29) / 8 * 8
+    );
     check!(Rgb565, Flat, 241, 3, 7, 5);
     check!(Rgb888, Gouraud, 240, 240, 640, 64);
     check!(TriangleId, Flat, 64, 63, 511, 9);

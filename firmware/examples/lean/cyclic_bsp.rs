@@ -12,7 +12,7 @@ use embedded_graphics::pixelcolor::Rgb888;
 use fixed::types::I16F16;
 use scanline3d::resolve::bsp::{BspNode, BspTree, BspWorkspace, NO_CHILD};
 use scanline3d::scene::{Mesh, MeshColors, SceneError, Vertex};
-use scanline3d::{Storage, Workspace};
+use scanline3d::{Depth, Storage, Workspace};
 
 const fn c(bits: i32) -> I16F16 {
     I16F16::from_bits(bits)
@@ -136,9 +136,9 @@ pub const NEEDS_CLIPPING: bool = false;
 pub const CULL_BACK_FACES: bool = false;
 /// Mesh instances: this file holds one mesh.
 pub const INSTANCES: usize = 1;
-/// The workspace this budget asks for.
+/// The workspace this budget asks for, with one-byte row bucket heads (`MAX_TRIANGLES` <= 255).
 pub type SceneWorkspace<P, S> =
-    Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE, INSTANCES>;
+    Workspace<P, S, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE, INSTANCES, Depth, 0, u8>;
 /// The renderer this budget asks for, for configuration `C` (a `scanline3d::Config`).
 pub type SceneStorage<C> = Storage<C, WIDTH, HEIGHT, MAX_TRIANGLES, MAX_ACTIVE>;
 
