@@ -58,7 +58,7 @@ pub mod vector;
 pub use hybrid::ScreenBound;
 pub use intersect::Ray;
 pub use row_shadow::ShadowCandidate;
-pub use scene::{Colour, Light, LightKind, Material, Scene, TraceCamera, TraceSceneError};
+pub use scene::{Checker, Colour, Light, LightKind, Material, Scene, TraceCamera, TraceSceneError};
 pub use shape::{Object, Plane, Polygon, Shape, ShapeError, Sphere, Triangle};
 pub use tracer::{PixelTrace, ShadowCache, TraceError, TraceOptions, TraceStats, Tracer};
 pub use vector::Vec3;

@@ -136,6 +136,9 @@ pub struct PixelTrace {
     pub depth: I16F16,
     /// Bit k set when light k contributes nothing at the primary hit (N·L ≤ 0 or blocked).
     pub shadow: u8,
+    /// Index in [`Scene::materials`] of the material at the primary hit (a checker texture's
+    /// cell's), if any.
+    pub material: Option<u16>,
 }
 
 /// A ray waiting on the stack.
@@ -332,6 +335,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             id: None,
             depth: I16F16::ZERO,
             shadow: 0,
+            material: None,
         };
         let raw = self.camera.pixel_direction(column, row);
         let Some((dir, len)) = raw.normalized_with_length() else {
@@ -367,7 +371,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             match hit {
                 None => add_weighted(&mut sum, &self.scene.background, ray.weight),
                 Some(hit) => {
-                    let shadow = self.shade(
+                    let (shadow, material) = self.shade(
                         &ray,
                         hit,
                         &mut sum,
@@ -380,6 +384,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                         out.id = Some(hit.object);
                         out.depth = hit.t.checked_div(len).unwrap_or(I16F16::MAX);
                         out.shadow = shadow;
+                        out.material = material;
                     }
                 }
             }
@@ -503,7 +508,8 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     }
 
     /// Adds the local term at `hit` times the ray's weight to `sum`, pushes the reflected and
-    /// refracted rays the rules allow, and returns the shadow mask at the hit.
+    /// refracted rays the rules allow, and returns the shadow mask at the hit and the index of
+    /// the material there.
     // The per-pixel state a ray adds to (colour sum, ray stack, shadow cache, the row's
     // shadow candidates, counts), each borrowed apart.
     #[allow(clippy::too_many_arguments)]
@@ -516,16 +522,17 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         cache: &mut ShadowCache,
         row_shadows: Option<&RowShadows<'_>>,
         stats: &mut TraceStats,
-    ) -> u8 {
+    ) -> (u8, Option<u16>) {
         let scene = self.scene;
         let Some(object) = scene.objects.get(hit.object as usize) else {
-            return 0;
-        };
-        let Some(material) = scene.materials.get(usize::from(object.material)) else {
-            return 0;
+            return (0, None);
         };
         let ray = &pending.ray;
         let point = ray.origin.along(ray.dir, hit.t);
+        let index = scene.material_index_at(object, point);
+        let Some(material) = index.and_then(|m| scene.materials.get(usize::from(m))) else {
+            return (0, None);
+        };
         let outward = object.shape.normal(point);
         // N faces the incoming ray; `entering` when the outward normal does.
         let entering = outward.dot_bits(ray.dir) < 0;
@@ -564,7 +571,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         add_weighted(sum, &local, pending.weight);
 
         if pending.depth >= self.options.max_depth {
-            return shadow;
+            return (shadow, index);
         }
         let reflected = reflect(ray.dir, normal);
         let mut push = |k: I16F16, dir: Vec3, stats: &mut TraceStats| {
@@ -594,7 +601,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             let refracted = refract(ray.dir, normal, n1, n2).unwrap_or(reflected);
             push(material.kt, refracted, stats);
         }
-        shadow
+        (shadow, index)
     }
 }
 
