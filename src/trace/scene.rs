@@ -364,7 +364,9 @@ impl Scene<'_> {
         if index < self.materials.len() {
             return Some(object.material);
         }
-        let checker = self.checkers.get(index.checked_sub(self.materials.len())?)?;
+        let checker = self
+            .checkers
+            .get(index.checked_sub(self.materials.len())?)?;
         Some(checker.cell_material(point, object.shape.texture_axis()?))
     }
 
@@ -560,9 +562,20 @@ mod tests {
     fn textured_scenes_are_checked() {
         let grey = Colour::new([I16F16::from_num(0.5); 3]).unwrap();
         let m = Material::new(grey, [I16F16::ONE; 4], I16F16::ONE).unwrap();
-        let materials = [m, Material { kr: I16F16::ZERO, ..m }];
+        let materials = [
+            m,
+            Material {
+                kr: I16F16::ZERO,
+                ..m
+            },
+        ];
         let checkers = [Checker::new(0, 1, 0).unwrap()];
-        let square = [p(0.0, 0.0, 0.0), p(0.0, 0.0, 2.0), p(2.0, 0.0, 2.0), p(2.0, 0.0, 0.0)];
+        let square = [
+            p(0.0, 0.0, 0.0),
+            p(0.0, 0.0, 2.0),
+            p(2.0, 0.0, 2.0),
+            p(2.0, 0.0, 0.0),
+        ];
         let floor = Object {
             shape: Shape::Polygon(Polygon::new(&square).unwrap()),
             material: 2,
@@ -576,8 +589,15 @@ mod tests {
             material: 2,
         };
         let scene = |objects: &[Object<'_>], checkers: &[Checker]| {
-            Scene::textured(objects, &materials, checkers, &[], Colour::BLACK, I16F16::ZERO)
-                .map(|_| ())
+            Scene::textured(
+                objects,
+                &materials,
+                checkers,
+                &[],
+                Colour::BLACK,
+                I16F16::ZERO,
+            )
+            .map(|_| ())
         };
         assert_eq!(scene(&[floor, plane], &checkers), Ok(()));
         assert_eq!(
@@ -585,14 +605,29 @@ mod tests {
             Err(TraceSceneError::CheckerOnShape)
         );
         assert_eq!(scene(&[floor], &[]), Err(TraceSceneError::UnknownMaterial));
-        let missing = [Checker { b: 2, ..checkers[0] }];
+        let missing = [Checker {
+            b: 2,
+            ..checkers[0]
+        }];
         assert_eq!(scene(&[floor], &missing), Err(TraceSceneError::BadChecker));
         let objects = [floor];
-        let textured =
-            Scene::textured(&objects, &materials, &checkers, &[], Colour::BLACK, I16F16::ZERO)
-                .unwrap();
-        assert_eq!(textured.material_at(&floor, p(0.5, 0.0, 0.5)), Some(&materials[0]));
-        assert_eq!(textured.material_at(&floor, p(1.5, 0.0, 0.5)), Some(&materials[1]));
+        let textured = Scene::textured(
+            &objects,
+            &materials,
+            &checkers,
+            &[],
+            Colour::BLACK,
+            I16F16::ZERO,
+        )
+        .unwrap();
+        assert_eq!(
+            textured.material_at(&floor, p(0.5, 0.0, 0.5)),
+            Some(&materials[0])
+        );
+        assert_eq!(
+            textured.material_at(&floor, p(1.5, 0.0, 0.5)),
+            Some(&materials[1])
+        );
     }
 
     #[test]

@@ -842,6 +842,40 @@ mod tests {
     }
 
     #[test]
+    fn a_checker_cell_gives_every_coefficient() {
+        // The floor y = 0 with cells of 1 unit: diffuse (even) and mirror (odd) materials.
+        use crate::trace::scene::Checker;
+        let objects = [Object {
+            shape: Shape::Plane(Plane::new(v(0.0, 1.0, 0.0), f(0.0)).unwrap()),
+            material: 2,
+        }];
+        let materials = [material(0.0, 0.0), material(0.5, 0.0)];
+        let checkers = [Checker::new(0, 1, 0).unwrap()];
+        let scene =
+            Scene::textured(&objects, &materials, &checkers, &[], Colour::BLACK, f(0.5)).unwrap();
+        let down = |x: f64| {
+            let camera = TraceCamera::new(
+                [x, 1.0, -0.5],
+                [x, 0.0, -0.5],
+                [0.0, 0.0, -1.0],
+                1.0,
+                0.1,
+                10.0,
+                1,
+                1,
+            )
+            .unwrap();
+            let (p, s) =
+                Tracer::<5>::new(&scene, &camera, TraceOptions::default()).trace_pixel(0, 0);
+            (p.material, s.secondary_rays)
+        };
+        // (0.5, −0.5) is cell (0, −1), odd: the mirror; (−0.5, −0.5) is (−1, −1), even.
+        assert_eq!(down(0.5), (Some(1), 1));
+        assert_eq!(down(-0.5), (Some(0), 0));
+        assert_eq!(down(1.5), (Some(0), 0));
+    }
+
+    #[test]
     fn snell_and_total_internal_reflection() {
         let n = v(0.0, 1.0, 0.0);
         let d = v(0.6, -0.8, 0.0); // sin θi = 0.6

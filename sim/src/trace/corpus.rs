@@ -52,7 +52,8 @@ pub fn all() -> Vec<CorpusScene> {
     vec![
         CorpusScene {
             name: "classic",
-            about: "mirror sphere and glass sphere over a checker-textured floor polygon, two lights",
+            about:
+                "mirror sphere and glass sphere over a checker-textured floor polygon, two lights",
             cameras: vec![("front", camera([0.0, 3.0, 7.0], [0.0, 0.8, 0.0], 50.0))],
         },
         CorpusScene {

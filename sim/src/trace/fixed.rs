@@ -14,9 +14,9 @@ use scanline3d::trace::bvh::{self, BvhNode};
 use scanline3d::trace::grid::{self, GridShape};
 use scanline3d::trace::shape::{AaBox, Ellipsoid, Facet, Frustum};
 use scanline3d::trace::{
-    Checker, Colour, Light, LightKind, Material, Object, PixelTrace, Plane, Polygon, Scene, ScreenBound,
-    ShadowCache, ShadowCandidate, Shape, Sphere, TraceCamera, TraceOptions, TraceStats, Tracer,
-    Triangle, Vec3,
+    Checker, Colour, Light, LightKind, Material, Object, PixelTrace, Plane, Polygon, Scene,
+    ScreenBound, ShadowCache, ShadowCandidate, Shape, Sphere, TraceCamera, TraceOptions,
+    TraceStats, Tracer, Triangle, Vec3,
 };
 
 /// Ray-stack capacity of the host's fixed tracer: room for `--max-depth` up to 31.

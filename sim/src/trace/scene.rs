@@ -437,16 +437,19 @@ impl Parser {
         }
     }
 
-    fn push(&mut self, shape: Shape, surface: Surface, line: usize) -> Result<(), String> {
-        if let Surface::Checker(k) = surface {
-            if !matches!(shape, Shape::Plane { .. } | Shape::Polygon { .. }) {
-                return Err(format!(
-                    "checker '{}' is only for plane and polygon lines, not a {}",
-                    self.scene.checkers[k].name,
-                    shape.kind()
-                ));
-            }
+    /// An error when `surface` is a checker and `kind` of line cannot carry one.
+    fn check_surface(&self, surface: Surface, kind: &str) -> Result<(), String> {
+        match surface {
+            Surface::Checker(k) if kind != "plane" && kind != "polygon" => Err(format!(
+                "checker '{}' is only for plane and polygon lines, not a {kind}",
+                self.scene.checkers[k].name
+            )),
+            _ => Ok(()),
         }
+    }
+
+    fn push(&mut self, shape: Shape, surface: Surface, line: usize) -> Result<(), String> {
+        self.check_surface(surface, shape.kind())?;
         self.scene.objects.push(Object {
             shape,
             surface,
@@ -621,6 +624,7 @@ impl Parser {
                 let file = t.word("mesh file")?;
                 let m = self.material(t)?;
                 t.end()?;
+                self.check_surface(m, "mesh")?;
                 for corners in load_mesh(&dir.join(file))? {
                     self.push(Shape::Triangle { corners }, m, line)?;
                 }
@@ -831,6 +835,29 @@ polygon red 0 0 0 2 0 0 2 2 0 1 1 0 0 2 0
     }
 
     #[test]
+    fn checker_lines_parse() {
+        let s = parse(
+            "material a 1 1 1 0 1 0 0 1\nmaterial b 0 0 0 0 1 0 0 1\nchecker c b a 0.25\n\
+             plane 0 1 0 0 c\npolygon a 0 0 0 1 0 0 0 1 0\n",
+        )
+        .unwrap();
+        assert_eq!(
+            s.checkers,
+            [Checker {
+                name: "c".into(),
+                a: 1,
+                b: 0,
+                size: 0.25,
+                line: 3
+            }]
+        );
+        assert_eq!(s.objects[0].surface, Surface::Checker(0));
+        assert_eq!(s.objects[1].surface, Surface::Material(0));
+        assert_eq!(s.material_at(0, [0.1, 0.0, 0.1]).unwrap().name, "b");
+        assert_eq!(s.material_at(0, [0.3, 0.0, 0.1]).unwrap().name, "a");
+    }
+
+    #[test]
     fn bad_input_is_one_line_naming_the_line() {
         let head = "material m 1 1 1 0 1 0 0 1\n";
         let cases = [
@@ -863,6 +890,28 @@ polygon red 0 0 0 2 0 0 2 2 0 1 1 0 0 2 0
             ("material q 1 1 1 -1 1 0 0 1", "KA -1 is negative"),
             ("background 0 0 0\nbackground 0 0 0", "second background"),
             ("mesh missing.obj m", "missing.obj"),
+            ("checker c m nope 1", "unknown material 'nope'"),
+            ("checker c m m 0", "checker size 0 must be positive"),
+            ("checker c m m -2", "checker size -2 must be positive"),
+            ("checker c m m x", "checker size 'x' is not a number"),
+            ("checker c m m", "missing checker size"),
+            ("checker c m m inf", "not a finite number"),
+            ("checker m m m 1", "'m' defined twice"),
+            ("checker c m m 1 extra", "unexpected 'extra'"),
+            (
+                "checker c m m 1\nmaterial c 1 1 1 0 1 0 0 1",
+                "'c' defined twice",
+            ),
+            (
+                "checker c m m 1\nchecker d c m 1",
+                "'c' is not a plain material",
+            ),
+            (
+                "checker c m m 1\nsphere 0 0 0 1 c",
+                "only for plane and polygon lines, not a sphere",
+            ),
+            ("checker c m m 1\nbox 0 0 0 1 1 1 c", "not a box"),
+            ("checker c m m 1\nmesh missing.obj c", "not a mesh"),
         ];
         for (body, want) in cases {
             let err = parse(&format!("{head}\n# comment\n{body}\n")).unwrap_err();
