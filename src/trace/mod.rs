@@ -4,10 +4,10 @@
 //!
 //! [`vector`] (I16F16 vectors, integer square root) → [`shape`] (primitives, validated) →
 //! [`intersect`] (ray–primitive tests) → [`bvh`] (bounding volumes, built into caller buffers
-//! or exported as `static` data) → [`scene`] (materials, lights, camera) → [`row_shadow`]
-//! (hybrid mode's per-row shadow candidates) → [`tracer`] (the ray tree on an explicit stack,
-//! shading, rows, the shadow cache) → [`hybrid`] (primary visibility from the objects' screen
-//! bounds instead of a walk per pixel, the row's shadow candidates).
+//! or exported as `static` data) → [`scene`] (materials, checker textures, lights, camera) →
+//! [`row_shadow`] (hybrid mode's per-row shadow candidates) → [`tracer`] (the ray tree on an
+//! explicit stack, shading, rows, the shadow cache) → [`hybrid`] (primary visibility from the
+//! objects' screen bounds instead of a walk per pixel, the row's shadow candidates).
 //!
 //! ## Envelope and bit budget
 //!

@@ -331,12 +331,11 @@ impl<'a> Scene<'a> {
         for o in objects {
             match usize::from(o.material).checked_sub(materials.len()) {
                 None => {}
-                Some(k) if k < checkers.len() => {
-                    if o.shape.texture_axis().is_none() {
-                        return Err(TraceSceneError::CheckerOnShape);
-                    }
+                Some(k) if k >= checkers.len() => return Err(TraceSceneError::UnknownMaterial),
+                Some(_) if o.shape.texture_axis().is_none() => {
+                    return Err(TraceSceneError::CheckerOnShape)
                 }
-                Some(_) => return Err(TraceSceneError::UnknownMaterial),
+                Some(_) => {}
             }
         }
         if ambient < I16F16::ZERO || ambient > I16F16::ONE {
