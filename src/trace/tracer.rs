@@ -476,7 +476,17 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         };
         match (candidates, &self.scene.grid, &self.scene.bvh) {
             (Some(list), _, _) => {
-                let _ = any_blocks(self.scene, list, ray, EPSILON, t_max, &mut blocks);
+                // Two candidates are known not to block: the cached object, just tested with
+                // the same call, and a planar object the ray starts on (never met again).
+                let from_planar = self
+                    .scene
+                    .objects
+                    .get(from as usize)
+                    .is_some_and(|o| o.shape.plane().is_some());
+                let skip = (*cached, if from_planar { from } else { u32::MAX });
+                let _ = any_blocks(self.scene, list, ray, EPSILON, t_max, |id| {
+                    id != skip.0 && id != skip.1 && blocks(id)
+                });
             }
             (None, Some(grid), _) => {
                 if !grid.unbounded().iter().any(|id| blocks(*id)) {
