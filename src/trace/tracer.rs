@@ -459,8 +459,12 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         candidates: Option<&[ShadowCandidate]>,
         stats: &mut TraceStats,
     ) -> bool {
-        let mut tests = 1;
-        if self.hit(*cached, ray, from, EPSILON, t_max).is_some() {
+        // The cached object is tested only if it names one that can block: with candidates,
+        // one of them (any other cannot block this ray).
+        let cache_useful = *cached != u32::MAX
+            && candidates.is_none_or(|list| list.iter().any(|c| c.object == *cached));
+        let mut tests = u32::from(cache_useful);
+        if cache_useful && self.hit(*cached, ray, from, EPSILON, t_max).is_some() {
             stats.intersection_tests += tests;
             stats.shadow_cache_hits += 1;
             return true;
@@ -506,8 +510,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 }
             }
         }
-        // The cached object counts as a test only when it names one.
-        stats.intersection_tests += tests - u32::from(*cached == u32::MAX);
+        stats.intersection_tests += tests;
         match blocker {
             Some(id) => {
                 *cached = id;
