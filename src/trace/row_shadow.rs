@@ -91,13 +91,13 @@ pub(crate) fn padded_box(object: &Object<'_>) -> Option<([i32; 3], [i32; 3])> {
     bvh::bounds(&object.shape).map(|(lo, hi)| (lo.sub(pad).bits(), hi.add(pad).bits()))
 }
 
-/// The union of the boxes a row's first hits lie in (one per active object: `None` when the
-/// object is unbounded, `Some(None)` when the row sees none of it): `None` when an active
-/// object is unbounded (the row's shadow rays then walk the hierarchy), `Some(None)` when the
-/// row has no first hit.
+/// A box of raw I16F16 bits (inclusive), `None`: empty.
 pub(crate) type Region = Option<([i32; 3], [i32; 3])>;
 
-/// See [`Region`].
+/// The union of the boxes a row's first hits lie in, one per active object (`None` when the
+/// object is unbounded, `Some(None)` when the row sees none of it); `None` when an active
+/// object is unbounded: the row's first hits are then not bounded and its shadow rays walk
+/// the hierarchy.
 pub(crate) fn row_region(boxes: impl Iterator<Item = Option<Region>>) -> Option<Region> {
     let mut region: Region = None;
     for b in boxes {
