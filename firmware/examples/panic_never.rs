@@ -144,9 +144,10 @@ mod firmware {
     fn trace<const STACK: usize>(options: scanline3d::trace::TraceOptions, sink: &mut HashSink) {
         use scanline3d::trace::{Scene, TraceCamera, Tracer};
         let v = black_box(super::view::CLASSIC);
-        let scene = Scene::new(
+        let scene = Scene::textured(
             black_box(&super::classic::OBJECTS),
             &super::classic::MATERIALS,
+            black_box(&super::classic::CHECKERS),
             &super::classic::LIGHTS,
             super::classic::BACKGROUND,
             super::classic::AMBIENT,
@@ -177,7 +178,7 @@ mod firmware {
                 let mut shadow = [ShadowCandidate::default(); LISTS];
                 let n = black_box(super::classic::OBJECTS.len());
                 let l = black_box(LISTS);
-                for (b, a, c) in [(n, n, l), (n, 3, 5), (2, n, 0)] {
+                for (b, a, c) in [(n, n, l), (n, 2, 3), (2, n, 0)] {
                     let stats = Tracer::<STACK>::new(&with_bvh, &camera, options).render_hybrid(
                         bounds.get_mut(..b).unwrap_or(&mut []),
                         active.get_mut(..a).unwrap_or(&mut []),

@@ -1,5 +1,5 @@
 //! Firmware: the fixed-point Whitted tracer renders the lecture's classic scene (a mirror sphere
-//! and a glass sphere over a checkered floor of 64 polygons, two point lights) at 240×240, row by
+//! and a glass sphere over a floor polygon with a checker texture, two point lights) at 240×240, row by
 //! row into a hash of the row stream (no frame buffer), with shadows and depth limit 4: frame 0
 //! by the pure tracer, frame 1 in hybrid mode (primary visibility from the objects' screen
 //! bounds); both hashes equal the host's.
@@ -65,9 +65,10 @@ mod firmware {
     fn run() -> Result<(), &'static str> {
         arch::start_counter()?;
         measure::calibrate()?;
-        let scene = Scene::new(
+        let scene = Scene::textured(
             &classic::OBJECTS,
             &classic::MATERIALS,
+            &classic::CHECKERS,
             &classic::LIGHTS,
             classic::BACKGROUND,
             classic::AMBIENT,

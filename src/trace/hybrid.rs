@@ -22,7 +22,8 @@
 use crate::depth::DepthRow;
 use crate::sink::{Row, RowPixel, RowSink};
 use crate::trace::bvh::{self, heap_sort_by_key, PAD};
-use crate::trace::row_shadow::{row_shadows, RowShadows, ShadowCandidate};
+use crate::trace::row_shadow::{padded_box, row_region, row_shadows, RowShadows, ShadowCandidate};
+use crate::trace::shape::Object;
 use crate::trace::tracer::{Nearest, PixelTrace, ShadowCache, TraceError, TraceStats, Tracer};
 use crate::trace::vector::Vec3;
 use fixed::types::I8F24;
@@ -184,6 +185,55 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         (used, complete)
     }
 
+    /// Where the first hits of row `y` on `object` can lie, as a box (raw bits, inclusive):
+    /// `None` when unbounded, `Some(None)` when nowhere. A planar object's hits lie where the
+    /// row's rays meet its plane: when the rays through the corners of the row widened by a pixel
+    /// each way all meet the plane in front of the eye, the row's hits lie in the quadrilateral of
+    /// those four points, so its box (widened by `PAD`) is clipped to theirs; otherwise, and for
+    /// the other objects, it is the padded box. Only a speed-up: a shadow ray from a point
+    /// outside the row's region walks the hierarchy ([`RowShadows::for_ray`]).
+    fn row_box(&self, object: &Object<'_>, y: u16) -> Option<Option<([i32; 3], [i32; 3])>> {
+        let (lo, hi) = padded_box(object)?;
+        let Some((normal, offset)) = object.shape.plane() else {
+            return Some(Some((lo, hi)));
+        };
+        let camera = self.camera();
+        let f = |v: [I8F24; 3]| v.map(|c| c.to_num::<f32>());
+        let (corner, right, down) = (f(camera.corner), f(camera.right), f(camera.down));
+        let eye = camera.eye.bits().map(|c| c as f32 / 65536.0);
+        let n = normal.bits().map(|c| c as f32 / 65536.0);
+        let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        // The plane is n·p + offset = 0; along eye + t·dir, t = −(n·eye + offset) / (n·dir).
+        let num = -(dot(n, eye) + offset.to_num::<f32>());
+        let (row, last) = (f32::from(y), f32::from(camera.width));
+        let (mut a, mut b) = ([f32::MAX; 3], [f32::MIN; 3]);
+        for (column, row) in [
+            (-1.0, row - 1.0),
+            (last, row - 1.0),
+            (-1.0, row + 1.0),
+            (last, row + 1.0),
+        ] {
+            let dir: [f32; 3] =
+                core::array::from_fn(|i| corner[i] + column * right[i] + row * down[i]);
+            let t = num / dot(n, dir);
+            // Parallel, behind the eye or not finite: the row may see all of the object.
+            if !(t > 0.0 && t < 1.0e4) {
+                return Some(Some((lo, hi)));
+            }
+            for i in 0..3 {
+                let p = eye[i] + t * dir[i];
+                (a[i], b[i]) = (a[i].min(p), b[i].max(p));
+            }
+        }
+        let pad = PAD.to_bits();
+        // `as` saturates; a point's rounding is far inside the pixel of widening and the pad.
+        let clo: [i32; 3] =
+            core::array::from_fn(|i| ((a[i] * 65536.0) as i32).saturating_sub(pad).max(lo[i]));
+        let chi: [i32; 3] =
+            core::array::from_fn(|i| ((b[i] * 65536.0) as i32).saturating_add(pad).min(hi[i]));
+        Some((0..3).all(|i| clo[i] <= chi[i]).then_some((clo, chi)))
+    }
+
     /// Renders the frame in hybrid mode into `row` (length = the camera's width), handing each
     /// row to `sink`: the same rows as [`render`](Self::render). `bounds` holds the screen
     /// bounds (one per visible object), `active` the rectangles spanning a row; rows they cannot
@@ -259,8 +309,22 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 stats.fallback_rows += 1;
                 // The lists name the active set they were built for: rebuilt after a fallback.
                 lists = None;
-            } else if with_lists && (changed || lists.is_none()) {
-                lists = Some(row_shadows(scene, live.iter().map(|b| b.object), shadow));
+            } else if with_lists {
+                // The region changes from row to row where a planar object is active.
+                let boxes = live.iter().map(|b| {
+                    scene
+                        .objects
+                        .get(b.object as usize)
+                        .and_then(|o| self.row_box(o, y))
+                });
+                let region = row_region(boxes);
+                let same = !changed
+                    && lists
+                        .as_ref()
+                        .is_some_and(|l| l.as_ref().map(RowShadows::region) == region);
+                if !same {
+                    lists = Some(region.and_then(|region| row_shadows(scene, region, shadow)));
+                }
             }
             let row_lists = lists.as_ref().and_then(Option::as_ref);
             if scanned && row_lists.is_none() {
@@ -361,5 +425,62 @@ mod tests {
         }
         let mut small = [ScreenBound::default(); 1];
         assert_eq!(tracer.screen_bounds(&mut small), (1, false));
+    }
+
+    #[test]
+    fn a_rows_hits_on_a_polygon_lie_in_its_row_box() {
+        use crate::trace::shape::Polygon;
+        // The classic's floor, seen from its camera at 48 × 48.
+        let floor = [
+            v(-4.0, 0.0, -4.0),
+            v(-4.0, 0.0, 4.0),
+            v(4.0, 0.0, 4.0),
+            v(4.0, 0.0, -4.0),
+        ];
+        let objects = [Object {
+            shape: Shape::Polygon(Polygon::new(&floor).unwrap()),
+            material: 0,
+        }];
+        let grey = Colour::new([I16F16::from_num(0.5); 3]).unwrap();
+        let materials = [Material::new(grey, [I16F16::ONE; 4], I16F16::ONE).unwrap()];
+        let scene = Scene::new(&objects, &materials, &[], Colour::BLACK, I16F16::ZERO).unwrap();
+        let camera = TraceCamera::new(
+            [0.0, 3.0, 7.0],
+            [0.0, 0.8, 0.0],
+            [0.0, 1.0, 0.0],
+            50.0,
+            0.1,
+            100.0,
+            48,
+            48,
+        )
+        .unwrap();
+        let tracer = Tracer::<4>::new(&scene, &camera, TraceOptions::default());
+        let (lo, hi) = padded_box(&objects[0]).unwrap();
+        let (mut hits, mut clipped) = (0, 0);
+        for y in 0..48u16 {
+            let row = tracer.row_box(&objects[0], y).unwrap();
+            if row.is_some_and(|(a, b)| b[2] - a[2] < (hi[2] - lo[2]) / 4) {
+                clipped += 1;
+            }
+            for x in 0..48u16 {
+                let (dir, _) = camera
+                    .pixel_direction(x, y)
+                    .normalized_with_length()
+                    .unwrap();
+                let ray = crate::trace::Ray {
+                    origin: camera.eye,
+                    dir,
+                };
+                if let Some(t) = objects[0].shape.hit(&ray, I16F16::ZERO, I16F16::MAX) {
+                    let p = ray.origin.along(dir, t).bits();
+                    let (a, b) = row.expect("a row with a hit has a box");
+                    assert!((0..3).all(|i| a[i] <= p[i] && p[i] <= b[i]), "{x} {y}");
+                    hits += 1;
+                }
+            }
+        }
+        // The floor fills the lower rows, each of which sees a narrow band of it.
+        assert!(hits > 500 && clipped > 20, "{hits} {clipped}");
     }
 }

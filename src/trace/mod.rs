@@ -4,10 +4,10 @@
 //!
 //! [`vector`] (I16F16 vectors, integer square root) → [`shape`] (primitives, validated) →
 //! [`intersect`] (ray–primitive tests) → [`bvh`] (bounding volumes, built into caller buffers
-//! or exported as `static` data) → [`scene`] (materials, lights, camera) → [`row_shadow`]
-//! (hybrid mode's per-row shadow candidates) → [`tracer`] (the ray tree on an explicit stack,
-//! shading, rows, the shadow cache) → [`hybrid`] (primary visibility from the objects' screen
-//! bounds instead of a walk per pixel, the row's shadow candidates).
+//! or exported as `static` data) → [`scene`] (materials, checker textures, lights, camera) →
+//! [`row_shadow`] (hybrid mode's per-row shadow candidates) → [`tracer`] (the ray tree on an
+//! explicit stack, shading, rows, the shadow cache) → [`hybrid`] (primary visibility from the
+//! objects' screen bounds instead of a walk per pixel, the row's shadow candidates).
 //!
 //! ## Envelope and bit budget
 //!
@@ -58,7 +58,7 @@ pub mod vector;
 pub use hybrid::ScreenBound;
 pub use intersect::Ray;
 pub use row_shadow::ShadowCandidate;
-pub use scene::{Colour, Light, LightKind, Material, Scene, TraceCamera, TraceSceneError};
+pub use scene::{Checker, Colour, Light, LightKind, Material, Scene, TraceCamera, TraceSceneError};
 pub use shape::{Object, Plane, Polygon, Shape, ShapeError, Sphere, Triangle};
 pub use tracer::{PixelTrace, ShadowCache, TraceError, TraceOptions, TraceStats, Tracer};
 pub use vector::Vec3;

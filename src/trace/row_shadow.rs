@@ -74,10 +74,15 @@ impl<'b> RowShadows<'b> {
         let (start, end) = *self.ranges.get(k)?;
         self.candidates.get(usize::from(start)..usize::from(end))
     }
+
+    /// The region the lists were built for.
+    pub(crate) fn region(&self) -> Region {
+        self.region
+    }
 }
 
 /// The padded box of an object, raw I16F16 bits; `None` for an unbounded one.
-fn padded_box(object: &Object<'_>) -> Option<([i32; 3], [i32; 3])> {
+pub(crate) fn padded_box(object: &Object<'_>) -> Option<([i32; 3], [i32; 3])> {
     let pad = Vec3 {
         x: PAD,
         y: PAD,
@@ -86,17 +91,17 @@ fn padded_box(object: &Object<'_>) -> Option<([i32; 3], [i32; 3])> {
     bvh::bounds(&object.shape).map(|(lo, hi)| (lo.sub(pad).bits(), hi.add(pad).bits()))
 }
 
-/// Builds the candidate lists of the row whose visible objects are `active` into `out`;
-/// `None` when `out` is too small or an active object is unbounded (the row's first hits are
-/// then not bounded): the row's shadow rays walk the hierarchy.
-pub(crate) fn row_shadows<'b>(
-    scene: &Scene<'_>,
-    active: impl Iterator<Item = u32>,
-    out: &'b mut [ShadowCandidate],
-) -> Option<RowShadows<'b>> {
-    let mut region: Option<([i32; 3], [i32; 3])> = None;
-    for id in active {
-        let (lo, hi) = padded_box(scene.objects.get(id as usize)?)?;
+/// A box of raw I16F16 bits (inclusive), `None`: empty.
+pub(crate) type Region = Option<([i32; 3], [i32; 3])>;
+
+/// The union of the boxes a row's first hits lie in, one per active object (`None` when the
+/// object is unbounded, `Some(None)` when the row sees none of it); `None` when an active
+/// object is unbounded: the row's first hits are then not bounded and its shadow rays walk
+/// the hierarchy.
+pub(crate) fn row_region(boxes: impl Iterator<Item = Option<Region>>) -> Option<Region> {
+    let mut region: Region = None;
+    for b in boxes {
+        let Some((lo, hi)) = b? else { continue };
         region = Some(match region {
             None => (lo, hi),
             Some((a, b)) => (
@@ -105,6 +110,16 @@ pub(crate) fn row_shadows<'b>(
             ),
         });
     }
+    Some(region)
+}
+
+/// Builds the candidate lists for shadow rays starting in `region` (see [`row_region`]) into
+/// `out`; `None` when `out` is too small.
+pub(crate) fn row_shadows<'b>(
+    scene: &Scene<'_>,
+    region: Region,
+    out: &'b mut [ShadowCandidate],
+) -> Option<RowShadows<'b>> {
     let mut ranges = [(0u16, 0u16); MAX_LIGHTS];
     let mut used = 0usize;
     // No visible object: no first hit, no shadow ray; every list stays empty.

@@ -26,6 +26,11 @@ pub enum TraceSceneError {
     TooManyObjects,
     /// An object names a material index the scene does not have.
     UnknownMaterial,
+    /// A checker names a material the scene lacks, or its cell size is not a power of two
+    /// between 2^-8 and 2^8 world units.
+    BadChecker,
+    /// A checker texture is on an object other than a plane or a polygon.
+    CheckerOnShape,
     /// Camera: eye outside the envelope, eye = target, up parallel to the view direction,
     /// field of view outside (0°, 160°], near ≤ 0, far ≤ near, far beyond the envelope, or a
     /// size of zero or above [`MAX_TRACE_SIZE`].
@@ -42,6 +47,10 @@ impl core::fmt::Display for TraceSceneError {
             TraceSceneError::TooManyLights => "more than 8 lights",
             TraceSceneError::TooManyObjects => "too many objects",
             TraceSceneError::UnknownMaterial => "an object names a material the scene lacks",
+            TraceSceneError::BadChecker => {
+                "a checker names a missing material or its size is not a power of two in [2^-8, 2^8]"
+            }
+            TraceSceneError::CheckerOnShape => "a checker texture is only for planes and polygons",
             TraceSceneError::BadCamera => "the camera is outside the tracer's envelope",
         })
     }
@@ -122,6 +131,59 @@ impl Material {
     }
 }
 
+/// A checker texture over a plane or polygon: at a hit point, drop the coordinate of the
+/// normal's largest axis ([`Shape::texture_axis`](crate::trace::shape::Shape::texture_axis));
+/// the cell of the other two, `(u, v)` in increasing axis order, is
+/// `(floor(u / size), floor(v / size))`, and the surface there is material `a` when the cell's
+/// indices sum to an even number, `b` otherwise (every coefficient from that material).
+///
+/// The size is a power of two, so a cell index is an arithmetic shift of the raw I16F16
+/// coordinate (a floor, negative coordinates included): no division, no rounding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Checker {
+    /// Material of the even cells (an index into [`Scene::materials`]).
+    pub a: u16,
+    /// Material of the odd cells.
+    pub b: u16,
+    /// The cell size as a shift of raw I16F16 bits: size = 2^(shift − 16) world units, shift
+    /// in [`CHECKER_SHIFTS`] (2^-8 to 2^8 units).
+    pub shift: u8,
+}
+
+/// The shifts a [`Checker`] may have: cells of 2^-8 to 2^8 world units.
+pub const CHECKER_SHIFTS: core::ops::RangeInclusive<u8> = 8..=24;
+
+impl Checker {
+    /// A checker of materials `a` (even cells) and `b` with cells of 2^`log2_size` world units,
+    /// or an error for a size outside 2^-8..2^8 (the materials are checked by [`Scene::textured`]).
+    pub fn new(a: u16, b: u16, log2_size: i8) -> Result<Checker, TraceSceneError> {
+        let shift = u8::try_from(i16::from(log2_size) + 16)
+            .ok()
+            .filter(|s| CHECKER_SHIFTS.contains(s))
+            .ok_or(TraceSceneError::BadChecker)?;
+        Ok(Checker { a, b, shift })
+    }
+
+    /// The material index at `point`, projected along `axis` (the dropped one).
+    #[inline]
+    pub fn cell_material(&self, point: Vec3, axis: u8) -> u16 {
+        let [x, y, z] = point.bits();
+        let (u, v) = match axis {
+            0 => (y, z),
+            1 => (x, z),
+            _ => (x, y),
+        };
+        // An arithmetic shift is the floor of the division, for negative coordinates too.
+        let shift = u32::from(self.shift);
+        let parity = (u.wrapping_shr(shift) ^ v.wrapping_shr(shift)) & 1;
+        if parity == 0 {
+            self.a
+        } else {
+            self.b
+        }
+    }
+}
+
 /// Where a light is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightKind {
@@ -174,6 +236,8 @@ pub struct Scene<'a> {
     pub objects: &'a [Object<'a>],
     /// Materials, indexed by [`Object::material`].
     pub materials: &'a [Material],
+    /// Checker textures: an [`Object::material`] of `materials.len() + k` names checker k.
+    pub checkers: &'a [Checker],
     /// Lights; light k is bit k of a shadow mask.
     pub lights: &'a [Light],
     /// Colour of rays that hit nothing.
@@ -234,17 +298,45 @@ impl<'a> Scene<'a> {
         background: Colour,
         ambient: I16F16,
     ) -> Result<Scene<'a>, TraceSceneError> {
+        Scene::textured(objects, materials, &[], lights, background, ambient)
+    }
+
+    /// A scene whose objects may name checker textures ([`Object::material`] from
+    /// `materials.len()` on), or an error as [`Scene::new`], for a checker naming a missing
+    /// material, or for a checker on an object other than a plane or polygon.
+    pub fn textured(
+        objects: &'a [Object<'a>],
+        materials: &'a [Material],
+        checkers: &'a [Checker],
+        lights: &'a [Light],
+        background: Colour,
+        ambient: I16F16,
+    ) -> Result<Scene<'a>, TraceSceneError> {
         if lights.len() > MAX_LIGHTS {
             return Err(TraceSceneError::TooManyLights);
         }
         if objects.len() >= u32::MAX as usize {
             return Err(TraceSceneError::TooManyObjects);
         }
-        if objects
-            .iter()
-            .any(|o| usize::from(o.material) >= materials.len())
-        {
+        if materials.len() + checkers.len() > usize::from(u16::MAX) {
             return Err(TraceSceneError::UnknownMaterial);
+        }
+        let known = |m: u16| usize::from(m) < materials.len();
+        if checkers
+            .iter()
+            .any(|c| !known(c.a) || !known(c.b) || !CHECKER_SHIFTS.contains(&c.shift))
+        {
+            return Err(TraceSceneError::BadChecker);
+        }
+        for o in objects {
+            match usize::from(o.material).checked_sub(materials.len()) {
+                None => {}
+                Some(k) if k >= checkers.len() => return Err(TraceSceneError::UnknownMaterial),
+                Some(_) if o.shape.texture_axis().is_none() => {
+                    return Err(TraceSceneError::CheckerOnShape)
+                }
+                Some(_) => {}
+            }
         }
         if ambient < I16F16::ZERO || ambient > I16F16::ONE {
             return Err(TraceSceneError::BadColour);
@@ -252,12 +344,36 @@ impl<'a> Scene<'a> {
         Ok(Scene {
             objects,
             materials,
+            checkers,
             lights,
             background,
             ambient,
             bvh: None,
             grid: None,
         })
+    }
+}
+
+impl Scene<'_> {
+    /// The index in [`Scene::materials`] of the material of `object` at `point` on its
+    /// surface: its own, or its checker's cell's.
+    #[inline]
+    pub fn material_index_at(&self, object: &Object<'_>, point: Vec3) -> Option<u16> {
+        let index = usize::from(object.material);
+        if index < self.materials.len() {
+            return Some(object.material);
+        }
+        let checker = self
+            .checkers
+            .get(index.checked_sub(self.materials.len())?)?;
+        Some(checker.cell_material(point, object.shape.texture_axis()?))
+    }
+
+    /// The material of `object` at `point` on its surface: its own, or its checker's cell's.
+    #[inline]
+    pub fn material_at(&self, object: &Object<'_>, point: Vec3) -> Option<&Material> {
+        self.materials
+            .get(usize::from(self.material_index_at(object, point)?))
     }
 }
 
@@ -403,6 +519,115 @@ impl TraceCamera {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::trace::shape::{Plane, Polygon, Shape, Sphere};
+
+    fn p(x: f64, y: f64, z: f64) -> Vec3 {
+        Vec3 {
+            x: I16F16::from_num(x),
+            y: I16F16::from_num(y),
+            z: I16F16::from_num(z),
+        }
+    }
+
+    #[test]
+    fn checker_cells_are_floors_of_the_projected_coordinates() {
+        let unit = Checker::new(0, 1, 0).unwrap();
+        // Floor y = 0 (axis 1 dropped): u = x, v = z; (-4, -4) is even, its neighbours odd.
+        assert_eq!(unit.cell_material(p(-3.5, 0.0, -3.5), 1), 0);
+        assert_eq!(unit.cell_material(p(-2.5, 0.0, -3.5), 1), 1);
+        assert_eq!(unit.cell_material(p(-3.5, 0.0, -2.5), 1), 1);
+        // Boundaries belong to the cell above: x = 0 is cell 0, x = −2^-16 cell −1.
+        assert_eq!(unit.cell_material(p(0.0, 0.0, 0.5), 1), 0);
+        assert_eq!(
+            unit.cell_material(Vec3::from_bits(-1, 0, 1 << 15), 1),
+            1,
+            "just below 0 is cell -1"
+        );
+        // The dropped axis does not matter; the other two do.
+        assert_eq!(unit.cell_material(p(7.3, 0.5, 0.5), 0), 0);
+        assert_eq!(unit.cell_material(p(7.3, 1.5, 0.5), 0), 1);
+        assert_eq!(unit.cell_material(p(0.5, 1.5, 9.0), 2), 1);
+        // Cells of 2 and of 1/4 units.
+        let big = Checker::new(0, 1, 1).unwrap();
+        assert_eq!(big.cell_material(p(1.9, 0.0, -0.1), 1), 1);
+        assert_eq!(big.cell_material(p(2.1, 0.0, -0.1), 1), 0);
+        let small = Checker::new(0, 1, -2).unwrap();
+        assert_eq!(small.cell_material(p(0.3, 0.0, 0.1), 1), 1);
+        assert_eq!(Checker::new(0, 1, 9), Err(TraceSceneError::BadChecker));
+        assert_eq!(Checker::new(0, 1, -9), Err(TraceSceneError::BadChecker));
+    }
+
+    #[test]
+    fn textured_scenes_are_checked() {
+        let grey = Colour::new([I16F16::from_num(0.5); 3]).unwrap();
+        let m = Material::new(grey, [I16F16::ONE; 4], I16F16::ONE).unwrap();
+        let materials = [
+            m,
+            Material {
+                kr: I16F16::ZERO,
+                ..m
+            },
+        ];
+        let checkers = [Checker::new(0, 1, 0).unwrap()];
+        let square = [
+            p(0.0, 0.0, 0.0),
+            p(0.0, 0.0, 2.0),
+            p(2.0, 0.0, 2.0),
+            p(2.0, 0.0, 0.0),
+        ];
+        let floor = Object {
+            shape: Shape::Polygon(Polygon::new(&square).unwrap()),
+            material: 2,
+        };
+        let plane = Object {
+            shape: Shape::Plane(Plane::new(p(0.0, 1.0, 0.0), I16F16::ZERO).unwrap()),
+            material: 2,
+        };
+        let ball = Object {
+            shape: Shape::Sphere(Sphere::new(p(0.0, 1.0, 0.0), I16F16::ONE).unwrap()),
+            material: 2,
+        };
+        let scene = |objects: &[Object<'_>], checkers: &[Checker]| {
+            Scene::textured(
+                objects,
+                &materials,
+                checkers,
+                &[],
+                Colour::BLACK,
+                I16F16::ZERO,
+            )
+            .map(|_| ())
+        };
+        assert_eq!(scene(&[floor, plane], &checkers), Ok(()));
+        assert_eq!(
+            scene(&[floor, ball], &checkers),
+            Err(TraceSceneError::CheckerOnShape)
+        );
+        assert_eq!(scene(&[floor], &[]), Err(TraceSceneError::UnknownMaterial));
+        let missing = [Checker {
+            b: 2,
+            ..checkers[0]
+        }];
+        assert_eq!(scene(&[floor], &missing), Err(TraceSceneError::BadChecker));
+        let objects = [floor];
+        let textured = Scene::textured(
+            &objects,
+            &materials,
+            &checkers,
+            &[],
+            Colour::BLACK,
+            I16F16::ZERO,
+        )
+        .unwrap();
+        assert_eq!(
+            textured.material_at(&floor, p(0.5, 0.0, 0.5)),
+            Some(&materials[0])
+        );
+        assert_eq!(
+            textured.material_at(&floor, p(1.5, 0.0, 0.5)),
+            Some(&materials[1])
+        );
+    }
 
     #[test]
     fn camera_centre_ray_points_at_the_target() {

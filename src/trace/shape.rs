@@ -149,19 +149,24 @@ impl Facet {
                 return Err(ShapeError::NotPlanar);
             }
         }
-        let [x, y, z] = normal.bits().map(i32::unsigned_abs);
-        let axis = if x >= y && x >= z {
-            0
-        } else if y >= z {
-            1
-        } else {
-            2
-        };
         Ok(Facet {
             normal,
             offset,
-            axis,
+            axis: dominant_axis(normal),
         })
+    }
+}
+
+/// The axis (0 = x, 1 = y, 2 = z) of `normal`'s largest component, the first of equal ones:
+/// the axis a polygon's point-in-polygon test and a checker texture drop.
+pub fn dominant_axis(normal: Vec3) -> u8 {
+    let [x, y, z] = normal.bits().map(i32::unsigned_abs);
+    if x >= y && x >= z {
+        0
+    } else if y >= z {
+        1
+    } else {
+        2
     }
 }
 
@@ -346,12 +351,28 @@ pub enum Shape<'a> {
     Frustum(Frustum),
 }
 
-/// A primitive with its material (an index into the scene's materials).
+impl Shape<'_> {
+    /// The axis a checker texture drops on this primitive (its normal's largest, as the
+    /// point-in-polygon test), or `None` for a primitive that cannot carry one: only planes and
+    /// polygons are textured.
+    #[inline]
+    pub fn texture_axis(&self) -> Option<u8> {
+        match self {
+            Shape::Plane(p) => Some(dominant_axis(p.normal)),
+            Shape::Polygon(p) => Some(p.facet.axis),
+            _ => None,
+        }
+    }
+}
+
+/// A primitive with its surface: a material, or a checker texture of two materials.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Object<'a> {
     /// The primitive.
     pub shape: Shape<'a>,
-    /// Index into [`Scene::materials`](crate::trace::scene::Scene::materials).
+    /// The surface: an index into [`Scene::materials`](crate::trace::scene::Scene::materials),
+    /// or, from `materials.len()` on, `materials.len() + k` for checker k of
+    /// [`Scene::checkers`](crate::trace::scene::Scene::checkers).
     pub material: u16,
 }
 

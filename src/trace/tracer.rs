@@ -136,6 +136,9 @@ pub struct PixelTrace {
     pub depth: I16F16,
     /// Bit k set when light k contributes nothing at the primary hit (N·L ≤ 0 or blocked).
     pub shadow: u8,
+    /// Index in [`Scene::materials`] of the material at the primary hit (a checker texture's
+    /// cell's), if any.
+    pub material: Option<u16>,
 }
 
 /// A ray waiting on the stack.
@@ -332,6 +335,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             id: None,
             depth: I16F16::ZERO,
             shadow: 0,
+            material: None,
         };
         let raw = self.camera.pixel_direction(column, row);
         let Some((dir, len)) = raw.normalized_with_length() else {
@@ -367,7 +371,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             match hit {
                 None => add_weighted(&mut sum, &self.scene.background, ray.weight),
                 Some(hit) => {
-                    let shadow = self.shade(
+                    let (shadow, material) = self.shade(
                         &ray,
                         hit,
                         &mut sum,
@@ -380,6 +384,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                         out.id = Some(hit.object);
                         out.depth = hit.t.checked_div(len).unwrap_or(I16F16::MAX);
                         out.shadow = shadow;
+                        out.material = material;
                     }
                 }
             }
@@ -454,8 +459,12 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         candidates: Option<&[ShadowCandidate]>,
         stats: &mut TraceStats,
     ) -> bool {
-        let mut tests = 1;
-        if self.hit(*cached, ray, from, EPSILON, t_max).is_some() {
+        // The cached object is tested only if it names one that can block: with candidates,
+        // one of them (any other cannot block this ray).
+        let cache_useful = *cached != u32::MAX
+            && candidates.is_none_or(|list| list.iter().any(|c| c.object == *cached));
+        let mut tests = u32::from(cache_useful);
+        if cache_useful && self.hit(*cached, ray, from, EPSILON, t_max).is_some() {
             stats.intersection_tests += tests;
             stats.shadow_cache_hits += 1;
             return true;
@@ -471,7 +480,17 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         };
         match (candidates, &self.scene.grid, &self.scene.bvh) {
             (Some(list), _, _) => {
-                let _ = any_blocks(self.scene, list, ray, EPSILON, t_max, &mut blocks);
+                // Two candidates are known not to block: the cached object, just tested with
+                // the same call, and a planar object the ray starts on (never met again).
+                let from_planar = self
+                    .scene
+                    .objects
+                    .get(from as usize)
+                    .is_some_and(|o| o.shape.plane().is_some());
+                let skip = (*cached, if from_planar { from } else { u32::MAX });
+                let _ = any_blocks(self.scene, list, ray, EPSILON, t_max, |id| {
+                    id != skip.0 && id != skip.1 && blocks(id)
+                });
             }
             (None, Some(grid), _) => {
                 if !grid.unbounded().iter().any(|id| blocks(*id)) {
@@ -491,8 +510,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 }
             }
         }
-        // The cached object counts as a test only when it names one.
-        stats.intersection_tests += tests - u32::from(*cached == u32::MAX);
+        stats.intersection_tests += tests;
         match blocker {
             Some(id) => {
                 *cached = id;
@@ -503,7 +521,8 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     }
 
     /// Adds the local term at `hit` times the ray's weight to `sum`, pushes the reflected and
-    /// refracted rays the rules allow, and returns the shadow mask at the hit.
+    /// refracted rays the rules allow, and returns the shadow mask at the hit and the index of
+    /// the material there.
     // The per-pixel state a ray adds to (colour sum, ray stack, shadow cache, the row's
     // shadow candidates, counts), each borrowed apart.
     #[allow(clippy::too_many_arguments)]
@@ -516,16 +535,17 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         cache: &mut ShadowCache,
         row_shadows: Option<&RowShadows<'_>>,
         stats: &mut TraceStats,
-    ) -> u8 {
+    ) -> (u8, Option<u16>) {
         let scene = self.scene;
         let Some(object) = scene.objects.get(hit.object as usize) else {
-            return 0;
-        };
-        let Some(material) = scene.materials.get(usize::from(object.material)) else {
-            return 0;
+            return (0, None);
         };
         let ray = &pending.ray;
         let point = ray.origin.along(ray.dir, hit.t);
+        let index = scene.material_index_at(object, point);
+        let Some(material) = index.and_then(|m| scene.materials.get(usize::from(m))) else {
+            return (0, None);
+        };
         let outward = object.shape.normal(point);
         // N faces the incoming ray; `entering` when the outward normal does.
         let entering = outward.dot_bits(ray.dir) < 0;
@@ -564,7 +584,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         add_weighted(sum, &local, pending.weight);
 
         if pending.depth >= self.options.max_depth {
-            return shadow;
+            return (shadow, index);
         }
         let reflected = reflect(ray.dir, normal);
         let mut push = |k: I16F16, dir: Vec3, stats: &mut TraceStats| {
@@ -594,7 +614,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             let refracted = refract(ray.dir, normal, n1, n2).unwrap_or(reflected);
             push(material.kt, refracted, stats);
         }
-        shadow
+        (shadow, index)
     }
 }
 
@@ -832,6 +852,40 @@ mod tests {
                 "{b:?}"
             );
         }
+    }
+
+    #[test]
+    fn a_checker_cell_gives_every_coefficient() {
+        // The floor y = 0 with cells of 1 unit: diffuse (even) and mirror (odd) materials.
+        use crate::trace::scene::Checker;
+        let objects = [Object {
+            shape: Shape::Plane(Plane::new(v(0.0, 1.0, 0.0), f(0.0)).unwrap()),
+            material: 2,
+        }];
+        let materials = [material(0.0, 0.0), material(0.5, 0.0)];
+        let checkers = [Checker::new(0, 1, 0).unwrap()];
+        let scene =
+            Scene::textured(&objects, &materials, &checkers, &[], Colour::BLACK, f(0.5)).unwrap();
+        let down = |x: f64| {
+            let camera = TraceCamera::new(
+                [x, 1.0, -0.5],
+                [x, 0.0, -0.5],
+                [0.0, 0.0, -1.0],
+                1.0,
+                0.1,
+                10.0,
+                1,
+                1,
+            )
+            .unwrap();
+            let (p, s) =
+                Tracer::<5>::new(&scene, &camera, TraceOptions::default()).trace_pixel(0, 0);
+            (p.material, s.secondary_rays)
+        };
+        // (0.5, −0.5) is cell (0, −1), odd: the mirror; (−0.5, −0.5) is (−1, −1), even.
+        assert_eq!(down(0.5), (Some(1), 1));
+        assert_eq!(down(-0.5), (Some(0), 0));
+        assert_eq!(down(1.5), (Some(0), 0));
     }
 
     #[test]

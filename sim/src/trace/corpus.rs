@@ -52,8 +52,19 @@ pub fn all() -> Vec<CorpusScene> {
     vec![
         CorpusScene {
             name: "classic",
-            about: "mirror sphere and glass sphere over a checkered floor of polygons, two lights",
+            about:
+                "mirror sphere and glass sphere over a checker-textured floor polygon, two lights",
             cameras: vec![("front", camera([0.0, 3.0, 7.0], [0.0, 0.8, 0.0], 50.0))],
+        },
+        CorpusScene {
+            name: "classic-polygons",
+            about: "the classic with its floor made of 8 x 8 polygons instead of a texture",
+            cameras: vec![("front", camera([0.0, 3.0, 7.0], [0.0, 0.8, 0.0], 50.0))],
+        },
+        CorpusScene {
+            name: "checkers",
+            about: "checker textures on a plane and on polygons along each axis, cells of 1/4 to 2",
+            cameras: vec![("front", camera([1.0, 4.0, 6.0], [-0.5, 0.8, -1.0], 55.0))],
         },
         CorpusScene {
             name: "water",

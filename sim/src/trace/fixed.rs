@@ -5,7 +5,7 @@
 //! The conversion goes through the library's validating constructors (so the host and the
 //! firmware trace the same bits), rounding every f64 to the nearest I16F16.
 
-use super::scene::{LightKind as SrcLight, Shape as SrcShape, TracedScene};
+use super::scene::{LightKind as SrcLight, Shape as SrcShape, Surface, TracedScene};
 use crate::scene::CameraSpec;
 use embedded_graphics::pixelcolor::Rgb565;
 use fixed::types::I16F16;
@@ -14,9 +14,9 @@ use scanline3d::trace::bvh::{self, BvhNode};
 use scanline3d::trace::grid::{self, GridShape};
 use scanline3d::trace::shape::{AaBox, Ellipsoid, Facet, Frustum};
 use scanline3d::trace::{
-    Colour, Light, LightKind, Material, Object, PixelTrace, Plane, Polygon, Scene, ScreenBound,
-    ShadowCache, ShadowCandidate, Shape, Sphere, TraceCamera, TraceOptions, TraceStats, Tracer,
-    Triangle, Vec3,
+    Checker, Colour, Light, LightKind, Material, Object, PixelTrace, Plane, Polygon, Scene,
+    ScreenBound, ShadowCache, ShadowCandidate, Shape, Sphere, TraceCamera, TraceOptions,
+    TraceStats, Tracer, Triangle, Vec3,
 };
 
 /// Ray-stack capacity of the host's fixed tracer: room for `--max-depth` up to 31.
@@ -52,6 +52,9 @@ pub struct FixedScene {
     entries: Vec<(Entry, u16)>,
     /// Materials in file order.
     pub materials: Vec<Material>,
+    /// Checker textures in file order (an object's material index `materials.len() + k`
+    /// names checker k).
+    pub checkers: Vec<Checker>,
     /// Lights in file order.
     pub lights: Vec<Light>,
     /// Background colour.
@@ -102,6 +105,25 @@ impl FixedScene {
                     fix(m.ior, &what)?,
                 )
                 .map_err(|e| format!("{what}: {e}"))
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        let checkers = scene
+            .checkers
+            .iter()
+            .map(|c| {
+                let what = format!("line {}: checker {}", c.line, c.name);
+                let log2 = c.size.log2();
+                let index = |m: usize| {
+                    u16::try_from(m).map_err(|_| format!("{what}: too many materials"))
+                };
+                if log2.fract() != 0.0 || !(-8.0..=8.0).contains(&log2) {
+                    return Err(format!(
+                        "{what}: size {} is not a power of two from 2^-8 to 2^8 (the fixed tracer's cells are shifts)",
+                        c.size
+                    ));
+                }
+                Checker::new(index(c.a)?, index(c.b)?, log2 as i8)
+                    .map_err(|e| format!("{what}: {e}"))
             })
             .collect::<Result<Vec<_>, String>>()?;
         let lights = scene
@@ -155,14 +177,19 @@ impl FixedScene {
                         .map_err(err)?,
                 )),
             };
+            let surface = match o.surface {
+                Surface::Material(m) => m,
+                Surface::Checker(k) => scene.materials.len() + k,
+            };
             let material =
-                u16::try_from(o.material).map_err(|_| format!("{what}: too many materials"))?;
+                u16::try_from(surface).map_err(|_| format!("{what}: too many materials"))?;
             entries.push((entry, material));
         }
         let mut fixed = FixedScene {
             polygons,
             entries,
             materials,
+            checkers,
             lights,
             background: colour(scene.background, "background")?,
             ambient: fix(scene.ambient, "ambient")?,
@@ -221,9 +248,10 @@ impl FixedScene {
         f: impl FnOnce(&Scene<'_>) -> R,
     ) -> Result<R, String> {
         let objects = self.objects();
-        let mut scene = Scene::new(
+        let mut scene = Scene::textured(
             &objects,
             &self.materials,
+            &self.checkers,
             &self.lights,
             self.background,
             self.ambient,
@@ -339,6 +367,9 @@ pub struct FixedFrame {
     pub depth: Vec<f32>,
     /// Bit k set when light k contributes nothing at the primary hit.
     pub shadow: Vec<u8>,
+    /// Index of the material at the primary hit (a checker texture's cell's), −1 for
+    /// background.
+    pub materials: Vec<i32>,
     /// What the frame cost.
     pub stats: TraceStats,
 }
@@ -366,6 +397,7 @@ pub fn render(
             ids: Vec::with_capacity(w * h),
             depth: Vec::with_capacity(w * h),
             shadow: Vec::with_capacity(w * h),
+            materials: Vec::with_capacity(w * h),
             stats: TraceStats::default(),
         };
         let push = |frame: &mut FixedFrame, p: &PixelTrace| {
@@ -377,6 +409,7 @@ pub fn render(
                 .depth
                 .push(p.id.map_or(f32::INFINITY, |_| p.depth.to_num::<f32>()));
             frame.shadow.push(p.shadow);
+            frame.materials.push(p.material.map_or(-1, i32::from));
         };
         if hybrid {
             let mut bounds = vec![ScreenBound::default(); count];
@@ -471,10 +504,10 @@ fn colour(c: Colour) -> String {
     )
 }
 
-/// Rust source with the scene as `static` data (`OBJECTS`, `MATERIALS`, `LIGHTS`,
+/// Rust source with the scene as `static` data (`OBJECTS`, `MATERIALS`, `CHECKERS`, `LIGHTS`,
 /// `BACKGROUND`, `AMBIENT`, and each polygon's vertices): every value is the raw bits the
 /// library's constructors produced on the host, so nothing is parsed or validated again on the
-/// target except by [`Scene::new`].
+/// target except by [`Scene::textured`].
 pub fn export_source(scene: &FixedScene, command: &str) -> String {
     let mut s = format!(
         "//! A traced scene as static fixed-point data for `scanline3d::trace`.\n//!\n//! Generated by `{command}`; do not edit.\n\n\
@@ -482,7 +515,7 @@ pub fn export_source(scene: &FixedScene, command: &str) -> String {
          #[allow(unused_imports)]\n\
          use scanline3d::trace::shape::{{AaBox, Ellipsoid, Facet, Frustum}};\n\
          #[allow(unused_imports)]\n\
-         use scanline3d::trace::{{Colour, Light, LightKind, Material, Object, Plane, Polygon, Shape, Sphere, Triangle, Vec3}};\n\n"
+         use scanline3d::trace::{{Checker, Colour, Light, LightKind, Material, Object, Plane, Polygon, Shape, Sphere, Triangle, Vec3}};\n\n"
     );
     for (i, p) in scene.polygons.iter().enumerate() {
         s += &format!(
@@ -564,6 +597,17 @@ pub fn export_source(scene: &FixedScene, command: &str) -> String {
             bits(m.kr),
             bits(m.kt),
             bits(m.ior)
+        );
+    }
+    s += "];\n\n";
+    s += &format!(
+        "/// Checker textures; an object's material `MATERIALS.len() + k` is checker k.\npub static CHECKERS: [Checker; {}] = [\n",
+        scene.checkers.len()
+    );
+    for c in &scene.checkers {
+        s += &format!(
+            "    Checker {{ a: {}, b: {}, shift: {} }},\n",
+            c.a, c.b, c.shift
         );
     }
     s += "];\n\n";

@@ -181,13 +181,23 @@ fn frustum(near: &mut Nearest, ray: &Ray, p0: V3, r0: f64, p1: V3, r1: f64) {
     }
 }
 
+/// The axis (0 = x, 1 = y, 2 = z) of `normal`'s largest component, the first of equal ones:
+/// what the point-in-polygon test and a checker texture drop.
+pub fn dominant_axis(normal: V3) -> usize {
+    let [x, y, z] = normal.map(f64::abs);
+    if x >= y && x >= z {
+        0
+    } else if y >= z {
+        1
+    } else {
+        2
+    }
+}
+
 /// Even-odd point-in-polygon test of `p` (on the polygon's plane) in the projection that drops
 /// the normal's largest axis.
 pub fn inside_polygon(vertices: &[V3], normal: V3, p: V3) -> bool {
-    let drop = (0..3)
-        .max_by(|&i, &j| normal[i].abs().total_cmp(&normal[j].abs()))
-        .unwrap_or(2);
-    let (u, v) = match drop {
+    let (u, v) = match dominant_axis(normal) {
         0 => (1, 2),
         1 => (2, 0),
         _ => (0, 1),

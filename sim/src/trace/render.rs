@@ -20,6 +20,9 @@ pub struct TracedImage {
     pub depth: Vec<f32>,
     /// Bit k set when light k contributes nothing at the primary hit (N·L ≤ 0 or blocked).
     pub shadow: Vec<u8>,
+    /// Index of the material at the primary hit (a checker texture's cell's), −1 for
+    /// background.
+    pub materials: Vec<i32>,
     /// What tracing did.
     pub stats: TraceStats,
 }
@@ -48,6 +51,7 @@ pub fn render(
         ids: Vec::with_capacity(n),
         depth: Vec::with_capacity(n),
         shadow: Vec::with_capacity(n),
+        materials: Vec::with_capacity(n),
         stats: TraceStats::default(),
     };
     for y in 0..h {
@@ -58,6 +62,15 @@ pub fn render(
             img.depth
                 .push(p.hit.map_or(f32::INFINITY, |hit| hit.t as f32));
             img.shadow.push(p.shadow);
+            // The hit point exactly as the tracer shaded it (`Ray::at` of the primary ray).
+            let material = p.hit.and_then(|hit| {
+                let ray = super::vector::Ray {
+                    origin: cam.eye,
+                    dir: super::scene::primary_ray(&cam, x, y, w, h),
+                };
+                scene.material_index_at(hit.id, ray.at(hit.t))
+            });
+            img.materials.push(material.map_or(-1, |m| m as i32));
         }
     }
     Ok(img)

@@ -8,6 +8,7 @@
 //! ambient I
 //! light point X Y Z I | light directional DX DY DZ I   # D points from the surface to the light
 //! material NAME R G B KA KD KR KT IOR    # IOR a number or air|water|glass|dense-glass|diamond
+//! checker NAME MAT_A MAT_B SIZE          # a texture for plane and polygon lines
 //! sphere CX CY CZ R MAT
 //! plane NX NY NZ D MAT                   # points p with n·p + d = 0
 //! box X0 Y0 Z0 X1 Y1 Z1 MAT              # axis-aligned, corners (min, max)
@@ -22,6 +23,12 @@
 //! [`TracedScene::objects`]: one per primitive line in file order, one per triangle of a mesh
 //! (in OBJ face order, polygons fan-triangulated). A material must be defined before a line
 //! uses it. `background` and `ambient` default to 0 and may appear once each.
+//!
+//! A checker texture is a material name for `plane` and `polygon` lines (an error on any
+//! other): at a hit point p, drop the coordinate of the surface normal's largest axis (the first
+//! of equal ones, as the polygon test); the cell of the other two coordinates `(u, v)` is
+//! `(floor(u / SIZE), floor(v / SIZE))`, and everything of the material there is `MAT_A`'s when
+//! the cell's indices sum to an even number, `MAT_B`'s otherwise ([`TracedScene::material_at`]).
 //!
 //! Inside and outside: closed primitives and closed meshes have an inside; a plane's or a
 //! polygon's outside is the side its normal points to. A polygon's normal follows its vertex
@@ -53,8 +60,10 @@ pub struct TracedScene {
     pub ambient: f64,
     /// Lights in file order (light k is bit k of the shadow image).
     pub lights: Vec<TracedLight>,
-    /// Materials in file order; [`Object::material`] indexes this.
+    /// Materials in file order; [`Surface::Material`] indexes this.
     pub materials: Vec<Material>,
+    /// Checker textures in file order; [`Surface::Checker`] indexes this.
+    pub checkers: Vec<Checker>,
     /// Objects; the index is the object's id.
     pub objects: Vec<Object>,
 }
@@ -96,13 +105,38 @@ pub struct Material {
     pub ior: f64,
 }
 
-/// One object: a shape and its material.
+/// A checker texture of two materials over a plane or polygon.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Checker {
+    /// The name lines refer to it by (shared with the materials').
+    pub name: String,
+    /// Material of the cells whose indices sum to an even number (index into
+    /// [`TracedScene::materials`]).
+    pub a: usize,
+    /// Material of the odd cells.
+    pub b: usize,
+    /// Side of a cell, > 0.
+    pub size: f64,
+    /// The scene-file line that defined it (1-based).
+    pub line: usize,
+}
+
+/// What an object's surface is made of.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Surface {
+    /// One material: an index into [`TracedScene::materials`].
+    Material(usize),
+    /// A checker texture: an index into [`TracedScene::checkers`].
+    Checker(usize),
+}
+
+/// One object: a shape and its surface.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Object {
     /// The geometry.
     pub shape: Shape,
-    /// Index into [`TracedScene::materials`].
-    pub material: usize,
+    /// Its material or checker texture.
+    pub surface: Surface,
     /// The scene-file line that made it (1-based).
     pub line: usize,
 }
@@ -218,6 +252,7 @@ impl TracedScene {
                 ambient: 0.0,
                 lights: Vec::new(),
                 materials: Vec::new(),
+                checkers: Vec::new(),
                 objects: Vec::new(),
             },
             seen_background: false,
@@ -241,11 +276,33 @@ impl TracedScene {
         Ok(p.scene)
     }
 
-    /// The material of object `id`.
-    pub fn material_of(&self, id: usize) -> Option<&Material> {
-        self.objects
-            .get(id)
-            .and_then(|o| self.materials.get(o.material))
+    /// The material of object `id` at point `p` of its surface: its own, or for a checker
+    /// texture the material of the cell `p` lies in.
+    pub fn material_at(&self, id: usize, p: V3) -> Option<&Material> {
+        self.materials.get(self.material_index_at(id, p)?)
+    }
+
+    /// The index in [`TracedScene::materials`] of [`material_at`](Self::material_at).
+    pub fn material_index_at(&self, id: usize, p: V3) -> Option<usize> {
+        let object = self.objects.get(id)?;
+        match object.surface {
+            Surface::Material(m) => Some(m),
+            Surface::Checker(k) => {
+                let checker = self.checkers.get(k)?;
+                let normal = match &object.shape {
+                    Shape::Plane { normal, .. } | Shape::Polygon { normal, .. } => *normal,
+                    _ => return None,
+                };
+                let (u, v) = match super::intersect::dominant_axis(normal) {
+                    0 => (p[1], p[2]),
+                    1 => (p[0], p[2]),
+                    _ => (p[0], p[1]),
+                };
+                let cell = |c: f64| (c / checker.size).floor();
+                let even = (cell(u) + cell(v)).rem_euclid(2.0) == 0.0;
+                Some(if even { checker.a } else { checker.b })
+            }
+        }
     }
 
     /// Number of mesh triangles among the objects.
@@ -331,6 +388,14 @@ struct Parser {
     seen_ambient: bool,
 }
 
+impl Parser {
+    /// Whether a material or checker of this name exists (they share one namespace).
+    fn defined(&self, name: &str) -> bool {
+        self.scene.materials.iter().any(|m| m.name == name)
+            || self.scene.checkers.iter().any(|c| c.name == name)
+    }
+}
+
 fn sub(a: V3, b: V3) -> V3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
@@ -346,21 +411,51 @@ fn is_proper(v: V3) -> bool {
 }
 
 impl Parser {
-    fn material(&self, t: &mut Tokens) -> Result<usize, String> {
+    /// A material or checker name: the surface of an object.
+    fn material(&self, t: &mut Tokens) -> Result<Surface, String> {
         let name = t.word("material name")?;
-        self.scene
-            .materials
-            .iter()
-            .position(|m| m.name == name)
-            .ok_or_else(|| format!("unknown material '{name}'"))
+        let scene = &self.scene;
+        match scene.materials.iter().position(|m| m.name == name) {
+            Some(m) => Ok(Surface::Material(m)),
+            None => scene
+                .checkers
+                .iter()
+                .position(|c| c.name == name)
+                .map(Surface::Checker)
+                .ok_or_else(|| format!("unknown material '{name}'")),
+        }
     }
 
-    fn push(&mut self, shape: Shape, material: usize, line: usize) {
+    /// A material name that is not a checker (a checker's cells are plain materials).
+    fn plain_material(&self, t: &mut Tokens) -> Result<usize, String> {
+        match self.material(t)? {
+            Surface::Material(m) => Ok(m),
+            Surface::Checker(k) => Err(format!(
+                "checker '{}' is not a plain material (a checker's cells are)",
+                self.scene.checkers[k].name
+            )),
+        }
+    }
+
+    /// An error when `surface` is a checker and `kind` of line cannot carry one.
+    fn check_surface(&self, surface: Surface, kind: &str) -> Result<(), String> {
+        match surface {
+            Surface::Checker(k) if kind != "plane" && kind != "polygon" => Err(format!(
+                "checker '{}' is only for plane and polygon lines, not a {kind}",
+                self.scene.checkers[k].name
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    fn push(&mut self, shape: Shape, surface: Surface, line: usize) -> Result<(), String> {
+        self.check_surface(surface, shape.kind())?;
         self.scene.objects.push(Object {
             shape,
-            material,
+            surface,
             line,
         });
+        Ok(())
     }
 
     fn line(&mut self, t: &mut Tokens, line: usize, dir: &Path) -> Result<(), String> {
@@ -399,7 +494,7 @@ impl Parser {
             }
             "material" => {
                 let name = t.word("material name")?;
-                if self.scene.materials.iter().any(|m| m.name == name) {
+                if self.defined(name) {
                     return Err(format!("material '{name}' defined twice"));
                 }
                 let color = [t.unit("red")?, t.unit("green")?, t.unit("blue")?];
@@ -432,11 +527,27 @@ impl Parser {
                     ior,
                 });
             }
+            "checker" => {
+                let name = t.word("checker name")?;
+                if self.defined(name) {
+                    return Err(format!("material '{name}' defined twice"));
+                }
+                let a = self.plain_material(t)?;
+                let b = self.plain_material(t)?;
+                let size = t.positive("checker size")?;
+                self.scene.checkers.push(Checker {
+                    name: name.to_string(),
+                    a,
+                    b,
+                    size,
+                    line,
+                });
+            }
             "sphere" => {
                 let centre = t.v3("centre")?;
                 let radius = t.positive("radius")?;
                 let m = self.material(t)?;
-                self.push(Shape::Sphere { centre, radius }, m, line);
+                self.push(Shape::Sphere { centre, radius }, m, line)?;
             }
             "plane" => {
                 let n = t.v3("normal")?;
@@ -447,7 +558,7 @@ impl Parser {
                     return Err("plane normal is zero".into());
                 }
                 let normal = n.map(|c| c / len);
-                self.push(Shape::Plane { normal, d: d / len }, m, line);
+                self.push(Shape::Plane { normal, d: d / len }, m, line)?;
             }
             "box" => {
                 let min = t.v3("min corner")?;
@@ -458,7 +569,7 @@ impl Parser {
                         "box corners must be (min, max) with min < max on every axis".into(),
                     );
                 }
-                self.push(Shape::Box { min, max }, m, line);
+                self.push(Shape::Box { min, max }, m, line)?;
             }
             "cylinder" => {
                 let p0 = t.v3("first cap centre")?;
@@ -468,7 +579,7 @@ impl Parser {
                 if !is_proper(sub(p1, p0)) {
                     return Err("cylinder axis has zero length".into());
                 }
-                self.push(Shape::Cylinder { p0, p1, radius }, m, line);
+                self.push(Shape::Cylinder { p0, p1, radius }, m, line)?;
             }
             "cone" => {
                 let p0 = t.v3("first cap centre")?;
@@ -482,7 +593,7 @@ impl Parser {
                 if r0 == 0.0 && r1 == 0.0 {
                     return Err("cone radii are both zero".into());
                 }
-                self.push(Shape::Cone { p0, r0, p1, r1 }, m, line);
+                self.push(Shape::Cone { p0, r0, p1, r1 }, m, line)?;
             }
             "ellipsoid" => {
                 let centre = t.v3("centre")?;
@@ -492,7 +603,7 @@ impl Parser {
                     t.positive("z radius")?,
                 ];
                 let m = self.material(t)?;
-                self.push(Shape::Ellipsoid { centre, radii }, m, line);
+                self.push(Shape::Ellipsoid { centre, radii }, m, line)?;
             }
             "polygon" => {
                 let m = self.material(t)?;
@@ -507,14 +618,15 @@ impl Parser {
                     vertices.push(t.v3(&format!("vertex {}", k + 1))?);
                 }
                 let normal = polygon_normal(&vertices)?;
-                self.push(Shape::Polygon { vertices, normal }, m, line);
+                self.push(Shape::Polygon { vertices, normal }, m, line)?;
             }
             "mesh" => {
                 let file = t.word("mesh file")?;
                 let m = self.material(t)?;
                 t.end()?;
+                self.check_surface(m, "mesh")?;
                 for corners in load_mesh(&dir.join(file))? {
-                    self.push(Shape::Triangle { corners }, m, line);
+                    self.push(Shape::Triangle { corners }, m, line)?;
                 }
             }
             k => return Err(format!("unknown keyword '{k}'")),
@@ -719,7 +831,30 @@ polygon red 0 0 0 2 0 0 2 2 0 1 1 0 0 2 0
             other => panic!("{other:?}"),
         }
         assert_eq!(s.objects[6].line, 15);
-        assert_eq!(s.material_of(2).unwrap().name, "glass");
+        assert_eq!(s.material_at(2, [0.0; 3]).unwrap().name, "glass");
+    }
+
+    #[test]
+    fn checker_lines_parse() {
+        let s = parse(
+            "material a 1 1 1 0 1 0 0 1\nmaterial b 0 0 0 0 1 0 0 1\nchecker c b a 0.25\n\
+             plane 0 1 0 0 c\npolygon a 0 0 0 1 0 0 0 1 0\n",
+        )
+        .unwrap();
+        assert_eq!(
+            s.checkers,
+            [Checker {
+                name: "c".into(),
+                a: 1,
+                b: 0,
+                size: 0.25,
+                line: 3
+            }]
+        );
+        assert_eq!(s.objects[0].surface, Surface::Checker(0));
+        assert_eq!(s.objects[1].surface, Surface::Material(0));
+        assert_eq!(s.material_at(0, [0.1, 0.0, 0.1]).unwrap().name, "b");
+        assert_eq!(s.material_at(0, [0.3, 0.0, 0.1]).unwrap().name, "a");
     }
 
     #[test]
@@ -755,6 +890,28 @@ polygon red 0 0 0 2 0 0 2 2 0 1 1 0 0 2 0
             ("material q 1 1 1 -1 1 0 0 1", "KA -1 is negative"),
             ("background 0 0 0\nbackground 0 0 0", "second background"),
             ("mesh missing.obj m", "missing.obj"),
+            ("checker c m nope 1", "unknown material 'nope'"),
+            ("checker c m m 0", "checker size 0 must be positive"),
+            ("checker c m m -2", "checker size -2 must be positive"),
+            ("checker c m m x", "checker size 'x' is not a number"),
+            ("checker c m m", "missing checker size"),
+            ("checker c m m inf", "not a finite number"),
+            ("checker m m m 1", "'m' defined twice"),
+            ("checker c m m 1 extra", "unexpected 'extra'"),
+            (
+                "checker c m m 1\nmaterial c 1 1 1 0 1 0 0 1",
+                "'c' defined twice",
+            ),
+            (
+                "checker c m m 1\nchecker d c m 1",
+                "'c' is not a plain material",
+            ),
+            (
+                "checker c m m 1\nsphere 0 0 0 1 c",
+                "only for plane and polygon lines, not a sphere",
+            ),
+            ("checker c m m 1\nbox 0 0 0 1 1 1 c", "not a box"),
+            ("checker c m m 1\nmesh missing.obj c", "not a mesh"),
         ];
         for (body, want) in cases {
             let err = parse(&format!("{head}\n# comment\n{body}\n")).unwrap_err();

@@ -244,7 +244,7 @@ impl<'a> Tracer<'a> {
     /// `KA·C·ambient + Σ unblocked lights KD·max(0, N·L)·C·I`, and the shadow bits (bit k set
     /// when light k contributes nothing: N·L ≤ 0 or a shadow ray is blocked).
     pub fn local(&self, id: usize, p: V3, n: V3, stats: &mut TraceStats) -> ([f64; 3], u8) {
-        let Some(m) = self.scene.material_of(id) else {
+        let Some(m) = self.scene.material_at(id, p) else {
             return (self.scene.background, 0);
         };
         let mut c = m.color.map(|ch| m.ka * ch * self.scene.ambient);
@@ -284,10 +284,10 @@ impl<'a> Tracer<'a> {
         weight: f64,
         stats: &mut TraceStats,
     ) -> ([f64; 3], u8) {
-        let (Some(m), Some(d)) = (self.scene.material_of(hit.id), normalize(ray.dir)) else {
+        let p = ray.at(hit.t);
+        let (Some(m), Some(d)) = (self.scene.material_at(hit.id, p), normalize(ray.dir)) else {
             return (self.scene.background, 0);
         };
-        let p = ray.at(hit.t);
         let v = scale(d, -1.0);
         // Leaving the shape when the ray meets the surface from the side opposite its normal.
         let leaving = dot(hit.normal, d) > 0.0;

@@ -674,3 +674,94 @@ fn the_depth_image_holds_eye_depth_along_the_view_axis() {
         img.depth
     );
 }
+
+/// The checker rule against its formula: on a textured plane seen from above (ambient light
+/// only, so a pixel's colour is its material's `KA·C·ambient`), each pixel's colour is that of
+/// material A where `floor(x / SIZE) + floor(z / SIZE)` is even at the hit point and B
+/// elsewhere, over cells on both sides of both axes.
+#[test]
+fn a_checker_texture_follows_its_formula() {
+    let scene = parse(
+        "ambient 1\n\
+         material a 0.2 0.4 0.6 1 0 0 0 1\n\
+         material b 0.8 0.6 0.2 1 0 0 0 1\n\
+         checker tiles a b 0.5\n\
+         plane 0 1 0 0 tiles\n",
+    );
+    let spec = CameraSpec {
+        fovy: 60.0,
+        ..camera([0.3, 5.0, 0.2], [0.3, 0.0, 0.2], [0.0, 0.0, -1.0])
+    };
+    let cam = check_camera(&spec).unwrap();
+    let (w, h) = (64, 64);
+    let img = render(&scene, &spec, w, h, Limits::default(), Structure::Both).unwrap();
+    let colour = |k: usize| scene.materials[k].color.map(|c| (255.0 * c).round() as u8);
+    let (mut seen, mut negative) = ([0; 2], 0);
+    for y in 0..h {
+        for x in 0..w {
+            let dir = scanline3d_sim::trace::scene::primary_ray(&cam, x, y, w, h);
+            let t = -spec.eye[1] / dir[1];
+            let p = [spec.eye[0] + t * dir[0], 0.0, spec.eye[2] + t * dir[2]];
+            let cell = |c: f64| (c / 0.5).floor() as i64;
+            let k = (cell(p[0]) + cell(p[2])).rem_euclid(2) as usize;
+            seen[k] += 1;
+            negative += usize::from(p[0] < 0.0 && p[2] < 0.0);
+            let i = y * w + x;
+            assert_eq!(img.color[i], colour(k), "pixel ({x}, {y}) at {p:?}");
+            assert_eq!(img.materials[i], k as i32, "pixel ({x}, {y})");
+        }
+    }
+    assert!(
+        seen[0] > 1000 && seen[1] > 1000 && negative > 100,
+        "{seen:?} {negative}"
+    );
+}
+
+/// The cell boundaries and the projection: a boundary belongs to the cell above it (a floor),
+/// negative coordinates included; the coordinate of the normal's largest axis is dropped (the
+/// first of equal ones, as the polygon test); and everything of the material comes from the
+/// cell: a mirror cell spawns a reflected ray, a diffuse one nothing.
+#[test]
+fn checker_cells_boundaries_axes_and_coefficients() {
+    let scene = parse(
+        "material a 1 1 1 1 0 0 0 1\n\
+         material mirror 1 1 1 0.1 0 0.5 0 1\n\
+         checker c a mirror 1\n\
+         plane 0 1 0 0 c\n\
+         polygon c 2 0 0 2 0 1 2 1 1 2 1 0\n\
+         polygon c 0 0 0 1 1 0 1 1 1 0 0 1\n",
+    );
+    let at = |id: usize, p: V3| scene.material_index_at(id, p).unwrap();
+    // Floor y = 0: x and z kept.
+    for (p, k) in [
+        ([0.0, 0.0, 0.5], 0),
+        ([-1e-12, 0.0, 0.5], 1),
+        ([1.0, 0.0, 0.5], 1),
+        ([-1.0, 0.0, 0.5], 1),
+        ([-1.0, 0.0, -1.0], 0),
+        ([-0.5, 0.0, -0.5], 0),
+        ([-1.5, 0.0, 0.5], 0),
+        ([3.5, 0.0, -2.5], 0),
+        ([3.5, 0.0, -1.5], 1),
+    ] {
+        assert_eq!(at(0, p), k, "{p:?}");
+    }
+    // The wall x = 2 (normal along x): y and z kept, x ignored.
+    assert_eq!(at(1, [2.0, 0.5, 0.5]), 0);
+    assert_eq!(at(1, [2.0, 1.5, 0.5]), 1);
+    assert_eq!(at(1, [2.0, 0.5, -0.5]), 1);
+    // A polygon whose normal (1, −1, 0)/√2 has equal x and y: x is dropped, y and z kept.
+    assert_eq!(at(2, [0.5, 0.5, 0.5]), 0);
+    assert_eq!(at(2, [1.5, 0.5, 0.5]), 0, "x does not count");
+    assert_eq!(at(2, [0.5, 1.5, 0.5]), 1, "y does");
+    // The mirror cell's KR: a ray straight down into cell (0, 0) reflects, into (1, 0) not.
+    let down = |x: f64| Ray {
+        origin: [x, 1.0, 0.5],
+        dir: [0.0, -1.0, 0.0],
+    };
+    let (_, plain) = trace_logged(&scene, down(0.5), Limits::default());
+    let (_, mirror) = trace_logged(&scene, down(1.5), Limits::default());
+    assert!(log(&plain).is_empty());
+    assert_eq!(log(&mirror).len(), 1);
+    assert_eq!(log(&mirror)[0].spawn, Spawn::Reflection);
+}
