@@ -12,18 +12,9 @@ const CLIPPY_WRAPPER: &[(&str, &str)] = &[
     ),
 ];
 
-/// Runs `cargo test` with the given extra arguments, echoing its output and summing the
-/// per-binary "test result" lines.
-pub(crate) fn cargo_test(extra: &[&str], totals: &mut (u64, u64)) -> Result<(), String> {
-    cargo_test_with(extra, &[], totals)
-}
-
-/// [`cargo_test`] with extra environment variables.
-fn cargo_test_with(
-    extra: &[&str],
-    env: &[(&str, &str)],
-    totals: &mut (u64, u64),
-) -> Result<(), String> {
+/// Runs `cargo test` with the given extra arguments and environment variables, echoing its
+/// output and summing the per-binary "test result" lines.
+fn cargo_test(extra: &[&str], env: &[(&str, &str)], totals: &mut (u64, u64)) -> Result<(), String> {
     let mut cmd = cargo();
     cmd.args(["test", "--workspace"])
         .args(extra)
@@ -86,17 +77,22 @@ pub(crate) fn test() -> Result<(), String> {
     run(cargo()
         .args(["doc", "--package", "scanline3d", "--no-deps"])
         .env("RUSTDOCFLAGS", "-D warnings"))?;
-    // Clippy lints the workspace while the debug tests compile: clippy-driver is the compiler
-    // of the workspace's crates there (as `cargo clippy` sets it), so the crate graph is not
-    // checked once and built again. The benchmarks, which the tests do not build, are then
-    // compiled the same way (their dependencies are the tests' dev-dependencies, built). The
-    // xtask is built with `host` here (for its `dispatch` test), and linted with it.
+    // One host test run, the strict one: overflow checks and debug assertions on. The release
+    // semantics (both off) are those of the firmware built below, whose frame hashes must
+    // equal these host renders on three targets; a release host run would compile the whole
+    // workspace again to check little more (no `unsafe`: optimisation cannot change what safe
+    // code computes). Clippy lints the workspace while the tests compile: clippy-driver is the
+    // compiler of the workspace's crates there (as `cargo clippy` sets it), so the crate graph
+    // is not checked once and built again. The benchmarks, which the tests do not build, are
+    // then compiled the same way (their dependencies are the tests' dev-dependencies, built).
+    // The xtask is built with `host` and `peers` here (for its `dispatch` test, and the peer
+    // renderers' tests in sim/tests/peers.rs), and linted with them.
     let mut totals = (0, 0);
     step("tests, debug (overflow checks on), compiled through clippy (warnings denied)");
-    cargo_test_with(&["--features", "xtask/host"], CLIPPY_WRAPPER, &mut totals)?;
+    cargo_test(&["--features", "xtask/peers"], CLIPPY_WRAPPER, &mut totals)?;
     step("benchmarks compiled through clippy (warnings denied), not run");
-    cargo_test_with(
-        &["--benches", "--no-run", "--features", "xtask/host"],
+    cargo_test(
+        &["--benches", "--no-run", "--features", "xtask/peers"],
         CLIPPY_WRAPPER,
         &mut totals,
     )?;
@@ -104,19 +100,6 @@ pub(crate) fn test() -> Result<(), String> {
     run(cargo()
         .args(["clippy", "--package", "xtask", "--", "-D", "warnings"])
         .env("CARGO_TARGET_DIR", root().join("target/xtask-lint")))?;
-    // Doctests ran above; in release they would only be compiled again, one binary each.
-    step("tests, release, without doctests (with the peer renderers: sim/tests/peers.rs)");
-    cargo_test(
-        &[
-            "--release",
-            "--lib",
-            "--bins",
-            "--tests",
-            "--features",
-            "scanline3d-sim/peers",
-        ],
-        &mut totals,
-    )?;
     // Link-time proof that the render path cannot panic: the panic_never example's panic
     // handler calls an undefined symbol, so the link fails if any panic is reachable. It also
     // builds the library for each target: no_std, no allocator. The firmware examples run below
@@ -147,22 +130,19 @@ pub(crate) fn test() -> Result<(), String> {
 #[cfg(feature = "host")]
 pub(crate) fn test_targets() -> Result<(), String> {
     // The example crates compile (two jobs) while the firmware runs under QEMU, one core a
-    // run; their output interleaves.
+    // run, and then the fuzzer, which takes one core; their output interleaves. The lean
+    // firmware was built with the `firmware` profile, whose dependencies were built: its hashes
+    // are checked here, and `cargo xtask lean` builds it size-optimised for the flash and RAM
+    // table.
     let example_builds = std::thread::spawn(examples);
     firmware()?;
     crate::trace::trace()?;
     crate::metaball::metaball()?;
     crate::patch::patch()?;
+    lean_runs("firmware", false)?;
+    fuzz_built(FUZZ_SECONDS_IN_TEST)?;
     example_builds
         .join()
         .map_err(|_| "the example build thread panicked".to_string())??;
-    // Likewise the lean firmware runs beside the fuzzer, which takes one core. It was built
-    // with the `firmware` profile, whose dependencies were built: its hashes are checked here,
-    // and `cargo xtask lean` builds it size-optimised for the flash and RAM table.
-    let lean_step = std::thread::spawn(|| lean_runs("firmware", false));
-    fuzz_built(FUZZ_SECONDS_IN_TEST)?;
-    lean_step
-        .join()
-        .map_err(|_| "the lean firmware thread panicked".to_string())??;
     Ok(())
 }

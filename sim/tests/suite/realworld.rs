@@ -33,12 +33,6 @@ fn spec_of(mesh: &MeshData, camera: CameraSpec) -> SceneSpec {
 fn table(name: &str, spec: &SceneSpec) -> Vec<(String, Metrics)> {
     let mut rows = Vec::new();
     for a in Algorithm::ALL {
-        // Newell splits the soup into tens of thousands of pieces: seconds in release,
-        // minutes in a debug build, so only release runs it there.
-        if a == Algorithm::Newell && name.starts_with("soup") && cfg!(debug_assertions) {
-            println!("| {name} | {a} | (release builds only) | | | |");
-            continue;
-        }
         let start = std::time::Instant::now();
         let (m, fixed, _) = accuracy_with(spec, W, H, 4, a).unwrap();
         let seconds = start.elapsed().as_secs_f64();
