@@ -23,10 +23,10 @@ use crate::depth::DepthRow;
 use crate::sink::{Row, RowPixel, RowSink};
 use crate::trace::bvh::{self, heap_sort_by_key, PAD};
 use crate::trace::row_shadow::{padded_box, row_region, row_shadows, RowShadows, ShadowCandidate};
-use crate::trace::shape::Object;
+use crate::trace::shape::{Object, Shape};
 use crate::trace::tracer::{Nearest, PixelTrace, ShadowCache, TraceError, TraceStats, Tracer};
 use crate::trace::vector::Vec3;
-use fixed::types::I8F24;
+use fixed::types::{I16F16, I8F24};
 
 /// Pixels added on each side of a projected box: covers the truncation to whole pixels and the
 /// rounding of ray directions and of the projection (f32, relative error near 2^-20).
@@ -96,6 +96,50 @@ impl Scan<'_> {
     }
 }
 
+/// A sphere's or an ellipsoid's centre and semi-axes widened by [`PAD`] (world units, f32);
+/// `None` for the other shapes.
+fn ellipsoid_of(shape: &Shape<'_>) -> Option<([f32; 3], [f32; 3])> {
+    let (centre, radii) = match shape {
+        Shape::Sphere(s) => (s.centre, [s.radius; 3]),
+        Shape::Ellipsoid(e) => (e.centre, [e.radii.x, e.radii.y, e.radii.z]),
+        _ => return None,
+    };
+    let f = |v: I16F16| v.saturating_add(PAD).to_num::<f32>();
+    Some((centre.bits().map(|c| c as f32 / 65536.0), radii.map(f)))
+}
+
+/// The range of `X / Z` over an axis-aligned ellipsoid centred `c` (relative to the eye) with
+/// semi-axes `radii`, wholly in front of the eye (`Z = p·forward > 0` on it), where
+/// `X = p·axis / |axis|`: the slopes `m` of the two planes `X = m·Z` tangent to it, which
+/// solve `(n·c)² = Σ nᵢ² rᵢ²` for `n = axis / |axis| − m·forward`. `None` if rounding left no
+/// two roots.
+fn tangent_slopes(
+    c: [f32; 3],
+    radii: [f32; 3],
+    axis: [f32; 3],
+    forward: [f32; 3],
+) -> Option<(f32, f32)> {
+    let length = libm::sqrtf(axis.iter().map(|a| a * a).sum());
+    let a = axis.map(|v| v / length);
+    let sum = |f: &dyn Fn(usize) -> f32| (0..3).map(f).sum::<f32>();
+    let (cx, cz) = (sum(&|i| a[i] * c[i]), sum(&|i| forward[i] * c[i]));
+    let r2 = radii.map(|r| r * r);
+    let (saa, sff, saf) = (
+        sum(&|i| a[i] * a[i] * r2[i]),
+        sum(&|i| forward[i] * forward[i] * r2[i]),
+        sum(&|i| a[i] * forward[i] * r2[i]),
+    );
+    // m²·(cz² − Sff) − 2m·(cx·cz − Saf) + (cx² − Saa) = 0.
+    let q = cz * cz - sff;
+    let half_b = cx * cz - saf;
+    let disc = half_b * half_b - q * (cx * cx - saa);
+    if !(q > 0.0 && disc >= 0.0) {
+        return None;
+    }
+    let root = libm::sqrtf(disc);
+    Some(((half_b - root) / q, (half_b + root) / q))
+}
+
 impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     /// Writes the screen bounds of the visible objects into `bounds`, sorted by first row;
     /// returns how many were written and whether all fitted.
@@ -113,12 +157,63 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         let near = camera.near.to_num::<f32>() / 2.0;
         let eye = camera.eye.bits().map(|c| c as f32 / 65536.0);
         let full = (0, w - 1, 0, h - 1);
+        // The pixel rectangle of coordinate ranges, widened by the margin; `None` off screen.
+        let rect_of = |x: (f32, f32), y: (f32, f32)| {
+            // `as` saturates; truncation towards zero is inside the margin.
+            let (x0, x1) = (
+                (x.0 as i32).saturating_sub(MARGIN),
+                (x.1 as i32).saturating_add(MARGIN),
+            );
+            let (y0, y1) = (
+                (y.0 as i32).saturating_sub(MARGIN),
+                (y.1 as i32).saturating_add(MARGIN),
+            );
+            let (wi, hi) = (i32::from(w), i32::from(h));
+            (x1 >= 0 && y1 >= 0 && x0 < wi && y0 < hi).then(|| {
+                // max/min, not clamp: clamp's check for an empty range would link a panic.
+                let clamp = |v: i32, n: i32| v.max(0).min(n - 1) as u16;
+                (clamp(x0, wi), clamp(x1, wi), clamp(y0, hi), clamp(y1, hi))
+            })
+        };
         let mut used = 0;
         let mut complete = true;
         for (id, object) in self.scene().objects.iter().enumerate() {
-            let rect = match bvh::bounds(&object.shape) {
-                None => Some(full),
-                Some((lo, hi)) => {
+            // Per axis the range of a seen point's pixel coordinate, and the range of the eye
+            // depths of the object's points.
+            let extent = match ellipsoid_of(&object.shape) {
+                // A sphere or ellipsoid wholly in front: its exact outline (the planes through
+                // the eye tangent to it), far inside its box's corners.
+                Some((c, radii)) => {
+                    let c: [f32; 3] = core::array::from_fn(|i| c[i] - eye[i]);
+                    // Half its extent along the view direction: √(Σ forwardᵢ² rᵢ²).
+                    let half = libm::sqrtf(
+                        (0..3)
+                            .map(|i| forward[i] * forward[i] * radii[i] * radii[i])
+                            .sum(),
+                    );
+                    let depth = dot(c, forward);
+                    (depth - half > near).then(|| {
+                        let outline = |axis: [f32; 3], origin: f32, step: f32| {
+                            let (lo, hi) = tangent_slopes(c, radii, axis, forward)?;
+                            // A slope m = X / Z is the pixel coordinate (m·|axis| − origin) / step.
+                            let n = libm::sqrtf(step);
+                            Some(((lo * n - origin) / step, (hi * n - origin) / step))
+                        };
+                        Some((
+                            outline(right, cr, rr)?,
+                            outline(down, cd, dd)?,
+                            depth - half,
+                            depth + half,
+                        ))
+                    })
+                }
+                None => None,
+            }
+            .flatten();
+            let rect = match (extent, bvh::bounds(&object.shape)) {
+                (_, None) => Some(full),
+                (Some((x, y, _, _)), Some(_)) => rect_of(x, y),
+                (None, Some((lo, hi))) => {
                     let pad = Vec3 {
                         x: PAD,
                         y: PAD,
@@ -145,21 +240,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                     } else if nearest < near {
                         Some(full)
                     } else {
-                        // `as` saturates; truncation towards zero is inside the margin.
-                        let (x0, x1) = (
-                            (x.0 as i32).saturating_sub(MARGIN),
-                            (x.1 as i32).saturating_add(MARGIN),
-                        );
-                        let (y0, y1) = (
-                            (y.0 as i32).saturating_sub(MARGIN),
-                            (y.1 as i32).saturating_add(MARGIN),
-                        );
-                        let (wi, hi) = (i32::from(w), i32::from(h));
-                        (x1 >= 0 && y1 >= 0 && x0 < wi && y0 < hi).then(|| {
-                            // max/min, not clamp: clamp's check for an empty range would link a panic.
-                            let clamp = |v: i32, n: i32| v.max(0).min(n - 1) as u16;
-                            (clamp(x0, wi), clamp(x1, wi), clamp(y0, hi), clamp(y1, hi))
-                        })
+                        rect_of(x, y)
                     }
                 }
             };
