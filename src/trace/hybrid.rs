@@ -140,6 +140,57 @@ fn tangent_slopes(
     Some(((half_b - root) / q, (half_b + root) / q))
 }
 
+/// Whether a polygon's outline, projected along `axis` (as the point-in-polygon test sees
+/// it), turns one way only: convex (exact, raw bits).
+fn convex(vertices: &[Vec3], axis: u8) -> bool {
+    let project = |v: &Vec3| {
+        let [x, y, z] = v.bits().map(i64::from);
+        match axis {
+            0 => (y, z),
+            1 => (z, x),
+            _ => (x, y),
+        }
+    };
+    let n = vertices.len();
+    let (mut positive, mut negative) = (false, false);
+    // A star turns one way too: a convex outline's edges also change direction along the
+    // first axis only twice (zeros skipped).
+    let (mut changes, mut last_dx) = (0, 0i64);
+    for i in 0..n {
+        let (Some(a), Some(b), Some(c)) = (
+            vertices.get(i),
+            vertices.get((i + 1) % n),
+            vertices.get((i + 2) % n),
+        ) else {
+            return false;
+        };
+        let ((ax, ay), (bx, by), (cx, cy)) = (project(a), project(b), project(c));
+        // Differences below 2^30 raw: the products stay below 2^61.
+        let turn = (bx - ax) * (cy - by) - (by - ay) * (cx - bx);
+        positive |= turn > 0;
+        negative |= turn < 0;
+        let dx = bx - ax;
+        if dx != 0 {
+            if last_dx != 0 && (dx > 0) != (last_dx > 0) {
+                changes += 1;
+            }
+            last_dx = dx;
+        }
+    }
+    // The wrap from the last edge to the first.
+    let first_dx = (0..n)
+        .filter_map(|i| {
+            let (a, b) = (vertices.get(i)?, vertices.get((i + 1) % n)?);
+            Some(project(b).0 - project(a).0)
+        })
+        .find(|dx| *dx != 0)
+        .unwrap_or(0);
+    if first_dx != 0 && last_dx != 0 && (first_dx > 0) != (last_dx > 0) {
+        changes += 1;
+    }
+    n >= 3 && !(positive && negative) && changes <= 2
+}
+
 impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     /// Writes the screen bounds of the visible objects into `bounds`, sorted by first row;
     /// returns how many were written and whether all fitted.
@@ -264,6 +315,98 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             heap_sort_by_key(written, |b| (b.y0, b.object));
         }
         (used, complete)
+    }
+
+    /// The columns of row `y` whose primary rays certainly meet convex polygon `object` inside
+    /// its outline when they meet its plane (inclusive; `None`: no such column, or not a convex
+    /// polygon wholly in front of the eye). The outline seen on screen is convex, so a pixel is
+    /// safe when the pixels two columns and two rows away on each side are inside it: those
+    /// corners' rays bound the pixel's ray with its rounding (below 2^-14 rad, a hundredth of
+    /// a pixel here) by [`MARGIN`] pixels, and the columns are shrunk by one more for the f32
+    /// arithmetic. Rows whose hits are so near that two pixels span less than 2^-8 units (the
+    /// hit point's own rounding is near 2^-12) get `None`. Only a speed-up: the other columns
+    /// take the full test.
+    fn inside_columns(&self, object: &Object<'_>, y: u16) -> Option<(u16, u16)> {
+        let Shape::Polygon(polygon) = &object.shape else {
+            return None;
+        };
+        if !convex(polygon.vertices, polygon.facet.axis) {
+            return None;
+        }
+        let camera = self.camera();
+        let f = |v: [I8F24; 3]| v.map(|c| c.to_num::<f32>());
+        let (corner, right, down) = (f(camera.corner), f(camera.right), f(camera.down));
+        let eye = camera.eye.bits().map(|c| c as f32 / 65536.0);
+        let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let cross = |a: [f32; 3], b: [f32; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let (w, h) = (f32::from(camera.width), f32::from(camera.height));
+        let forward: [f32; 3] = core::array::from_fn(|i| {
+            corner[i] + (w - 1.0) / 2.0 * right[i] + (h - 1.0) / 2.0 * down[i]
+        });
+        let (rr, cr) = (dot(right, right), dot(corner, right));
+        let near = camera.near.to_num::<f32>() / 2.0;
+        let vertex = |v: &Vec3| -> [f32; 3] {
+            let b = v.bits();
+            core::array::from_fn(|i| b[i] as f32 / 65536.0 - eye[i])
+        };
+        if polygon
+            .vertices
+            .iter()
+            .any(|v| dot(vertex(v), forward) <= near)
+        {
+            return None;
+        }
+        let row = f32::from(y);
+        let (mut lo, mut hi) = (f32::MIN, f32::MAX);
+        let mut nearest = f32::MAX;
+        for r in [row - 2.0, row + 2.0] {
+            // The plane through the eye holding the row's rays, and where it crosses the outline.
+            let through: [f32; 3] = core::array::from_fn(|i| corner[i] + r * down[i]);
+            let n = cross(right, through);
+            let mut columns = [0.0f32; 2];
+            let mut crossings = 0;
+            let last = polygon.vertices.last()?;
+            let mut a = vertex(last);
+            let mut sa = dot(n, a);
+            for v in polygon.vertices {
+                let b = vertex(v);
+                let sb = dot(n, b);
+                if sa == 0.0 || sb == 0.0 {
+                    return None;
+                }
+                if (sa < 0.0) != (sb < 0.0) {
+                    let k = sa / (sa - sb);
+                    let p: [f32; 3] = core::array::from_fn(|i| a[i] + k * (b[i] - a[i]));
+                    let z = dot(p, forward);
+                    nearest = nearest.min(z);
+                    *columns.get_mut(crossings)? = (dot(p, right) / z - cr) / rr;
+                    crossings += 1;
+                }
+                (a, sa) = (b, sb);
+            }
+            if crossings != 2 {
+                return None;
+            }
+            let [c0, c1] = columns;
+            (lo, hi) = (lo.max(c0.min(c1)), hi.min(c0.max(c1)));
+        }
+        // Two pixels at the nearest crossing's depth, in world units (a pixel's ray turns by
+        // about |right| radians).
+        if !(nearest * 2.0 * libm::sqrtf(rr) >= 1.0 / 256.0) {
+            return None;
+        }
+        let margin = (MARGIN + 1) as f32;
+        let (first, last) = (libm::ceilf(lo + margin), libm::floorf(hi - margin));
+        (first <= last && last >= 0.0 && first < w).then(|| {
+            // `as` saturates.
+            (first.max(0.0) as u16, last.min(w - 1.0) as u16)
+        })
     }
 
     /// Where the first hits of row `y` on `object` can lie, as a box (raw bits, inclusive):
@@ -408,6 +551,18 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 }
             }
             let row_lists = lists.as_ref().and_then(Option::as_ref);
+            // Per active convex polygon (up to four), the columns that skip its outline test.
+            let mut inside = [(u32::MAX, 1u16, 0u16); 4];
+            if scanned {
+                let polygons = live.iter().filter_map(|b| {
+                    let object = scene.objects.get(b.object as usize)?;
+                    let (first, last) = self.inside_columns(object, y)?;
+                    Some((b.object, first, last))
+                });
+                for (slot, entry) in inside.iter_mut().zip(polygons) {
+                    *slot = entry;
+                }
+            }
             if scanned && row_lists.is_none() {
                 stats.shadow_fallback_rows += 1;
             }
@@ -417,7 +572,14 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                         let mut search = Nearest::new(u32::MAX, t_min, t_max);
                         for b in live {
                             if b.x0 <= x && x <= b.x1 {
-                                search.offer(scene, b.object, ray);
+                                let known_inside = inside.iter().any(|&(id, first, last)| {
+                                    id == b.object && first <= x && x <= last
+                                });
+                                if known_inside {
+                                    search.offer_inside_outline(scene, b.object, ray);
+                                } else {
+                                    search.offer(scene, b.object, ray);
+                                }
                             }
                         }
                         search.finish(stats)
