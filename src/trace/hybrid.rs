@@ -551,16 +551,18 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 }
             }
             let row_lists = lists.as_ref().and_then(Option::as_ref);
-            // Per active convex polygon (up to four), the columns that skip its outline test.
-            let mut inside = [(u32::MAX, 1u16, 0u16); 4];
+            // Per active rectangle (the first four), the columns where its object's outline
+            // test is known to pass (empty unless a convex polygon's).
+            let mut inside = [(1u16, 0u16); 4];
             if scanned {
-                let polygons = live.iter().filter_map(|b| {
-                    let object = scene.objects.get(b.object as usize)?;
-                    let (first, last) = self.inside_columns(object, y)?;
-                    Some((b.object, first, last))
-                });
-                for (slot, entry) in inside.iter_mut().zip(polygons) {
-                    *slot = entry;
+                for (slot, b) in inside.iter_mut().zip(live) {
+                    if let Some(columns) = scene
+                        .objects
+                        .get(b.object as usize)
+                        .and_then(|o| self.inside_columns(o, y))
+                    {
+                        *slot = columns;
+                    }
                 }
             }
             if scanned && row_lists.is_none() {
@@ -570,12 +572,10 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 let (p, s) = if scanned {
                     self.trace_with(x, y, &mut cache, row_lists, |ray, t_min, t_max, stats| {
                         let mut search = Nearest::new(u32::MAX, t_min, t_max);
-                        for b in live {
+                        for (i, b) in live.iter().enumerate() {
                             if b.x0 <= x && x <= b.x1 {
-                                let known_inside = inside.iter().any(|&(id, first, last)| {
-                                    id == b.object && first <= x && x <= last
-                                });
-                                if known_inside {
+                                let (first, last) = inside.get(i).copied().unwrap_or((1, 0));
+                                if first <= x && x <= last {
                                     search.offer_inside_outline(scene, b.object, ray);
                                 } else {
                                     search.offer(scene, b.object, ray);
