@@ -398,7 +398,8 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         }
         // Two pixels at the nearest crossing's depth, in world units (a pixel's ray turns by
         // about |right| radians).
-        if !(nearest * 2.0 * libm::sqrtf(rr) >= 1.0 / 256.0) {
+        let span = nearest * 2.0 * libm::sqrtf(rr);
+        if span.is_nan() || span < 1.0 / 256.0 {
             return None;
         }
         let margin = (MARGIN + 1) as f32;
