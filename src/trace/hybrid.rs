@@ -727,4 +727,89 @@ mod tests {
         // The floor fills the lower rows, each of which sees a narrow band of it.
         assert!(hits > 500 && clipped > 20, "{hits} {clipped}");
     }
+
+    #[test]
+    fn known_inside_columns_pass_the_outline_test() {
+        use crate::trace::shape::Polygon;
+        // The classic's floor, seen from its camera at 48 × 48.
+        let floor = [
+            v(-4.0, 0.0, -4.0),
+            v(-4.0, 0.0, 4.0),
+            v(4.0, 0.0, 4.0),
+            v(4.0, 0.0, -4.0),
+        ];
+        let objects = [Object {
+            shape: Shape::Polygon(Polygon::new(&floor).unwrap()),
+            material: 0,
+        }];
+        let grey = Colour::new([I16F16::from_num(0.5); 3]).unwrap();
+        let materials = [Material::new(grey, [I16F16::ONE; 4], I16F16::ONE).unwrap()];
+        let scene = Scene::new(&objects, &materials, &[], Colour::BLACK, I16F16::ZERO).unwrap();
+        let camera = TraceCamera::new(
+            [0.0, 3.0, 7.0],
+            [0.0, 0.8, 0.0],
+            [0.0, 1.0, 0.0],
+            50.0,
+            0.1,
+            100.0,
+            48,
+            48,
+        )
+        .unwrap();
+        let tracer = Tracer::<4>::new(&scene, &camera, TraceOptions::default());
+        let t_min = I16F16::from_bits(1);
+        let (mut known, mut hits) = (0, 0);
+        for y in 0..48u16 {
+            let columns = tracer.inside_columns(&objects[0], y);
+            for x in 0..48u16 {
+                let (dir, _) = camera
+                    .pixel_direction(x, y)
+                    .normalized_with_length()
+                    .unwrap();
+                let ray = crate::trace::Ray {
+                    origin: camera.eye,
+                    dir,
+                };
+                let full = objects[0].shape.hit(&ray, t_min, I16F16::MAX);
+                hits += usize::from(full.is_some());
+                if columns.is_some_and(|(first, last)| (first..=last).contains(&x)) {
+                    // The plane's t alone is the full test's answer there.
+                    let plane = objects[0]
+                        .shape
+                        .hit_inside_outline(&ray, t_min, I16F16::MAX);
+                    assert!(full.is_some() && plane == full, "{x} {y}");
+                    known += 1;
+                }
+            }
+        }
+        // Most of the floor's pixels skip the outline test.
+        assert!(known * 2 > hits && hits > 500, "{known} of {hits}");
+    }
+
+    #[test]
+    fn only_convex_outlines_count_as_convex() {
+        let square = [
+            v(0.0, 0.0, 0.0),
+            v(0.0, 0.0, 1.0),
+            v(1.0, 0.0, 1.0),
+            v(1.0, 0.0, 0.0),
+        ];
+        assert!(convex(&square, 1));
+        // An L: one turn the other way.
+        let l = [
+            v(0.0, 0.0, 0.0),
+            v(0.0, 0.0, 2.0),
+            v(2.0, 0.0, 2.0),
+            v(2.0, 0.0, 1.0),
+            v(1.0, 0.0, 1.0),
+            v(1.0, 0.0, 0.0),
+        ];
+        assert!(!convex(&l, 1));
+        // A pentagram turns one way only but winds twice.
+        let star: [Vec3; 5] = core::array::from_fn(|i| {
+            let a = (i as f64) * 4.0 * core::f64::consts::PI / 5.0;
+            v(a.cos(), 0.0, a.sin())
+        });
+        assert!(!convex(&star, 1));
+    }
 }
