@@ -208,6 +208,22 @@ impl Nearest {
         self.limit()
     }
 
+    /// [`offer`](Self::offer) for a primary ray (`from` is none) known to meet planar object
+    /// `id` inside its outline if it meets its plane: the point-in-polygon test is skipped.
+    pub(crate) fn offer_inside_outline(&mut self, scene: &Scene<'_>, id: u32, ray: &Ray) {
+        self.tests += 1;
+        let limit = self.limit();
+        let t = scene
+            .objects
+            .get(id as usize)
+            .and_then(|object| object.shape.hit_inside_outline(ray, self.t_min, limit));
+        if let Some(t) = t {
+            if self.best.is_none_or(|b| t < b.t || id < b.object) {
+                self.best = Some(Hit { t, object: id });
+            }
+        }
+    }
+
     /// The nearest hit found; adds the tests made to `stats`.
     pub(crate) fn finish(self, stats: &mut TraceStats) -> Option<Hit> {
         stats.intersection_tests += self.tests;
