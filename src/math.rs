@@ -75,6 +75,37 @@ impl MathBackend for Micromath {
     }
 }
 
+/// The core has no 32 × 32 → 64-bit multiply (ARMv6-M, the Arm profile without 32-bit
+/// atomics): every `i64` product is a call to `__aeabi_lmul` (about 45 instructions with the
+/// call), so products whose operands are known to be narrow are written out in 32-bit
+/// multiplies there. Elsewhere the `i64` product is one or two instructions.
+pub(crate) const NO_WIDE_MULTIPLY: bool =
+    cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
+
+/// `(a · b) mod 2^64` for `0 <= b < 2^16`, as `a.wrapping_mul(b as i64)`: on cores without a
+/// wide multiply ([`NO_WIDE_MULTIPLY`]) from three 32-bit multiplies (`a`'s low word in two
+/// 16-bit halves and its high word, each times `b`, whose products fit 32 bits), elsewhere
+/// the `i64` multiply. The same bits either way (test `narrow_products_are_exact`).
+#[inline]
+pub(crate) fn mul_i64_u16(a: i64, b: u16) -> i64 {
+    if NO_WIDE_MULTIPLY {
+        mul_i64_u16_in_words(a, b)
+    } else {
+        a.wrapping_mul(b as i64)
+    }
+}
+
+/// [`mul_i64_u16`] from 32-bit multiplies, on every target (tested on the host too).
+#[inline]
+fn mul_i64_u16_in_words(a: i64, b: u16) -> i64 {
+    let b = b as u32;
+    let (hi, lo) = ((a >> 32) as u32, a as u32);
+    // a·b = hi·b·2^32 + (lo >> 16)·b·2^16 + (lo & 0xFFFF)·b; both halves' products < 2^32.
+    let (mid, low) = ((lo >> 16) * b, (lo & 0xFFFF) * b);
+    let low_word = ((mid as u64) << 16) + low as u64;
+    low_word.wrapping_add((hi.wrapping_mul(b) as u64) << 32) as i64
+}
+
 /// Cosine of the angle between an integer vector `v` of any scale and a unit vector `unit`
 /// (I2F30 bits), in I2F30 bits truncated towards zero; `None` for the zero vector.
 ///
@@ -408,6 +439,27 @@ mod tests {
                     r * r <= v as u64 && (r + 1) * (r + 1) > v as u64,
                     "{name} {v}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn narrow_products_are_exact() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let edges = [0i64, 1, -1, i64::MAX, i64::MIN, u32::MAX as i64, -(1 << 32)];
+        for k in 0..400_000u64 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let a = match k % 4 {
+                0 => x as i64,
+                1 => (x as i64) >> (x % 64),
+                _ => edges[(k / 4 % 7) as usize].wrapping_add((x >> 60) as i64 - 8),
+            };
+            for b in [(x >> 48) as u16, 0, 1, u16::MAX, (x >> 20) as u16 & 0x7FF] {
+                let want = a.wrapping_mul(b as i64);
+                assert_eq!(mul_i64_u16_in_words(a, b), want, "{a} * {b}");
+                assert_eq!(mul_i64_u16(a, b), want, "{a} * {b}");
             }
         }
     }

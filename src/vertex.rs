@@ -13,7 +13,7 @@
 //!
 //! [`MAX_MODEL_COORD`]: crate::scene::MAX_MODEL_COORD
 
-use crate::math::{fit_bits, NormalPrecision};
+use crate::math::{fit_bits, NormalPrecision, NO_WIDE_MULTIPLY};
 use crate::scene::{Light, Transform, Vertex};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::{I16F16, I2F30};
@@ -170,6 +170,9 @@ impl ModelView {
     /// Transforms a model vertex (validated mesh, so inside the proven envelope).
     #[inline]
     pub fn apply(&self, v: &Vertex) -> EyePoint {
+        if NO_WIDE_MULTIPLY {
+            return self.apply_in_words(v);
+        }
         let row = |r: usize| {
             let sum = self.m[r][0].to_bits() as i64 * v[0].to_bits() as i64
                 + self.m[r][1].to_bits() as i64 * v[1].to_bits() as i64
@@ -177,6 +180,42 @@ impl ModelView {
                 + ((self.t[r].to_bits() as i64) << 16);
             // I32F32 -> I16F16, rounding to nearest; the envelope proof bounds the result.
             I16F16::from_bits(((sum + (1 << 15)) >> 16) as i32)
+        };
+        EyePoint {
+            x: row(0),
+            y: row(1),
+            w: row(2),
+        }
+    }
+}
+
+impl ModelView {
+    /// [`ModelView::apply`] from 32-bit multiplies, the same bits (test
+    /// `transform_in_words_equals_the_64_bit_one`). With `v = vh·2^16 + vl` and
+    /// `m = mh·2^16 + ml` (`vl`, `ml` the unsigned low halves), `m·v = (m·vh + mh·vl)·2^16 +
+    /// ml·vl`, so the rounded row `⌊(Σ m·v + t·2^16 + 2^15) / 2^16⌋` is
+    /// `Σ (m·vh + mh·vl) + t` plus the carry of the low products `⌊(Σ ml·vl + 2^15) / 2^16⌋`,
+    /// taken from their halves so nothing exceeds 32 bits. The high part is summed modulo
+    /// 2^32 (wrapping): the row's low 32 bits, as the 64-bit path's `as i32` keeps them.
+    #[inline]
+    fn apply_in_words(&self, v: &Vertex) -> EyePoint {
+        let v = v.map(|c| c.to_bits());
+        let row = |r: usize| {
+            let mut high = self.t[r].to_bits();
+            let (mut carry_high, mut carry_low) = (0u32, 1u32 << 15);
+            for (m, &v) in self.m[r].iter().zip(&v) {
+                let m = m.to_bits();
+                let (vh, vl) = (v >> 16, v as u32 & 0xFFFF);
+                let (mh, ml) = (m >> 16, m as u32 & 0xFFFF);
+                high = high
+                    .wrapping_add(m.wrapping_mul(vh))
+                    .wrapping_add(mh.wrapping_mul(vl as i32));
+                // ml·vl < 2^32; the three halves' sums stay below 2^18.
+                let low = ml * vl;
+                carry_high += low >> 16;
+                carry_low += low & 0xFFFF;
+            }
+            I16F16::from_bits(high.wrapping_add((carry_high + (carry_low >> 16)) as i32))
         };
         EyePoint {
             x: row(0),
@@ -352,8 +391,25 @@ impl Lighting {
 
 /// `base * intensity` per channel, rounded to nearest.
 pub fn shade(base: Rgb888, intensity: I2F30) -> Rgb888 {
-    let i = intensity.to_bits() as i64;
+    let bits = intensity.to_bits();
+    if NO_WIDE_MULTIPLY && (0..=1 << 30).contains(&bits) {
+        return shade_in_words(base, bits as u32);
+    }
+    let i = bits as i64;
     let ch = |c: u8| (((c as i64 * i) + (1 << 29)) >> 30).clamp(0, 255) as u8;
+    Rgb888::new(ch(base.r()), ch(base.g()), ch(base.b()))
+}
+
+/// [`shade`] for an intensity `i` in `[0, 2^30]` in 32-bit multiplies, the same channels:
+/// with `i = ih·2^8 + il`, `⌊(c·i + 2^29) / 2^30⌋ = ⌊(c·ih + ⌊(c·il + 2^29) / 2^8⌋) / 2^22⌋`,
+/// whose sum stays below 2^31 for `c <= 255`.
+#[inline]
+fn shade_in_words(base: Rgb888, i: u32) -> Rgb888 {
+    let (ih, il) = (i >> 8, i & 0xFF);
+    let ch = |c: u8| {
+        let c = c as u32;
+        ((c * ih + ((c * il + (1 << 29)) >> 8)) >> 22).min(255) as u8
+    };
     Rgb888::new(ch(base.r()), ch(base.g()), ch(base.b()))
 }
 
@@ -409,6 +465,43 @@ mod tests {
         assert!((e.x.to_num::<f32>() - f[0]).abs() < 1e-3);
         assert!((e.y.to_num::<f32>() - f[1]).abs() < 1e-3);
         assert!((e.w.to_num::<f32>() + f[2]).abs() < 1e-3);
+    }
+
+    #[test]
+    fn transform_in_words_equals_the_64_bit_one() {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |bits: u32| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x as i64 >> (64 - bits)) as i32
+        };
+        for case in 0..200_000 {
+            // Matrix entries and vertices of every size, up to the model envelope (2^28 bits)
+            // and full I16F16 entries, so products near 2^59 and rows of any sign are tried.
+            let mb = 1 + (case % 32) as u32;
+            let vb = 1 + (case / 32 % 29) as u32;
+            let mv = ModelView {
+                m: [(); 3].map(|_| [(); 3].map(|_| I16F16::from_bits(next(mb)))),
+                t: [(); 3].map(|_| I16F16::from_bits(next(32))),
+            };
+            let p = [(); 3].map(|_| I16F16::from_bits(next(vb)));
+            let want = [0, 1, 2].map(|r| {
+                let sum: i128 = (0..3)
+                    .map(|k| mv.m[r][k].to_bits() as i128 * p[k].to_bits() as i128)
+                    .sum::<i128>()
+                    + ((mv.t[r].to_bits() as i128) << 16);
+                ((sum + (1 << 15)) >> 16) as i32
+            });
+            let got = mv.apply_in_words(&p);
+            assert_eq!(
+                [got.x, got.y, got.w].map(|c| c.to_bits()),
+                want,
+                "case {case}"
+            );
+            let wide = mv.apply(&p);
+            assert_eq!((wide.x, wide.y, wide.w), (got.x, got.y, got.w));
+        }
     }
 
     #[test]
@@ -501,6 +594,32 @@ mod tests {
         assert_eq!(m.face::<W>([&a, &b, &c]), I2F30::from_bits(1 << 30));
         assert_eq!(m.vertex::<W>(&v(0.0, 0.0, 1.0)), I2F30::from_num(0.25));
         assert_eq!(m.vertex::<W>(&v(0.0, 0.0, -3.0)), I2F30::from_bits(1 << 30));
+    }
+
+    #[test]
+    fn shade_in_words_equals_shade() {
+        let wide = |c: u8, i: u32| (((c as i64 * i as i64) + (1 << 29)) >> 30).clamp(0, 255);
+        let mut x = 0x2545_f491u32;
+        for step in 0..400_000u32 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            // Every intensity near each channel's rounding points, and random ones.
+            let i = match step % 2 {
+                0 => x % ((1 << 30) + 1),
+                _ => (((x % 256) << 30) / 255 + (x >> 28)).min(1 << 30),
+            };
+            let base = Rgb888::new(x as u8, (x >> 8) as u8, (step % 256) as u8);
+            let got = shade_in_words(base, i);
+            let want = [base.r(), base.g(), base.b()].map(|c| wide(c, i) as u8);
+            assert_eq!([got.r(), got.g(), got.b()], want, "{base:?} {i}");
+        }
+        for c in [0u8, 1, 127, 128, 254, 255] {
+            for i in [0u32, 1, 1 << 29, (1 << 30) - 1, 1 << 30] {
+                let got = shade_in_words(Rgb888::new(c, c, c), i);
+                assert_eq!(got.r() as i64, wide(c, i), "{c} {i}");
+            }
+        }
     }
 
     #[test]
