@@ -82,6 +82,30 @@ impl MathBackend for Micromath {
 pub(crate) const NO_WIDE_MULTIPLY: bool =
     cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
 
+/// `a · b` as `i64`: on cores without a wide multiply ([`NO_WIDE_MULTIPLY`]) from four
+/// 32-bit multiplies of 16-bit halves, elsewhere the `i64` multiply (one instruction). The
+/// same value either way (test `narrow_products_are_exact`).
+#[inline]
+pub(crate) fn mul_wide(a: i32, b: i32) -> i64 {
+    if NO_WIDE_MULTIPLY {
+        mul_wide_in_halves(a, b)
+    } else {
+        a as i64 * b as i64
+    }
+}
+
+/// [`mul_wide`] from 32-bit multiplies, on every target (tested on the host too). With
+/// `a = ah·2^16 + al` (`ah` signed, `al` in `[0, 2^16)`) and `b` alike, `a·b = ah·bh·2^32 +
+/// (ah·bl + al·bh)·2^16 + al·bl`; each of the four products fits 32 bits.
+#[inline]
+fn mul_wide_in_halves(a: i32, b: i32) -> i64 {
+    let (ah, al) = (a >> 16, a & 0xFFFF);
+    let (bh, bl) = (b >> 16, b & 0xFFFF);
+    let cross = (ah * bl) as i64 + (al * bh) as i64;
+    let low = (al as u32 * bl as u32) as i64;
+    (((ah * bh) as i64) << 32) + (cross << 16) + low
+}
+
 /// `(a · b) mod 2^64` for `0 <= b < 2^16`, as `a.wrapping_mul(b as i64)`: on cores without a
 /// wide multiply ([`NO_WIDE_MULTIPLY`]) from three 32-bit multiplies (`a`'s low word in two
 /// 16-bit halves and its high word, each times `b`, whose products fit 32 bits), elsewhere
@@ -116,13 +140,13 @@ fn mul_i64_u16_in_words(a: i64, b: u16) -> i64 {
 pub(crate) fn cosine_i64(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
     // |s_i| <= 2^30: each fits `i32`, so the products below are 32 × 32 → 64 bits.
     let s = fit_bits(v, 30)?.map(|c| c as i32);
-    let len = isqrt_u64(s.iter().map(|&c| (c as i64 * c as i64) as u64).sum());
+    let len = isqrt_u64(s.iter().map(|&c| mul_wide(c, c) as u64).sum());
     if len == 0 {
         return None;
     }
     // |s_i · unit_i| < 2^60 and, by Cauchy–Schwarz, every partial sum is at most
     // |s| · |unit| < 2^61: no overflow, and the quotient is within about ±2^30.
-    let dot: i64 = (0..3).map(|k| s[k] as i64 * unit[k] as i64).sum();
+    let dot: i64 = (0..3).map(|k| mul_wide(s[k], unit[k])).sum();
     // `len <= sqrt(3) · 2^30` fits 32 bits and is non-zero here.
     let q = div_rem_u64_u32(dot.unsigned_abs(), len as u32).0 as i32;
     Some(if dot < 0 { -q } else { q })
@@ -447,6 +471,7 @@ mod tests {
     fn narrow_products_are_exact() {
         let mut x = 0x2545_f491_4f6c_dd1du64;
         let edges = [0i64, 1, -1, i64::MAX, i64::MIN, u32::MAX as i64, -(1 << 32)];
+        assert_eq!(mul_wide_in_halves(i32::MIN, i32::MIN), 1 << 62);
         for k in 0..400_000u64 {
             x ^= x << 13;
             x ^= x >> 7;
@@ -456,6 +481,12 @@ mod tests {
                 1 => (x as i64) >> (x % 64),
                 _ => edges[(k / 4 % 7) as usize].wrapping_add((x >> 60) as i64 - 8),
             };
+            let (c, d) = ((x >> 32) as i32, (a as i32) >> (x % 32));
+            for (c, d) in [(c, d), (c, i32::MIN), (i32::MIN, d), (i32::MAX, d), (c, -1)] {
+                let want = c as i64 * d as i64;
+                assert_eq!(mul_wide_in_halves(c, d), want, "{c} * {d}");
+                assert_eq!(mul_wide(c, d), want, "{c} * {d}");
+            }
             for b in [(x >> 48) as u16, 0, 1, u16::MAX, (x >> 20) as u16 & 0x7FF] {
                 let want = a.wrapping_mul(b as i64);
                 assert_eq!(mul_i64_u16_in_words(a, b), want, "{a} * {b}");

@@ -13,7 +13,7 @@
 //!
 //! [`MAX_MODEL_COORD`]: crate::scene::MAX_MODEL_COORD
 
-use crate::math::{fit_bits, NormalPrecision, NO_WIDE_MULTIPLY};
+use crate::math::{fit_bits, mul_wide, NormalPrecision, NO_WIDE_MULTIPLY};
 use crate::scene::{Light, Transform, Vertex};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::{I16F16, I2F30};
@@ -347,7 +347,7 @@ impl Lighting {
         let n = fit_bits(n, 30)?.map(|c| c as i32);
         Some(
             self.normal_matrix
-                .map(|row| (0..3).map(|k| row[k] as i64 * n[k] as i64).sum()),
+                .map(|row| (0..3).map(|k| mul_wide(row[k], n[k])).sum()),
         )
     }
 
@@ -359,9 +359,9 @@ impl Lighting {
         let e2 = [0, 1, 2].map(|k| d(v[0], v[2], k));
         // Coordinates within ±2^28 bits: edge components < 2^29, products < 2^58, sums < 2^59.
         let n = [
-            e1[1] * e2[2] - e1[2] * e2[1],
-            e1[2] * e2[0] - e1[0] * e2[2],
-            e1[0] * e2[1] - e1[1] * e2[0],
+            cross_diff(e1[1], e2[2], e1[2], e2[1]),
+            cross_diff(e1[2], e2[0], e1[0], e2[2]),
+            cross_diff(e1[0], e2[1], e1[1], e2[0]),
         ];
         self.cross_product::<N>(n)
     }
@@ -386,6 +386,16 @@ impl Lighting {
             }
             None => self.ambient,
         }
+    }
+}
+
+/// `a·b − c·d` as the `i64` expression gives it: in [`mul_wide`]s when every factor fits
+/// `i32` (a face of a validated mesh: edge components below 2^29).
+#[inline]
+fn cross_diff(a: i64, b: i64, c: i64, d: i64) -> i64 {
+    match [a, b, c, d].map(i32::try_from) {
+        [Ok(a), Ok(b), Ok(c), Ok(d)] => mul_wide(a, b) - mul_wide(c, d),
+        _ => a * b - c * d,
     }
 }
 
