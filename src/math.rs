@@ -152,6 +152,33 @@ pub(crate) fn cosine_i64(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
     Some(if dot < 0 { -q } else { q })
 }
 
+/// Bounds `(lo, hi)` on `cosine_i64(v, unit).max(0)` (the Lambert term), without its
+/// 64-bit square root and division: `None` for the zero vector, `(0, 0)` when the dot
+/// product is not positive (the cosine is then at most 0), else an interval about `2^-14` of
+/// the cosine wide. Lighting uses it to skip the exact cosine when both ends give one colour.
+///
+/// Why the bounds hold, with `s` the 30-bit vector, `S = |s|² >= 2^58`, `R = ⌊√S⌋`, the dot
+/// product `D` in `(0, 2^61)` and the exact result `q = ⌊D / R⌋`: for `S' = ⌊S / 2^30⌋`
+/// (at least 2^28, below 2^32) and `r = ⌊√S'⌋` (at least 2^14), `r·2^15 <= R < (r+1)·2^15`.
+/// With `Dh = ⌊D / 2^29⌋` (below 2^32) and `A = ⌊Dh / r⌋`: `q < (Dh+1)·2^14 / r <
+/// (A + 1)·2^14 + 2^14 / r`, so `q <= (A+1)·2^14`; and `q >= ⌊Dh·2^14 / (r+1)⌋`, where
+/// `Dh·2^14 / (r+1) = (Dh / r)·2^14 − (Dh / r)·2^14 / (r+1) > A·2^14 − (A+1)`.
+/// Test `lambert_bounds_hold`.
+pub(crate) fn lambert_bounds_i64(v: [i64; 3], unit: [i32; 3]) -> Option<(i32, i32)> {
+    let s = fit_bits(v, 30)?.map(|c| c as i32);
+    let dot: i64 = (0..3).map(|k| mul_wide(s[k], unit[k])).sum();
+    if dot <= 0 {
+        return Some((0, 0));
+    }
+    let square: u64 = s.iter().map(|&c| mul_wide(c, c) as u64).sum();
+    // S < 3·2^60, so S' < 3·2^30; r >= 2^14 (S >= 2^58).
+    let r = isqrt32((square >> 30) as u32).max(1);
+    let a = ((dot >> 29) as u32 / r) as i64;
+    let lo = ((a << 14) - a - 1).max(0);
+    let hi = (a + 1) << 14;
+    Some((lo.min(i32::MAX as i64) as i32, hi.min(i32::MAX as i64) as i32))
+}
+
 /// `n.div_euclid(d)` (the floor of `n / d`) for `d >= 1` (`d < 1` is taken as 1), through
 /// [`div_rem_u64_u32`] when `d` fits 32 bits.
 #[inline]
@@ -391,6 +418,11 @@ pub trait NormalPrecision:
     /// Cosine between `v` (any non-zero scale) and the unit vector `unit` (I2F30 bits), in
     /// I2F30 bits; `None` for the zero vector.
     fn cosine(v: [i64; 3], unit: [i32; 3]) -> Option<i32>;
+    /// Bounds `(lo, hi)` on `cosine(v, unit).max(0)`, cheaper than it; `None` for the zero
+    /// vector.
+    fn lambert_bounds(v: [i64; 3], unit: [i32; 3]) -> Option<(i32, i32)> {
+        Self::cosine(v, unit).map(|c| (c.max(0), c.max(0)))
+    }
 }
 
 mod sealed {
@@ -412,6 +444,10 @@ impl NormalPrecision for WideNormals {
     #[inline]
     fn cosine(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
         cosine_i64(v, unit)
+    }
+    #[inline]
+    fn lambert_bounds(v: [i64; 3], unit: [i32; 3]) -> Option<(i32, i32)> {
+        lambert_bounds_i64(v, unit)
     }
 }
 
@@ -636,6 +672,31 @@ mod tests {
             });
             assert_eq!(cosine_i64(v, unit), want, "{v:?}");
         }
+    }
+
+    #[test]
+    fn lambert_bounds_hold() {
+        let dirs = [[0.3, -0.5, 0.8], [1.0, 0.0, 0.0], [-0.2, -0.9, -0.1], [0.0, 0.0, 1.0]];
+        let mut widest = 0;
+        for (i, v) in vectors(400_000).enumerate() {
+            let (unit, _) = exact(v, dirs[i % 4]);
+            // Near the light too: v close to the unit vector, where the cosine is near 1.
+            let near = [0, 1, 2].map(|k| ((unit[k] as i64) << (i % 30)) ^ (v[k] & 0xFFF));
+            for v in [v, near] {
+                let want = cosine_i64(v, unit).map(|c| c.max(0));
+                let got = lambert_bounds_i64(v, unit);
+                match (want, got) {
+                    (Some(q), Some((lo, hi))) => {
+                        assert!(lo <= q && q <= hi, "{v:?}: {q} not in {lo}..={hi}");
+                        widest = widest.max(hi - lo);
+                    }
+                    (None, None) => {}
+                    _ => panic!("{v:?}: {want:?} {got:?}"),
+                }
+            }
+        }
+        // About 2^-14 of the largest cosine (2^30), as documented.
+        assert!(widest <= 5 << 16, "{widest}");
     }
 
     #[test]

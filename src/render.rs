@@ -471,7 +471,8 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         let verts = self.instance.mesh.vertices();
         let zero = [I16F16::ZERO; 3];
         let v = idx.map(|i| internal(verts.get(i as usize), &zero));
-        shade(self.vertex_colors(tri, idx)[0], self.lighting.face::<N>(v))
+        self.lighting
+            .face_color::<N>(self.vertex_colors(tri, idx)[0], v)
     }
 
     /// The colour attributes of triangle `tri`'s vertices: lit per vertex for Gouraud
