@@ -176,7 +176,10 @@ pub(crate) fn lambert_bounds_i64(v: [i64; 3], unit: [i32; 3]) -> Option<(i32, i3
     let a = ((dot >> 29) as u32 / r) as i64;
     let lo = ((a << 14) - a - 1).max(0);
     let hi = (a + 1) << 14;
-    Some((lo.min(i32::MAX as i64) as i32, hi.min(i32::MAX as i64) as i32))
+    Some((
+        lo.min(i32::MAX as i64) as i32,
+        hi.min(i32::MAX as i64) as i32,
+    ))
 }
 
 /// `n.div_euclid(d)` (the floor of `n / d`) for `d >= 1` (`d < 1` is taken as 1), through
@@ -676,7 +679,12 @@ mod tests {
 
     #[test]
     fn lambert_bounds_hold() {
-        let dirs = [[0.3, -0.5, 0.8], [1.0, 0.0, 0.0], [-0.2, -0.9, -0.1], [0.0, 0.0, 1.0]];
+        let dirs = [
+            [0.3, -0.5, 0.8],
+            [1.0, 0.0, 0.0],
+            [-0.2, -0.9, -0.1],
+            [0.0, 0.0, 1.0],
+        ];
         let mut widest = 0;
         for (i, v) in vectors(400_000).enumerate() {
             let (unit, _) = exact(v, dirs[i % 4]);

@@ -675,8 +675,12 @@ mod tests {
         };
         let mut exact_needed = 0;
         for case in 0..4_000 {
-            let light = Light::new([next(1.0), next(1.0), 1.0], next(0.5) + 0.5, next(0.5) + 0.5)
-                .unwrap();
+            let light = Light::new(
+                [next(1.0), next(1.0), 1.0],
+                next(0.5) + 0.5,
+                next(0.5) + 0.5,
+            )
+            .unwrap();
             let model = Transform::rotation_y(next(3.0))
                 .then_after(&Transform::rotation_x(next(3.0)))
                 .then_after(&Transform::scale([next(2.0) + 2.5, 1.0, next(0.9) + 1.0]));
@@ -694,8 +698,8 @@ mod tests {
                     let w = l.normal_to_world(face_normal([&a, &b, &c]));
                     let bounds = w.and_then(|w| WideNormals::lambert_bounds(w, l.direction));
                     if let Some((lo, hi)) = bounds {
-                        exact_needed += (shade(base, l.intensity(lo))
-                            != shade(base, l.intensity(hi))) as u32;
+                        exact_needed +=
+                            (shade(base, l.intensity(lo)) != shade(base, l.intensity(hi))) as u32;
                     }
                 }
             }
