@@ -27,7 +27,7 @@
 //! solved in i128 once per triangle and stepped in i64 (depth) or i32 (colour).
 
 use crate::depth::Depth;
-use crate::math::{floor_div_i64, mul_i64_u16, mul_wide};
+use crate::math::{floor_div_i64, mul_i64_u16, mul_wide, NO_WIDE_MULTIPLY};
 use crate::project::ScreenVertex;
 use core::cmp::Ordering;
 use fixed::types::I16F16;
@@ -413,11 +413,17 @@ fn cross_diff_i64(a: i64, b: i64, c: i64, d: i64) -> Option<i64> {
         .then(|| mul_wide(a as i32, b as i32) - mul_wide(c as i32, d as i32))
 }
 
-/// `a·b − c·d` as the `i64` expression gives it, through [`cross_diff_i64`] (32 × 32 → 64-bit
-/// products) when every factor fits 31 bits, as screen positions' differences do.
+/// `a·b − c·d` as the `i64` expression gives it; on cores without a wide multiply through
+/// [`cross_diff_i64`] (32 × 32 → 64-bit products) when every factor fits 31 bits, as screen
+/// positions' differences do. (Elsewhere the range test costs more than it saves.)
 #[inline]
 fn cross_diff_exact(a: i64, b: i64, c: i64, d: i64) -> i64 {
-    cross_diff_i64(a, b, c, d).unwrap_or_else(|| a * b - c * d)
+    if NO_WIDE_MULTIPLY {
+        if let Some(v) = cross_diff_i64(a, b, c, d) {
+            return v;
+        }
+    }
+    a * b - c * d
 }
 
 /// [`round_div`] in 64 bits, `None` if `2·n + d` does not fit (`d >= 1`).

@@ -420,14 +420,17 @@ impl Lighting {
     }
 }
 
-/// `a·b − c·d` as the `i64` expression gives it: in [`mul_wide`]s when every factor fits
-/// `i32` (a face of a validated mesh: edge components below 2^29).
+/// `a·b − c·d` as the `i64` expression gives it; on cores without a wide multiply in
+/// [`mul_wide`]s when every factor fits `i32` (a face of a validated mesh: edge components
+/// below 2^29).
 #[inline]
 fn cross_diff(a: i64, b: i64, c: i64, d: i64) -> i64 {
-    match [a, b, c, d].map(i32::try_from) {
-        [Ok(a), Ok(b), Ok(c), Ok(d)] => mul_wide(a, b) - mul_wide(c, d),
-        _ => a * b - c * d,
+    if NO_WIDE_MULTIPLY {
+        if let [Ok(a), Ok(b), Ok(c), Ok(d)] = [a, b, c, d].map(i32::try_from) {
+            return mul_wide(a, b) - mul_wide(c, d);
+        }
     }
+    a * b - c * d
 }
 
 /// `base * intensity` per channel, rounded to nearest.
