@@ -27,7 +27,7 @@
 //! solved in i128 once per triangle and stepped in i64 (depth) or i32 (colour).
 
 use crate::depth::Depth;
-use crate::math::{floor_div_i64, mul_i64_u16, mul_wide, NO_WIDE_MULTIPLY};
+use crate::math::{floor_div_i64, mul_i64_u16, mul_wide};
 use crate::project::ScreenVertex;
 use core::cmp::Ordering;
 use fixed::types::I16F16;
@@ -141,13 +141,8 @@ impl TriangleWalk {
             o.swap(0, 1);
         }
         let [top, mid, bottom] = o;
-        let d = |p: i32, q: i32| p as i64 - q as i64;
-        let cross = cross_diff_exact(
-            d(bottom.0, top.0),
-            d(mid.1, top.1),
-            d(bottom.1, top.1),
-            d(mid.0, top.0),
-        );
+        let cross = (bottom.0 as i64 - top.0 as i64) * (mid.1 as i64 - top.1 as i64)
+            - (bottom.1 as i64 - top.1 as i64) * (mid.0 as i64 - top.0 as i64);
         let long_is_left = match cross.cmp(&0) {
             Ordering::Less => true,
             Ordering::Greater => false,
@@ -319,7 +314,7 @@ impl PlaneSolver {
         let (p0, p1, p2) = (p(&v[0]), p(&v[1]), p(&v[2]));
         let e1 = (p1.0 - p0.0, p1.1 - p0.1);
         let e2 = (p2.0 - p0.0, p2.1 - p0.1);
-        let area = cross_diff_exact(e1.0, e2.1, e2.0, e1.1);
+        let area = e1.0 * e2.1 - e2.0 * e1.1;
         if area == 0 {
             return None;
         }
@@ -411,19 +406,6 @@ fn cross_diff_i64(a: i64, b: i64, c: i64, d: i64) -> Option<i64> {
     let small = |v: i64| v.unsigned_abs() < LIMIT;
     (small(a) && small(b) && small(c) && small(d))
         .then(|| mul_wide(a as i32, b as i32) - mul_wide(c as i32, d as i32))
-}
-
-/// `a·b − c·d` as the `i64` expression gives it; on cores without a wide multiply through
-/// [`cross_diff_i64`] (32 × 32 → 64-bit products) when every factor fits 31 bits, as screen
-/// positions' differences do. (Elsewhere the range test costs more than it saves.)
-#[inline]
-fn cross_diff_exact(a: i64, b: i64, c: i64, d: i64) -> i64 {
-    if NO_WIDE_MULTIPLY {
-        if let Some(v) = cross_diff_i64(a, b, c, d) {
-            return v;
-        }
-    }
-    a * b - c * d
 }
 
 /// [`round_div`] in 64 bits, `None` if `2·n + d` does not fit (`d >= 1`).
@@ -695,8 +677,8 @@ pub fn signed_area<const S: u32>(v: &[ScreenVertex<S>; 3]) -> i64 {
 #[inline]
 pub fn signed_area_xy(v: &[(i32, i32); 3]) -> i64 {
     let [a, b, c] = *v;
-    let d = |p: i32, q: i32| p as i64 - q as i64;
-    cross_diff_exact(d(b.0, a.0), d(c.1, a.1), d(c.0, a.0), d(b.1, a.1))
+    (b.0 as i64 - a.0 as i64) * (c.1 as i64 - a.1 as i64)
+        - (c.0 as i64 - a.0 as i64) * (b.1 as i64 - a.1 as i64)
 }
 
 /// The first row a triangle's walk would cover on a `width × height` screen, or `None` when

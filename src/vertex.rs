@@ -383,6 +383,9 @@ impl Lighting {
     /// [`NormalPrecision::lambert_bounds`] agree, every term between gives that colour, the
     /// exact one included. Else (a colour step inside the bounds, a few faces in a hundred)
     /// the exact cosine decides. Test `face_color_equals_the_shaded_face`.
+    // Not inlined: in the caller its registers and the exact path's made the lean build's
+    // render stack 32 B deeper on thumbv6m (`cargo xtask lean`).
+    #[inline(never)]
     pub fn face_color<N: NormalPrecision>(&self, base: Rgb888, v: [&Vertex; 3]) -> Rgb888 {
         let Some(w) = self.normal_to_world(face_normal(v)) else {
             return shade(base, self.ambient);
@@ -425,10 +428,9 @@ impl Lighting {
 /// below 2^29).
 #[inline]
 fn cross_diff(a: i64, b: i64, c: i64, d: i64) -> i64 {
-    if NO_WIDE_MULTIPLY {
-        if let [Ok(a), Ok(b), Ok(c), Ok(d)] = [a, b, c, d].map(i32::try_from) {
-            return mul_wide(a, b) - mul_wide(c, d);
-        }
+    let fits = |v: i64| v as i32 as i64 == v;
+    if NO_WIDE_MULTIPLY && fits(a) && fits(b) && fits(c) && fits(d) {
+        return mul_wide(a as i32, b as i32) - mul_wide(c as i32, d as i32);
     }
     a * b - c * d
 }
