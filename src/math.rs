@@ -75,6 +75,61 @@ impl MathBackend for Micromath {
     }
 }
 
+/// The core has no 32 × 32 → 64-bit multiply (ARMv6-M, the Arm profile without 32-bit
+/// atomics): every `i64` product is a call to `__aeabi_lmul` (about 45 instructions with the
+/// call), so products whose operands are known to be narrow are written out in 32-bit
+/// multiplies there. Elsewhere the `i64` product is one or two instructions.
+pub(crate) const NO_WIDE_MULTIPLY: bool =
+    cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
+
+/// `a · b` as `i64`: on cores without a wide multiply ([`NO_WIDE_MULTIPLY`]) from four
+/// 32-bit multiplies of 16-bit halves, elsewhere the `i64` multiply (one instruction). The
+/// same value either way (test `narrow_products_are_exact`).
+#[inline]
+pub(crate) fn mul_wide(a: i32, b: i32) -> i64 {
+    if NO_WIDE_MULTIPLY {
+        mul_wide_in_halves(a, b)
+    } else {
+        a as i64 * b as i64
+    }
+}
+
+/// [`mul_wide`] from 32-bit multiplies, on every target (tested on the host too). With
+/// `a = ah·2^16 + al` (`ah` signed, `al` in `[0, 2^16)`) and `b` alike, `a·b = ah·bh·2^32 +
+/// (ah·bl + al·bh)·2^16 + al·bl`; each of the four products fits 32 bits.
+#[inline]
+fn mul_wide_in_halves(a: i32, b: i32) -> i64 {
+    let (ah, al) = (a >> 16, a & 0xFFFF);
+    let (bh, bl) = (b >> 16, b & 0xFFFF);
+    let cross = (ah * bl) as i64 + (al * bh) as i64;
+    let low = (al as u32 * bl as u32) as i64;
+    (((ah * bh) as i64) << 32) + (cross << 16) + low
+}
+
+/// `(a · b) mod 2^64` for `0 <= b < 2^16`, as `a.wrapping_mul(b as i64)`: on cores without a
+/// wide multiply ([`NO_WIDE_MULTIPLY`]) from three 32-bit multiplies (`a`'s low word in two
+/// 16-bit halves and its high word, each times `b`, whose products fit 32 bits), elsewhere
+/// the `i64` multiply. The same bits either way (test `narrow_products_are_exact`).
+#[inline]
+pub(crate) fn mul_i64_u16(a: i64, b: u16) -> i64 {
+    if NO_WIDE_MULTIPLY {
+        mul_i64_u16_in_words(a, b)
+    } else {
+        a.wrapping_mul(b as i64)
+    }
+}
+
+/// [`mul_i64_u16`] from 32-bit multiplies, on every target (tested on the host too).
+#[inline]
+fn mul_i64_u16_in_words(a: i64, b: u16) -> i64 {
+    let b = b as u32;
+    let (hi, lo) = ((a >> 32) as u32, a as u32);
+    // a·b = hi·b·2^32 + (lo >> 16)·b·2^16 + (lo & 0xFFFF)·b; both halves' products < 2^32.
+    let (mid, low) = ((lo >> 16) * b, (lo & 0xFFFF) * b);
+    let low_word = ((mid as u64) << 16) + low as u64;
+    low_word.wrapping_add((hi.wrapping_mul(b) as u64) << 32) as i64
+}
+
 /// Cosine of the angle between an integer vector `v` of any scale and a unit vector `unit`
 /// (I2F30 bits), in I2F30 bits truncated towards zero; `None` for the zero vector.
 ///
@@ -85,16 +140,46 @@ impl MathBackend for Micromath {
 pub(crate) fn cosine_i64(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
     // |s_i| <= 2^30: each fits `i32`, so the products below are 32 × 32 → 64 bits.
     let s = fit_bits(v, 30)?.map(|c| c as i32);
-    let len = isqrt_u64(s.iter().map(|&c| (c as i64 * c as i64) as u64).sum());
+    let len = isqrt_u64(s.iter().map(|&c| mul_wide(c, c) as u64).sum());
     if len == 0 {
         return None;
     }
     // |s_i · unit_i| < 2^60 and, by Cauchy–Schwarz, every partial sum is at most
     // |s| · |unit| < 2^61: no overflow, and the quotient is within about ±2^30.
-    let dot: i64 = (0..3).map(|k| s[k] as i64 * unit[k] as i64).sum();
+    let dot: i64 = (0..3).map(|k| mul_wide(s[k], unit[k])).sum();
     // `len <= sqrt(3) · 2^30` fits 32 bits and is non-zero here.
     let q = div_rem_u64_u32(dot.unsigned_abs(), len as u32).0 as i32;
     Some(if dot < 0 { -q } else { q })
+}
+
+/// Bounds `(lo, hi)` on `cosine_i64(v, unit).max(0)` (the Lambert term), without its
+/// 64-bit square root and division: `None` for the zero vector, `(0, 0)` when the dot
+/// product is not positive (the cosine is then at most 0), else an interval about `2^-14` of
+/// the cosine wide. Lighting uses it to skip the exact cosine when both ends give one colour.
+///
+/// Why the bounds hold, with `s` the 30-bit vector, `S = |s|² >= 2^58`, `R = ⌊√S⌋`, the dot
+/// product `D` in `(0, 2^61)` and the exact result `q = ⌊D / R⌋`: for `S' = ⌊S / 2^30⌋`
+/// (at least 2^28, below 2^32) and `r = ⌊√S'⌋` (at least 2^14), `r·2^15 <= R < (r+1)·2^15`.
+/// With `Dh = ⌊D / 2^29⌋` (below 2^32) and `A = ⌊Dh / r⌋`: `q < (Dh+1)·2^14 / r <
+/// (A + 1)·2^14 + 2^14 / r`, so `q <= (A+1)·2^14`; and `q >= ⌊Dh·2^14 / (r+1)⌋`, where
+/// `Dh·2^14 / (r+1) = (Dh / r)·2^14 − (Dh / r)·2^14 / (r+1) > A·2^14 − (A+1)`.
+/// Test `lambert_bounds_hold`.
+pub(crate) fn lambert_bounds_i64(v: [i64; 3], unit: [i32; 3]) -> Option<(i32, i32)> {
+    let s = fit_bits(v, 30)?.map(|c| c as i32);
+    let dot: i64 = (0..3).map(|k| mul_wide(s[k], unit[k])).sum();
+    if dot <= 0 {
+        return Some((0, 0));
+    }
+    let square: u64 = s.iter().map(|&c| mul_wide(c, c) as u64).sum();
+    // S < 3·2^60, so S' < 3·2^30; r >= 2^14 (S >= 2^58).
+    let r = isqrt32((square >> 30) as u32).max(1);
+    let a = ((dot >> 29) as u32 / r) as i64;
+    let lo = ((a << 14) - a - 1).max(0);
+    let hi = (a + 1) << 14;
+    Some((
+        lo.min(i32::MAX as i64) as i32,
+        hi.min(i32::MAX as i64) as i32,
+    ))
 }
 
 /// `n.div_euclid(d)` (the floor of `n / d`) for `d >= 1` (`d < 1` is taken as 1), through
@@ -336,6 +421,11 @@ pub trait NormalPrecision:
     /// Cosine between `v` (any non-zero scale) and the unit vector `unit` (I2F30 bits), in
     /// I2F30 bits; `None` for the zero vector.
     fn cosine(v: [i64; 3], unit: [i32; 3]) -> Option<i32>;
+    /// Bounds `(lo, hi)` on `cosine(v, unit).max(0)`, cheaper than it; `None` for the zero
+    /// vector.
+    fn lambert_bounds(v: [i64; 3], unit: [i32; 3]) -> Option<(i32, i32)> {
+        Self::cosine(v, unit).map(|c| (c.max(0), c.max(0)))
+    }
 }
 
 mod sealed {
@@ -357,6 +447,10 @@ impl NormalPrecision for WideNormals {
     #[inline]
     fn cosine(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
         cosine_i64(v, unit)
+    }
+    #[inline]
+    fn lambert_bounds(v: [i64; 3], unit: [i32; 3]) -> Option<(i32, i32)> {
+        lambert_bounds_i64(v, unit)
     }
 }
 
@@ -408,6 +502,34 @@ mod tests {
                     r * r <= v as u64 && (r + 1) * (r + 1) > v as u64,
                     "{name} {v}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn narrow_products_are_exact() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let edges = [0i64, 1, -1, i64::MAX, i64::MIN, u32::MAX as i64, -(1 << 32)];
+        assert_eq!(mul_wide_in_halves(i32::MIN, i32::MIN), 1 << 62);
+        for k in 0..400_000u64 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let a = match k % 4 {
+                0 => x as i64,
+                1 => (x as i64) >> (x % 64),
+                _ => edges[(k / 4 % 7) as usize].wrapping_add((x >> 60) as i64 - 8),
+            };
+            let (c, d) = ((x >> 32) as i32, (a as i32) >> (x % 32));
+            for (c, d) in [(c, d), (c, i32::MIN), (i32::MIN, d), (i32::MAX, d), (c, -1)] {
+                let want = c as i64 * d as i64;
+                assert_eq!(mul_wide_in_halves(c, d), want, "{c} * {d}");
+                assert_eq!(mul_wide(c, d), want, "{c} * {d}");
+            }
+            for b in [(x >> 48) as u16, 0, 1, u16::MAX, (x >> 20) as u16 & 0x7FF] {
+                let want = a.wrapping_mul(b as i64);
+                assert_eq!(mul_i64_u16_in_words(a, b), want, "{a} * {b}");
+                assert_eq!(mul_i64_u16(a, b), want, "{a} * {b}");
             }
         }
     }
@@ -553,6 +675,36 @@ mod tests {
             });
             assert_eq!(cosine_i64(v, unit), want, "{v:?}");
         }
+    }
+
+    #[test]
+    fn lambert_bounds_hold() {
+        let dirs = [
+            [0.3, -0.5, 0.8],
+            [1.0, 0.0, 0.0],
+            [-0.2, -0.9, -0.1],
+            [0.0, 0.0, 1.0],
+        ];
+        let mut widest = 0;
+        for (i, v) in vectors(400_000).enumerate() {
+            let (unit, _) = exact(v, dirs[i % 4]);
+            // Near the light too: v close to the unit vector, where the cosine is near 1.
+            let near = [0, 1, 2].map(|k| ((unit[k] as i64) << (i % 30)) ^ (v[k] & 0xFFF));
+            for v in [v, near] {
+                let want = cosine_i64(v, unit).map(|c| c.max(0));
+                let got = lambert_bounds_i64(v, unit);
+                match (want, got) {
+                    (Some(q), Some((lo, hi))) => {
+                        assert!(lo <= q && q <= hi, "{v:?}: {q} not in {lo}..={hi}");
+                        widest = widest.max(hi - lo);
+                    }
+                    (None, None) => {}
+                    _ => panic!("{v:?}: {want:?} {got:?}"),
+                }
+            }
+        }
+        // About 2^-14 of the largest cosine (2^30), as documented.
+        assert!(widest <= 5 << 16, "{widest}");
     }
 
     #[test]

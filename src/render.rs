@@ -471,7 +471,8 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         let verts = self.instance.mesh.vertices();
         let zero = [I16F16::ZERO; 3];
         let v = idx.map(|i| internal(verts.get(i as usize), &zero));
-        shade(self.vertex_colors(tri, idx)[0], self.lighting.face::<N>(v))
+        self.lighting
+            .face_color::<N>(self.vertex_colors(tri, idx)[0], v)
     }
 
     /// The colour attributes of triangle `tri`'s vertices: lit per vertex for Gouraud
@@ -1023,7 +1024,7 @@ pub(crate) fn walk_rows<
             if band == 1 {
                 stats.peak_active = stats.peak_active.max(active.live as u16);
                 active.retain(|t, order| {
-                    walk_band::<P, S, SUB, R>(t, order, y + 1, width, resolve, stats)
+                    walk_row::<P, S, SUB, R>(t, order, y, width, resolve, stats)
                 });
             }
         }
@@ -1082,6 +1083,31 @@ fn walk_band<P: RowPixel, S: Shading, const SUB: u32, R: Resolve<P, S>>(
             return false;
         }
     }
+}
+
+/// [`walk_band`] for a band of the one row `y`, which every live triangle has reached: its
+/// span there, if it is on the row, and one step, with one row test instead of the band
+/// loop's two. Returns whether the triangle continues below `y`.
+#[inline(always)]
+fn walk_row<P: RowPixel, S: Shading, const SUB: u32, R: Resolve<P, S>>(
+    t: &mut ActiveTri<S::Payload<P>, R::Key>,
+    order: usize,
+    y: i32,
+    width: i32,
+    resolve: &mut R,
+    stats: &mut FrameStats,
+) -> bool {
+    let row = t.walk.row();
+    if row > y {
+        return true; // (a clipped piece may start below the row)
+    }
+    let (l, r) = t.walk.span();
+    let (l, r) = (l.max(0), r.min(width));
+    if l < r {
+        stats.fragments += (r - l) as u32;
+        stats.pixels_written += resolve.span(t, order, row, l, r);
+    }
+    t.advance::<SUB>()
 }
 
 /// Transforms, clips, projects and culls every triangle of `scene` (lit per vertex if `S`

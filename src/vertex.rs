@@ -13,7 +13,7 @@
 //!
 //! [`MAX_MODEL_COORD`]: crate::scene::MAX_MODEL_COORD
 
-use crate::math::{fit_bits, NormalPrecision};
+use crate::math::{fit_bits, mul_wide, NormalPrecision, NO_WIDE_MULTIPLY};
 use crate::scene::{Light, Transform, Vertex};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::{I16F16, I2F30};
@@ -170,6 +170,9 @@ impl ModelView {
     /// Transforms a model vertex (validated mesh, so inside the proven envelope).
     #[inline]
     pub fn apply(&self, v: &Vertex) -> EyePoint {
+        if NO_WIDE_MULTIPLY {
+            return self.apply_in_words(v);
+        }
         let row = |r: usize| {
             let sum = self.m[r][0].to_bits() as i64 * v[0].to_bits() as i64
                 + self.m[r][1].to_bits() as i64 * v[1].to_bits() as i64
@@ -177,6 +180,42 @@ impl ModelView {
                 + ((self.t[r].to_bits() as i64) << 16);
             // I32F32 -> I16F16, rounding to nearest; the envelope proof bounds the result.
             I16F16::from_bits(((sum + (1 << 15)) >> 16) as i32)
+        };
+        EyePoint {
+            x: row(0),
+            y: row(1),
+            w: row(2),
+        }
+    }
+}
+
+impl ModelView {
+    /// [`ModelView::apply`] from 32-bit multiplies, the same bits (test
+    /// `transform_in_words_equals_the_64_bit_one`). With `v = vh·2^16 + vl` and
+    /// `m = mh·2^16 + ml` (`vl`, `ml` the unsigned low halves), `m·v = (m·vh + mh·vl)·2^16 +
+    /// ml·vl`, so the rounded row `⌊(Σ m·v + t·2^16 + 2^15) / 2^16⌋` is
+    /// `Σ (m·vh + mh·vl) + t` plus the carry of the low products `⌊(Σ ml·vl + 2^15) / 2^16⌋`,
+    /// taken from their halves so nothing exceeds 32 bits. The high part is summed modulo
+    /// 2^32 (wrapping): the row's low 32 bits, as the 64-bit path's `as i32` keeps them.
+    #[inline]
+    fn apply_in_words(&self, v: &Vertex) -> EyePoint {
+        let v = v.map(|c| c.to_bits());
+        let row = |r: usize| {
+            let mut high = self.t[r].to_bits();
+            let (mut carry_high, mut carry_low) = (0u32, 1u32 << 15);
+            for (m, &v) in self.m[r].iter().zip(&v) {
+                let m = m.to_bits();
+                let (vh, vl) = (v >> 16, v as u32 & 0xFFFF);
+                let (mh, ml) = (m >> 16, m as u32 & 0xFFFF);
+                high = high
+                    .wrapping_add(m.wrapping_mul(vh))
+                    .wrapping_add(mh.wrapping_mul(vl as i32));
+                // ml·vl < 2^32; the three halves' sums stay below 2^18.
+                let low = ml * vl;
+                carry_high += low >> 16;
+                carry_low += low & 0xFFFF;
+            }
+            I16F16::from_bits(high.wrapping_add((carry_high + (carry_low >> 16)) as i32))
         };
         EyePoint {
             x: row(0),
@@ -294,9 +333,13 @@ impl Lighting {
 
     /// Intensity of a world-space normal `n` (any non-zero scale).
     fn intensity_of_world_normal<N: NormalPrecision>(&self, n: [i64; 3]) -> I2F30 {
-        let lambert = N::cosine(n, self.direction).unwrap_or(0).max(0);
-        let i = self.ambient.to_bits() as i64
-            + ((self.diffuse.to_bits() as i64 * lambert as i64) >> 30);
+        self.intensity(N::cosine(n, self.direction).unwrap_or(0).max(0))
+    }
+
+    /// Intensity for the Lambert term `lambert` (I2F30 bits, at least 0): non-decreasing in it.
+    #[inline]
+    fn intensity(&self, lambert: i32) -> I2F30 {
+        let i = self.ambient.to_bits() as i64 + (mul_wide(self.diffuse.to_bits(), lambert) >> 30);
         I2F30::from_bits(i.clamp(0, 1 << 30) as i32)
     }
 
@@ -308,23 +351,53 @@ impl Lighting {
         let n = fit_bits(n, 30)?.map(|c| c as i32);
         Some(
             self.normal_matrix
-                .map(|row| (0..3).map(|k| row[k] as i64 * n[k] as i64).sum()),
+                .map(|row| (0..3).map(|k| mul_wide(row[k], n[k])).sum()),
         )
     }
 
     /// Intensity of a face with model-space vertices `v` (counter-clockwise = front), with
     /// the cosine taken at precision `N`.
     pub fn face<N: NormalPrecision>(&self, v: [&Vertex; 3]) -> I2F30 {
-        let d = |a: &Vertex, b: &Vertex, k: usize| b[k].to_bits() as i64 - a[k].to_bits() as i64;
-        let e1 = [0, 1, 2].map(|k| d(v[0], v[1], k));
-        let e2 = [0, 1, 2].map(|k| d(v[0], v[2], k));
-        // Coordinates within ±2^28 bits: edge components < 2^29, products < 2^58, sums < 2^59.
-        let n = [
-            e1[1] * e2[2] - e1[2] * e2[1],
-            e1[2] * e2[0] - e1[0] * e2[2],
-            e1[0] * e2[1] - e1[1] * e2[0],
-        ];
-        self.cross_product::<N>(n)
+        self.cross_product::<N>(face_normal(v))
+    }
+}
+
+/// The model-space normal of a face with vertices `v` (counter-clockwise = front), not
+/// normalized: the cross product of two edges.
+#[inline]
+fn face_normal(v: [&Vertex; 3]) -> [i64; 3] {
+    let d = |a: &Vertex, b: &Vertex, k: usize| b[k].to_bits() as i64 - a[k].to_bits() as i64;
+    let e1 = [0, 1, 2].map(|k| d(v[0], v[1], k));
+    let e2 = [0, 1, 2].map(|k| d(v[0], v[2], k));
+    // Coordinates within ±2^28 bits: edge components < 2^29, products < 2^58, sums < 2^59.
+    [
+        cross_diff(e1[1], e2[2], e1[2], e2[1]),
+        cross_diff(e1[2], e2[0], e1[0], e2[2]),
+        cross_diff(e1[0], e2[1], e1[1], e2[0]),
+    ]
+}
+
+impl Lighting {
+    /// `shade(base, self.face::<N>(v))`, mostly without the exact cosine: each channel is a
+    /// non-decreasing function of the Lambert term, so where the colours at both ends of
+    /// [`NormalPrecision::lambert_bounds`] agree, every term between gives that colour, the
+    /// exact one included. Else (a colour step inside the bounds, a few faces in a hundred)
+    /// the exact cosine decides. Test `face_color_equals_the_shaded_face`.
+    // Not inlined: in its caller it made the lean minimal build's render stack on thumbv6m
+    // 1,264 B instead of 1,192 B, over the 4 KiB RAM budget with the workspace.
+    #[inline(never)]
+    pub fn face_color<N: NormalPrecision>(&self, base: Rgb888, v: [&Vertex; 3]) -> Rgb888 {
+        let Some(w) = self.normal_to_world(face_normal(v)) else {
+            return shade(base, self.ambient);
+        };
+        let Some((lo, hi)) = N::lambert_bounds(w, self.direction) else {
+            return shade(base, self.intensity(0)); // (the exact cosine's zero vector)
+        };
+        let low = shade(base, self.intensity(lo));
+        if lo == hi || shade(base, self.intensity(hi)) == low {
+            return low;
+        }
+        shade(base, self.intensity_of_world_normal::<N>(w))
     }
 
     /// Intensity of a surface whose model-space normal is the cross product `n` of two model
@@ -350,10 +423,39 @@ impl Lighting {
     }
 }
 
+/// `a·b − c·d` as the `i64` expression gives it; on cores without a wide multiply in
+/// [`mul_wide`]s when every factor fits `i32` (a face of a validated mesh: edge components
+/// below 2^29).
+#[inline]
+fn cross_diff(a: i64, b: i64, c: i64, d: i64) -> i64 {
+    let fits = |v: i64| v as i32 as i64 == v;
+    if NO_WIDE_MULTIPLY && fits(a) && fits(b) && fits(c) && fits(d) {
+        return mul_wide(a as i32, b as i32) - mul_wide(c as i32, d as i32);
+    }
+    a * b - c * d
+}
+
 /// `base * intensity` per channel, rounded to nearest.
 pub fn shade(base: Rgb888, intensity: I2F30) -> Rgb888 {
-    let i = intensity.to_bits() as i64;
+    let bits = intensity.to_bits();
+    if NO_WIDE_MULTIPLY && (0..=1 << 30).contains(&bits) {
+        return shade_in_words(base, bits as u32);
+    }
+    let i = bits as i64;
     let ch = |c: u8| (((c as i64 * i) + (1 << 29)) >> 30).clamp(0, 255) as u8;
+    Rgb888::new(ch(base.r()), ch(base.g()), ch(base.b()))
+}
+
+/// [`shade`] for an intensity `i` in `[0, 2^30]` in 32-bit multiplies, the same channels:
+/// with `i = ih·2^8 + il`, `⌊(c·i + 2^29) / 2^30⌋ = ⌊(c·ih + ⌊(c·il + 2^29) / 2^8⌋) / 2^22⌋`,
+/// whose sum stays below 2^31 for `c <= 255`.
+#[inline]
+fn shade_in_words(base: Rgb888, i: u32) -> Rgb888 {
+    let (ih, il) = (i >> 8, i & 0xFF);
+    let ch = |c: u8| {
+        let c = c as u32;
+        ((c * ih + ((c * il + (1 << 29)) >> 8)) >> 22).min(255) as u8
+    };
     Rgb888::new(ch(base.r()), ch(base.g()), ch(base.b()))
 }
 
@@ -409,6 +511,43 @@ mod tests {
         assert!((e.x.to_num::<f32>() - f[0]).abs() < 1e-3);
         assert!((e.y.to_num::<f32>() - f[1]).abs() < 1e-3);
         assert!((e.w.to_num::<f32>() + f[2]).abs() < 1e-3);
+    }
+
+    #[test]
+    fn transform_in_words_equals_the_64_bit_one() {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |bits: u32| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x as i64 >> (64 - bits)) as i32
+        };
+        for case in 0..200_000 {
+            // Matrix entries and vertices of every size, up to the model envelope (2^28 bits)
+            // and full I16F16 entries, so products near 2^59 and rows of any sign are tried.
+            let mb = 1 + (case % 32) as u32;
+            let vb = 1 + (case / 32 % 29) as u32;
+            let mv = ModelView {
+                m: [(); 3].map(|_| [(); 3].map(|_| I16F16::from_bits(next(mb)))),
+                t: [(); 3].map(|_| I16F16::from_bits(next(32))),
+            };
+            let p = [(); 3].map(|_| I16F16::from_bits(next(vb)));
+            let want = [0, 1, 2].map(|r| {
+                let sum: i128 = (0..3)
+                    .map(|k| mv.m[r][k].to_bits() as i128 * p[k].to_bits() as i128)
+                    .sum::<i128>()
+                    + ((mv.t[r].to_bits() as i128) << 16);
+                ((sum + (1 << 15)) >> 16) as i32
+            });
+            let got = mv.apply_in_words(&p);
+            assert_eq!(
+                [got.x, got.y, got.w].map(|c| c.to_bits()),
+                want,
+                "case {case}"
+            );
+            let wide = mv.apply(&p);
+            assert_eq!((wide.x, wide.y, wide.w), (got.x, got.y, got.w));
+        }
     }
 
     #[test]
@@ -501,6 +640,77 @@ mod tests {
         assert_eq!(m.face::<W>([&a, &b, &c]), I2F30::from_bits(1 << 30));
         assert_eq!(m.vertex::<W>(&v(0.0, 0.0, 1.0)), I2F30::from_num(0.25));
         assert_eq!(m.vertex::<W>(&v(0.0, 0.0, -3.0)), I2F30::from_bits(1 << 30));
+    }
+
+    #[test]
+    fn shade_in_words_equals_shade() {
+        let wide = |c: u8, i: u32| (((c as i64 * i as i64) + (1 << 29)) >> 30).clamp(0, 255);
+        let mut x = 0x2545_f491u32;
+        for step in 0..400_000u32 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            // Every intensity near each channel's rounding points, and random ones.
+            let i = match step % 2 {
+                0 => x % ((1 << 30) + 1),
+                _ => (((x % 256) << 30) / 255 + (x >> 28)).min(1 << 30),
+            };
+            let base = Rgb888::new(x as u8, (x >> 8) as u8, (step % 256) as u8);
+            let got = shade_in_words(base, i);
+            let want = [base.r(), base.g(), base.b()].map(|c| wide(c, i) as u8);
+            assert_eq!([got.r(), got.g(), got.b()], want, "{base:?} {i}");
+        }
+        for c in [0u8, 1, 127, 128, 254, 255] {
+            for i in [0u32, 1, 1 << 29, (1 << 30) - 1, 1 << 30] {
+                let got = shade_in_words(Rgb888::new(c, c, c), i);
+                assert_eq!(got.r() as i64, wide(c, i), "{c} {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn face_color_equals_the_shaded_face() {
+        use crate::math::{NarrowNormals, WideNormals};
+        let mut x = 0x9e37_79b9u32;
+        let mut next = |range: f32| {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            (x as f32 / u32::MAX as f32 * 2.0 - 1.0) * range
+        };
+        let mut exact_needed = 0;
+        for case in 0..4_000 {
+            let light = Light::new(
+                [next(1.0), next(1.0), 1.0],
+                next(0.5) + 0.5,
+                next(0.5) + 0.5,
+            )
+            .unwrap();
+            let model = Transform::rotation_y(next(3.0))
+                .then_after(&Transform::rotation_x(next(3.0)))
+                .then_after(&Transform::scale([next(2.0) + 2.5, 1.0, next(0.9) + 1.0]));
+            let l = Lighting::new(&light, &model);
+            for _ in 0..25 {
+                let size = [1.0f32, 0.01, 100.0, 2000.0][case % 4];
+                let [a, b, c] = [(); 3].map(|_| v(next(size), next(size), next(size)));
+                let c2 = v(a[0].to_num::<f32>() + 1e-3, a[1].to_num(), a[2].to_num());
+                for [a, b, c] in [[a, b, c], [a, b, c2]] {
+                    let base = Rgb888::new(next(128.0) as u8 + 127, 255, case as u8);
+                    let want = shade(base, l.face::<WideNormals>([&a, &b, &c]));
+                    assert_eq!(l.face_color::<WideNormals>(base, [&a, &b, &c]), want);
+                    let narrow = shade(base, l.face::<NarrowNormals>([&a, &b, &c]));
+                    assert_eq!(l.face_color::<NarrowNormals>(base, [&a, &b, &c]), narrow);
+                    let w = l.normal_to_world(face_normal([&a, &b, &c]));
+                    let bounds = w.and_then(|w| WideNormals::lambert_bounds(w, l.direction));
+                    if let Some((lo, hi)) = bounds {
+                        exact_needed +=
+                            (shade(base, l.intensity(lo)) != shade(base, l.intensity(hi))) as u32;
+                    }
+                }
+            }
+        }
+        // The bounds decide almost every face (a few in a hundred need the exact cosine).
+        assert!(exact_needed < 200_000 / 20, "{exact_needed}");
     }
 
     #[test]
