@@ -671,10 +671,9 @@ mod tests {
         assert_eq!(tracer.screen_bounds(&mut small), (1, false));
     }
 
-    #[test]
-    fn a_rows_hits_on_a_polygon_lie_in_its_row_box() {
+    /// Runs `check` on the classic's floor (one polygon) seen from its camera at 48 × 48.
+    fn with_classic_floor(check: impl FnOnce(&Object<'_>, &Tracer<'_, '_, 4>, &TraceCamera)) {
         use crate::trace::shape::Polygon;
-        // The classic's floor, seen from its camera at 48 × 48.
         let floor = [
             v(-4.0, 0.0, -4.0),
             v(-4.0, 0.0, 4.0),
@@ -700,90 +699,70 @@ mod tests {
         )
         .unwrap();
         let tracer = Tracer::<4>::new(&scene, &camera, TraceOptions::default());
-        let (lo, hi) = padded_box(&objects[0]).unwrap();
-        let (mut hits, mut clipped) = (0, 0);
-        for y in 0..48u16 {
-            let row = tracer.row_box(&objects[0], y).unwrap();
-            if row.is_some_and(|(a, b)| b[2] - a[2] < (hi[2] - lo[2]) / 4) {
-                clipped += 1;
-            }
-            for x in 0..48u16 {
-                let (dir, _) = camera
-                    .pixel_direction(x, y)
-                    .normalized_with_length()
-                    .unwrap();
-                let ray = crate::trace::Ray {
-                    origin: camera.eye,
-                    dir,
-                };
-                if let Some(t) = objects[0].shape.hit(&ray, I16F16::ZERO, I16F16::MAX) {
-                    let p = ray.origin.along(dir, t).bits();
-                    let (a, b) = row.expect("a row with a hit has a box");
-                    assert!((0..3).all(|i| a[i] <= p[i] && p[i] <= b[i]), "{x} {y}");
-                    hits += 1;
+        check(&objects[0], &tracer, &camera);
+    }
+
+    #[test]
+    fn a_rows_hits_on_a_polygon_lie_in_its_row_box() {
+        with_classic_floor(|floor, tracer, camera| {
+            let (lo, hi) = padded_box(floor).unwrap();
+            let (mut hits, mut clipped) = (0, 0);
+            for y in 0..48u16 {
+                let row = tracer.row_box(floor, y).unwrap();
+                if row.is_some_and(|(a, b)| b[2] - a[2] < (hi[2] - lo[2]) / 4) {
+                    clipped += 1;
+                }
+                for x in 0..48u16 {
+                    let (dir, _) = camera
+                        .pixel_direction(x, y)
+                        .normalized_with_length()
+                        .unwrap();
+                    let ray = crate::trace::Ray {
+                        origin: camera.eye,
+                        dir,
+                    };
+                    if let Some(t) = floor.shape.hit(&ray, I16F16::ZERO, I16F16::MAX) {
+                        let p = ray.origin.along(dir, t).bits();
+                        let (a, b) = row.expect("a row with a hit has a box");
+                        assert!((0..3).all(|i| a[i] <= p[i] && p[i] <= b[i]), "{x} {y}");
+                        hits += 1;
+                    }
                 }
             }
-        }
-        // The floor fills the lower rows, each of which sees a narrow band of it.
-        assert!(hits > 500 && clipped > 20, "{hits} {clipped}");
+            // The floor fills the lower rows, each of which sees a narrow band of it.
+            assert!(hits > 500 && clipped > 20, "{hits} {clipped}");
+        });
     }
 
     #[test]
     fn known_inside_columns_pass_the_outline_test() {
-        use crate::trace::shape::Polygon;
-        // The classic's floor, seen from its camera at 48 × 48.
-        let floor = [
-            v(-4.0, 0.0, -4.0),
-            v(-4.0, 0.0, 4.0),
-            v(4.0, 0.0, 4.0),
-            v(4.0, 0.0, -4.0),
-        ];
-        let objects = [Object {
-            shape: Shape::Polygon(Polygon::new(&floor).unwrap()),
-            material: 0,
-        }];
-        let grey = Colour::new([I16F16::from_num(0.5); 3]).unwrap();
-        let materials = [Material::new(grey, [I16F16::ONE; 4], I16F16::ONE).unwrap()];
-        let scene = Scene::new(&objects, &materials, &[], Colour::BLACK, I16F16::ZERO).unwrap();
-        let camera = TraceCamera::new(
-            [0.0, 3.0, 7.0],
-            [0.0, 0.8, 0.0],
-            [0.0, 1.0, 0.0],
-            50.0,
-            0.1,
-            100.0,
-            48,
-            48,
-        )
-        .unwrap();
-        let tracer = Tracer::<4>::new(&scene, &camera, TraceOptions::default());
-        let t_min = I16F16::from_bits(1);
-        let (mut known, mut hits) = (0, 0);
-        for y in 0..48u16 {
-            let columns = tracer.inside_columns(&objects[0], y);
-            for x in 0..48u16 {
-                let (dir, _) = camera
-                    .pixel_direction(x, y)
-                    .normalized_with_length()
-                    .unwrap();
-                let ray = crate::trace::Ray {
-                    origin: camera.eye,
-                    dir,
-                };
-                let full = objects[0].shape.hit(&ray, t_min, I16F16::MAX);
-                hits += usize::from(full.is_some());
-                if columns.is_some_and(|(first, last)| (first..=last).contains(&x)) {
-                    // The plane's t alone is the full test's answer there.
-                    let plane = objects[0]
-                        .shape
-                        .hit_inside_outline(&ray, t_min, I16F16::MAX);
-                    assert!(full.is_some() && plane == full, "{x} {y}");
-                    known += 1;
+        with_classic_floor(|floor, tracer, camera| {
+            let t_min = I16F16::from_bits(1);
+            let (mut known, mut hits) = (0, 0);
+            for y in 0..48u16 {
+                let columns = tracer.inside_columns(floor, y);
+                for x in 0..48u16 {
+                    let (dir, _) = camera
+                        .pixel_direction(x, y)
+                        .normalized_with_length()
+                        .unwrap();
+                    let ray = crate::trace::Ray {
+                        origin: camera.eye,
+                        dir,
+                    };
+                    let full = floor.shape.hit(&ray, t_min, I16F16::MAX);
+                    hits += usize::from(full.is_some());
+                    if columns.is_some_and(|(first, last)| (first..=last).contains(&x)) {
+                        // The plane's t alone is the full test's answer there.
+                        let plane = floor.shape.hit_inside_outline(&ray, t_min, I16F16::MAX);
+                        assert!(full.is_some() && plane == full, "{x} {y}");
+                        known += 1;
+                    }
                 }
             }
-        }
-        // Most of the floor's pixels skip the outline test.
-        assert!(known * 2 > hits && hits > 500, "{known} of {hits}");
+            // Most of the floor's pixels skip the outline test.
+            assert!(known * 2 > hits && hits > 500, "{known} of {hits}");
+        });
     }
 
     #[test]
