@@ -12,6 +12,7 @@
 //! below one I16F16 step) and is checked: a value outside the I16F16 range is an error, never a
 //! wrapped number.
 
+use crate::math::div_rem_below;
 pub use crate::math::{isqrt32, isqrt32_bitwise, isqrt32_newton};
 use fixed::types::{I16F16, I32F32};
 
@@ -131,6 +132,14 @@ impl Vec3 {
         self.normalized_with_length().map(|(unit, _)| unit)
     }
 
+    /// Whether [`normalized`](Self::normalized) gives a unit vector: its length's [`sqrt`] is
+    /// at least 2^-8 exactly when `self · self` is at least 2^-16 (2^16 raw I32F32 bits; below
+    /// 2^32 raw the root is exact), without the root.
+    #[inline]
+    pub const fn normalizable(self) -> bool {
+        self.dot_bits(self) >= 1 << 16
+    }
+
     /// The unit vector along `self` and the length it was divided by ([`sqrt`] of `self ·
     /// self`), or `None` for a vector shorter than 2^-8: one square root for both.
     #[inline]
@@ -144,13 +153,15 @@ impl Vec3 {
 /// I16F16 range.
 #[inline]
 pub const fn narrow_bits(v: i64) -> i32 {
-    let s = v >> 16;
-    if s > i32::MAX as i64 {
-        i32::MAX
-    } else if s < i32::MIN as i64 {
+    // `v >> 16` fits an i32 exactly when bits 47 to 63 of `v` are all equal: tested on the
+    // high word alone, cheaper on a 32-bit core than two 64-bit comparisons.
+    let high = (v >> 32) as i32;
+    if high >> 15 == high >> 31 {
+        (v >> 16) as i32
+    } else if high < 0 {
         i32::MIN
     } else {
-        s as i32
+        i32::MAX
     }
 }
 
@@ -221,13 +232,19 @@ fn normalize_by(v: [i32; 3], len: i32) -> Option<[i32; 3]> {
 }
 
 /// ⌊2^46 / `len`⌋ (1/length in 30 fraction bits for a raw I16F16 length) for `len` in
-/// [2^8, 2^31), without a 64-bit division: `len` shifted to L in [2^30, 2^31), then
-/// [`reciprocal62`] scaled back by the shift. Exact for `len` ≥ 2^14 (a length of at least
-/// 1/4); below, the low `k − 17` bits of 2^(45 + k) / L are zero, a relative error below 2^-25
-/// (tested), far under the square root's 2^-15.
+/// [2^8, 2^31), without a 64-bit division. Above 2^14 (a length over 1/4, every direction the
+/// tracer normalises but the shortest) it is the exact quotient from two 16-bit digits of 32-bit
+/// divisions ([`div_rem_below`]: about half the instructions of [`reciprocal62`]'s Newton
+/// steps). Below, `len` shifted to L in [2^30, 2^31), then [`reciprocal62`] scaled back by the
+/// shift: exact at 2^14; under it the low `k − 17` bits of 2^(45 + k) / L are zero, a relative
+/// error below 2^-25 (tested), far under the square root's 2^-15.
 #[inline]
 pub fn reciprocal46(len: u32) -> i64 {
-    let k = len.leading_zeros(); // 1..=23
+    if len > 1 << 14 {
+        // 2^46 = 2^14 · 2^32 with 2^14 < len: the quotient fits 32 bits.
+        return i64::from(div_rem_below(1 << 14, 0, len).0);
+    }
+    let k = len.leading_zeros(); // 18..=23, or 1..=17 only at 2^14
     let r = reciprocal62(len << (k - 1)) as i64;
     // 2^46 / len = 2^(45 + k) / L = r · 2^(k − 17).
     if k <= 17 {
@@ -295,6 +312,7 @@ pub fn ratio16(n: u64, d: u64) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::vec::Vec;
 
     #[test]
     fn reciprocal46_is_within_its_bound() {
@@ -310,6 +328,78 @@ mod tests {
                 got <= exact && exact - got <= (exact >> 26) + 1,
                 "{len}: {got} vs {exact}"
             );
+        }
+    }
+
+    #[test]
+    fn reciprocal46_is_the_exact_quotient_from_2_to_the_14() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let lens = (0..200_000)
+            .map(|_| (next() >> 33) as u32)
+            .filter(|l| *l >= 1 << 14)
+            .chain((1u32 << 14..1 << 16).step_by(3))
+            .chain((14..31).flat_map(|b| [(1u32 << b) - 1, 1 << b, (1 << b) + 1]))
+            .chain([(1 << 31) - 1, (1 << 31) - 2, 46_341, 65_535, 65_537]);
+        for len in lens {
+            assert_eq!(reciprocal46(len), (1i64 << 46) / i64::from(len), "{len}");
+        }
+    }
+
+    #[test]
+    fn normalizable_is_whether_normalized_gives_a_vector() {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let small = |r: u64| (r % 769) as i32 - 384;
+        let mut vectors: Vec<Vec3> = (0..100_000)
+            .map(|_| Vec3::from_bits(small(next()), small(next() >> 16), small(next() >> 32)))
+            .collect();
+        vectors.extend((0..20_000).map(|_| {
+            let [a, b, c] = [next(), next(), next()].map(|r| (r >> (40 + r % 24)) as i32);
+            Vec3::from_bits(a, -b, c)
+        }));
+        for c in [0, 1, 255, 256, 257, 1 << 16, -(1 << 16), 1 << 28] {
+            vectors.extend([
+                Vec3::from_bits(c, 0, 0),
+                Vec3::from_bits(0, c, 0),
+                Vec3::from_bits(c, c, c),
+            ]);
+        }
+        for v in vectors {
+            assert_eq!(v.normalizable(), v.normalized().is_some(), "{v:?}");
+        }
+    }
+
+    #[test]
+    fn narrow_bits_is_the_clamped_shift() {
+        let wide = |v: i64| (v >> 16).clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
+        let mut x = 0xd1b5_4a32_d192_ed03u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let edges = (40..63).flat_map(|b| {
+            let p = 1i64 << b;
+            [p - 1, p, p + 1, -p - 1, -p, -p + 1]
+        });
+        let values = (0..200_000)
+            .map(|_| (next() as i64) >> (next() % 40))
+            .chain(edges)
+            .chain([0, -1, 1, i64::MAX, i64::MIN, (1 << 47) - 1, -(1 << 47)]);
+        for v in values {
+            assert_eq!(narrow_bits(v), wide(v), "{v}");
         }
     }
 
