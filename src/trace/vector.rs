@@ -174,7 +174,9 @@ pub fn mul(a: I16F16, b: I16F16) -> I16F16 {
 /// An I32F32 narrowed to I16F16, or `None` outside the I16F16 range.
 #[inline]
 pub fn narrow(v: I32F32) -> Option<I16F16> {
-    i32::try_from(v.to_bits() >> 16).ok().map(I16F16::from_bits)
+    // In range exactly when bits 47 to 63 are all equal (see `narrow_bits`).
+    let (bits, high) = (v.to_bits(), (v.to_bits() >> 32) as i32);
+    (high >> 15 == high >> 31).then_some(I16F16::from_bits((bits >> 16) as i32))
 }
 
 /// √v for a non-negative I32F32, as an I16F16 (negative input gives 0).
@@ -189,17 +191,17 @@ pub const fn sqrt(v: I32F32) -> I16F16 {
     if bits <= 0 {
         return I16F16::ZERO;
     }
-    let bits = bits as u64;
-    let high = 64 - bits.leading_zeros();
-    let shift = if high > 32 { (high - 31) & !1 } else { 0 };
-    // (high - 31) rounded up to even keeps the shifted value below 2^32.
-    let shift = if high > 32 && (bits >> shift) > u32::MAX as u64 {
-        shift + 2
-    } else {
-        shift
-    };
-    let root = (isqrt32((bits >> shift) as u32) as u64) << (shift / 2);
-    if root > i32::MAX as u64 {
+    let high = (bits >> 32) as u32;
+    if high == 0 {
+        // Below 2^32: the exact root, below 2^16.
+        return I16F16::from_bits(isqrt32(bits as u32) as i32);
+    }
+    // The smallest even shift that brings the radicand below 2^32 (2 to 32), from the high
+    // word alone: its 32 − lz bits rounded up to even.
+    let shift = (33 - high.leading_zeros()) & !1;
+    // root < 2^16 and shift / 2 ≤ 16: the product stays below 2^32.
+    let root = isqrt32(((bits as u64) >> shift) as u32) << (shift / 2);
+    if root > i32::MAX as u32 {
         I16F16::MAX
     } else {
         I16F16::from_bits(root as i32)
@@ -400,6 +402,57 @@ mod tests {
             .chain([0, -1, 1, i64::MAX, i64::MIN, (1 << 47) - 1, -(1 << 47)]);
         for v in values {
             assert_eq!(narrow_bits(v), wide(v), "{v}");
+        }
+    }
+
+    /// Raw I32F32 values: random magnitudes of every size, and the edges of each power of 2.
+    fn wide_values() -> Vec<i64> {
+        let mut x = 0x6a09_e667_f3bc_c908u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let edges = (0..63).flat_map(|b| {
+            let p = 1i64 << b;
+            [p - 1, p, p + 1, -p - 1, -p, -p + 1]
+        });
+        (0..200_000)
+            .map(|_| (next() as i64) >> (next() % 63))
+            .chain(edges)
+            .chain([0, i64::MAX, i64::MIN])
+            .collect()
+    }
+
+    #[test]
+    fn narrow_is_the_checked_shift() {
+        for v in wide_values() {
+            let want = i32::try_from(v >> 16).ok().map(I16F16::from_bits);
+            assert_eq!(narrow(I32F32::from_bits(v)), want, "{v}");
+        }
+    }
+
+    #[test]
+    fn sqrt_is_the_64_bit_form() {
+        // The form before the high-word shift: 64-bit leading zeros, shift and result.
+        let wide = |bits: i64| {
+            if bits <= 0 {
+                return 0;
+            }
+            let bits = bits as u64;
+            let high = 64 - bits.leading_zeros();
+            let shift = if high > 32 { (high - 31) & !1 } else { 0 };
+            let shift = if high > 32 && (bits >> shift) > u64::from(u32::MAX) {
+                shift + 2
+            } else {
+                shift
+            };
+            let root = u64::from(isqrt32((bits >> shift) as u32)) << (shift / 2);
+            root.min(i32::MAX as u64) as i32
+        };
+        for v in wide_values() {
+            assert_eq!(sqrt(I32F32::from_bits(v)).to_bits(), wide(v), "{v}");
         }
     }
 
