@@ -763,6 +763,47 @@ mod tests {
     }
 
     #[test]
+    fn background_pixel_is_the_traced_miss() {
+        let materials = [material(0.0, 0.0)];
+        let sky = Colour::new([f(0.25), f(0.35), f(0.55)]).unwrap();
+        let scene = Scene::new(&[], &materials, &[], sky, f(0.5)).unwrap();
+        let mut camera = TraceCamera::new(
+            [0.0; 3],
+            [0.0, 0.0, -1.0],
+            [0.0, 1.0, 0.0],
+            50.0,
+            0.1,
+            10.0,
+            8,
+            6,
+        )
+        .unwrap();
+        for degenerate in [false, true] {
+            if degenerate {
+                // Directions too short to normalise in the first rows: black, not the sky.
+                use fixed::types::I8F24;
+                camera.corner = [I8F24::ZERO; 3];
+                camera.right = [I8F24::ZERO; 3];
+                camera.down = [I8F24::from_bits(1 << 14), I8F24::ZERO, I8F24::ZERO];
+            }
+            let tracer = Tracer::<4>::new(&scene, &camera, TraceOptions::default());
+            let mut colours = std::vec::Vec::new();
+            for (x, y) in (0..8).flat_map(|x| (0..6).map(move |y| (x, y))) {
+                let p = tracer.background_pixel(x, y);
+                assert_eq!(p, tracer.trace_pixel(x, y), "({x}, {y})");
+                colours.push(p.0.colour);
+            }
+            // Both cases are met: the sky everywhere, or black rows then the sky.
+            let black = colours
+                .iter()
+                .filter(|c| **c == Rgb888::new(0, 0, 0))
+                .count();
+            assert_eq!(black > 0, degenerate);
+            assert!(black < colours.len());
+        }
+    }
+
+    #[test]
     fn ior_ratio_is_checked_div() {
         let mut x = 0x853c_49e6_748f_ea9bu64;
         let mut next = || {
