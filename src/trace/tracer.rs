@@ -415,23 +415,19 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     /// What [`trace_with`](Self::trace_with) gives pixel (`column`, `row`) when its primary ray
     /// is offered no object (hybrid mode, where no screen rectangle covers the pixel): the
     /// background, or black when the direction cannot be normalised, without normalising it.
-    pub(crate) fn background_pixel(&self, column: u16, row: u16) -> (PixelTrace, TraceStats) {
+    /// The ray's cost is one primary ray and nothing else.
+    pub(crate) fn background_pixel(&self, column: u16, row: u16) -> PixelTrace {
         let mut sum = Colour::BLACK;
         if self.camera.pixel_direction(column, row).normalizable() {
             add_weighted(&mut sum, &self.scene.background, I16F16::ONE);
         }
-        let out = PixelTrace {
+        PixelTrace {
             colour: to_rgb888(&sum),
             id: None,
             depth: I16F16::ZERO,
             shadow: 0,
             material: None,
-        };
-        let stats = TraceStats {
-            primary_rays: 1,
-            ..TraceStats::default()
-        };
-        (out, stats)
+        }
     }
 
     /// The nearest object along `ray` (which starts on object `from`) with `t` in
@@ -790,8 +786,12 @@ mod tests {
             let mut colours = std::vec::Vec::new();
             for (x, y) in (0..8).flat_map(|x| (0..6).map(move |y| (x, y))) {
                 let p = tracer.background_pixel(x, y);
-                assert_eq!(p, tracer.trace_pixel(x, y), "({x}, {y})");
-                colours.push(p.0.colour);
+                let one_ray = TraceStats {
+                    primary_rays: 1,
+                    ..TraceStats::default()
+                };
+                assert_eq!((p, one_ray), tracer.trace_pixel(x, y), "({x}, {y})");
+                colours.push(p.colour);
             }
             // Both cases are met: the sky everywhere, or black rows then the sky.
             let black = colours
