@@ -231,7 +231,7 @@ fn div_rem_u64_u32_in_halves(n: u64, d: u32) -> (u64, u32) {
 
 /// `(u1·2^32 + u0) / v` and its remainder for `u1 < v` (so the quotient fits 32 bits).
 #[inline]
-fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
+pub(crate) fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
     const B: u32 = 1 << 16;
     if u1 == 0 {
         // The common case (numerator below 2^32): one division.

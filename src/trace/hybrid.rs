@@ -570,6 +570,13 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 stats.shadow_fallback_rows += 1;
             }
             for x in 0..self.camera().width {
+                if scanned && !live.iter().any(|b| b.x0 <= x && x <= b.x1) {
+                    // No object can be seen here: the background, without the primary ray
+                    // (which would have made no test and spawned nothing).
+                    stats.primary_rays += 1;
+                    pixel(context, x, &self.background_pixel(x, y));
+                    continue;
+                }
                 let (p, s) = if scanned {
                     self.trace_with(x, y, &mut cache, row_lists, |ray, t_min, t_max, stats| {
                         let mut search = Nearest::new(u32::MAX, t_min, t_max);

@@ -25,6 +25,7 @@
 //! `complete: false`.
 
 use crate::depth::DepthRow;
+use crate::math::div_rem_u64_u32;
 use crate::sink::{Row, RowPixel, RowSink};
 use crate::trace::intersect::{reflect, Ray};
 use crate::trace::row_shadow::{any_blocks, RowShadows, ShadowCandidate};
@@ -411,6 +412,24 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         (out, stats)
     }
 
+    /// What [`trace_with`](Self::trace_with) gives pixel (`column`, `row`) when its primary ray
+    /// is offered no object (hybrid mode, where no screen rectangle covers the pixel): the
+    /// background, or black when the direction cannot be normalised, without normalising it.
+    /// The ray's cost is one primary ray and nothing else.
+    pub(crate) fn background_pixel(&self, column: u16, row: u16) -> PixelTrace {
+        let mut sum = Colour::BLACK;
+        if self.camera.pixel_direction(column, row).normalizable() {
+            add_weighted(&mut sum, &self.scene.background, I16F16::ONE);
+        }
+        PixelTrace {
+            colour: to_rgb888(&sum),
+            id: None,
+            depth: I16F16::ZERO,
+            shadow: 0,
+            material: None,
+        }
+    }
+
     /// The nearest object along `ray` (which starts on object `from`) with `t` in
     /// `[t_min, t_max)`.
     fn nearest(
@@ -637,7 +656,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
 /// The refracted direction of unit `d` through a surface with unit normal `n` facing it, from
 /// IOR `n1` into `n2` (Snell's law), or `None` on total internal reflection.
 pub fn refract(d: Vec3, n: Vec3, n1: I16F16, n2: I16F16) -> Option<Vec3> {
-    let eta = n1.checked_div(n2)?;
+    let eta = ior_ratio(n1, n2)?;
     let cos_i = I16F16::from_bits(narrow_bits(-d.dot_bits(n)));
     // k = 1 − η²(1 − cos²θi): the squared cosine of the refracted angle.
     let sin2_i = I32F32::ONE - cos_i.wide_mul(cos_i);
@@ -650,6 +669,20 @@ pub fn refract(d: Vec3, n: Vec3, n1: I16F16, n2: I16F16) -> Option<Vec3> {
     let cos_t = sqrt(k);
     let along_n = mul(eta, cos_i) - cos_t;
     d.scale(eta).add(n.scale(along_n)).normalized()
+}
+
+/// `n1 / n2` exactly as `n1.checked_div(n2)` (truncated; `None` if `n2` is 0 or the quotient
+/// overflows), for two positive values (IORs) from 32-bit divisions ([`div_rem_u64_u32`])
+/// instead of the 64-bit division's library call; other signs take `checked_div`.
+#[inline]
+fn ior_ratio(n1: I16F16, n2: I16F16) -> Option<I16F16> {
+    let (a, b) = (n1.to_bits(), n2.to_bits());
+    if a <= 0 || b <= 0 {
+        return n1.checked_div(n2);
+    }
+    // a · 2^16 / b, both positive: floor = truncation.
+    let (q, _) = div_rem_u64_u32((a as u64) << 16, b as u32);
+    i32::try_from(q).ok().map(I16F16::from_bits)
 }
 
 /// `sum += c · weight`, per channel.
@@ -723,6 +756,89 @@ mod tests {
         Tracer::<8>::new(&scene, &camera, options)
             .trace_pixel(0, 0)
             .1
+    }
+
+    #[test]
+    fn background_pixel_is_the_traced_miss() {
+        let materials = [material(0.0, 0.0)];
+        let sky = Colour::new([f(0.25), f(0.35), f(0.55)]).unwrap();
+        let scene = Scene::new(&[], &materials, &[], sky, f(0.5)).unwrap();
+        let mut camera = TraceCamera::new(
+            [0.0; 3],
+            [0.0, 0.0, -1.0],
+            [0.0, 1.0, 0.0],
+            50.0,
+            0.1,
+            10.0,
+            8,
+            6,
+        )
+        .unwrap();
+        for degenerate in [false, true] {
+            if degenerate {
+                // Directions too short to normalise in the first rows: black, not the sky.
+                use fixed::types::I8F24;
+                camera.corner = [I8F24::ZERO; 3];
+                camera.right = [I8F24::ZERO; 3];
+                camera.down = [I8F24::from_bits(1 << 14), I8F24::ZERO, I8F24::ZERO];
+            }
+            let tracer = Tracer::<4>::new(&scene, &camera, TraceOptions::default());
+            let mut colours = std::vec::Vec::new();
+            for (x, y) in (0..8).flat_map(|x| (0..6).map(move |y| (x, y))) {
+                let p = tracer.background_pixel(x, y);
+                let one_ray = TraceStats {
+                    primary_rays: 1,
+                    ..TraceStats::default()
+                };
+                assert_eq!((p, one_ray), tracer.trace_pixel(x, y), "({x}, {y})");
+                colours.push(p.colour);
+            }
+            // Both cases are met: the sky everywhere, or black rows then the sky.
+            let black = colours
+                .iter()
+                .filter(|c| **c == Rgb888::new(0, 0, 0))
+                .count();
+            assert_eq!(black > 0, degenerate);
+            assert!(black < colours.len());
+        }
+    }
+
+    #[test]
+    fn ior_ratio_is_checked_div() {
+        let mut x = 0x853c_49e6_748f_ea9bu64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut pairs: std::vec::Vec<(i32, i32)> = (0..200_000)
+            .map(|_| {
+                let (a, b) = (next(), next());
+                ((a >> (33 + a % 31)) as i32, (b >> (33 + b % 31)) as i32)
+            })
+            .collect();
+        let edges = [
+            0,
+            1,
+            2,
+            1 << 16,
+            3 << 15,
+            4 << 16,
+            i32::MAX,
+            i32::MIN,
+            -1,
+            -(1 << 16),
+        ];
+        pairs.extend(
+            edges
+                .iter()
+                .flat_map(|a| edges.iter().map(move |b| (*a, *b))),
+        );
+        for (a, b) in pairs {
+            let (a, b) = (I16F16::from_bits(a), I16F16::from_bits(b));
+            assert_eq!(ior_ratio(a, b), a.checked_div(b), "{a} / {b}");
+        }
     }
 
     #[test]

@@ -12,6 +12,7 @@
 //! below one I16F16 step) and is checked: a value outside the I16F16 range is an error, never a
 //! wrapped number.
 
+use crate::math::div_rem_below;
 pub use crate::math::{isqrt32, isqrt32_bitwise, isqrt32_newton};
 use fixed::types::{I16F16, I32F32};
 
@@ -131,6 +132,14 @@ impl Vec3 {
         self.normalized_with_length().map(|(unit, _)| unit)
     }
 
+    /// Whether [`normalized`](Self::normalized) gives a unit vector: its length's [`sqrt`] is
+    /// at least 2^-8 exactly when `self · self` is at least 2^-16 (2^16 raw I32F32 bits; below
+    /// 2^32 raw the root is exact), without the root.
+    #[inline]
+    pub const fn normalizable(self) -> bool {
+        self.dot_bits(self) >= 1 << 16
+    }
+
     /// The unit vector along `self` and the length it was divided by ([`sqrt`] of `self ·
     /// self`), or `None` for a vector shorter than 2^-8: one square root for both.
     #[inline]
@@ -144,13 +153,15 @@ impl Vec3 {
 /// I16F16 range.
 #[inline]
 pub const fn narrow_bits(v: i64) -> i32 {
-    let s = v >> 16;
-    if s > i32::MAX as i64 {
-        i32::MAX
-    } else if s < i32::MIN as i64 {
+    // `v >> 16` fits an i32 exactly when bits 47 to 63 of `v` are all equal: tested on the
+    // high word alone, cheaper on a 32-bit core than two 64-bit comparisons.
+    let high = (v >> 32) as i32;
+    if high >> 15 == high >> 31 {
+        (v >> 16) as i32
+    } else if high < 0 {
         i32::MIN
     } else {
-        s as i32
+        i32::MAX
     }
 }
 
@@ -163,7 +174,9 @@ pub fn mul(a: I16F16, b: I16F16) -> I16F16 {
 /// An I32F32 narrowed to I16F16, or `None` outside the I16F16 range.
 #[inline]
 pub fn narrow(v: I32F32) -> Option<I16F16> {
-    i32::try_from(v.to_bits() >> 16).ok().map(I16F16::from_bits)
+    // In range exactly when bits 47 to 63 are all equal (see `narrow_bits`).
+    let (bits, high) = (v.to_bits(), (v.to_bits() >> 32) as i32);
+    (high >> 15 == high >> 31).then_some(I16F16::from_bits((bits >> 16) as i32))
 }
 
 /// √v for a non-negative I32F32, as an I16F16 (negative input gives 0).
@@ -178,17 +191,17 @@ pub const fn sqrt(v: I32F32) -> I16F16 {
     if bits <= 0 {
         return I16F16::ZERO;
     }
-    let bits = bits as u64;
-    let high = 64 - bits.leading_zeros();
-    let shift = if high > 32 { (high - 31) & !1 } else { 0 };
-    // (high - 31) rounded up to even keeps the shifted value below 2^32.
-    let shift = if high > 32 && (bits >> shift) > u32::MAX as u64 {
-        shift + 2
-    } else {
-        shift
-    };
-    let root = (isqrt32((bits >> shift) as u32) as u64) << (shift / 2);
-    if root > i32::MAX as u64 {
+    let high = (bits >> 32) as u32;
+    if high == 0 {
+        // Below 2^32: the exact root, below 2^16.
+        return I16F16::from_bits(isqrt32(bits as u32) as i32);
+    }
+    // The smallest even shift that brings the radicand below 2^32 (2 to 32), from the high
+    // word alone: its 32 − lz bits rounded up to even.
+    let shift = (33 - high.leading_zeros()) & !1;
+    // root < 2^16 and shift / 2 ≤ 16: the product stays below 2^32.
+    let root = isqrt32(((bits as u64) >> shift) as u32) << (shift / 2);
+    if root > i32::MAX as u32 {
         I16F16::MAX
     } else {
         I16F16::from_bits(root as i32)
@@ -221,13 +234,19 @@ fn normalize_by(v: [i32; 3], len: i32) -> Option<[i32; 3]> {
 }
 
 /// ⌊2^46 / `len`⌋ (1/length in 30 fraction bits for a raw I16F16 length) for `len` in
-/// [2^8, 2^31), without a 64-bit division: `len` shifted to L in [2^30, 2^31), then
-/// [`reciprocal62`] scaled back by the shift. Exact for `len` ≥ 2^14 (a length of at least
-/// 1/4); below, the low `k − 17` bits of 2^(45 + k) / L are zero, a relative error below 2^-25
-/// (tested), far under the square root's 2^-15.
+/// [2^8, 2^31), without a 64-bit division. Above 2^14 (a length over 1/4, every direction the
+/// tracer normalises but the shortest) it is the exact quotient from two 16-bit digits of 32-bit
+/// divisions ([`div_rem_below`]: about half the instructions of [`reciprocal62`]'s Newton
+/// steps). Below, `len` shifted to L in [2^30, 2^31), then [`reciprocal62`] scaled back by the
+/// shift: exact at 2^14; under it the low `k − 17` bits of 2^(45 + k) / L are zero, a relative
+/// error below 2^-25 (tested), far under the square root's 2^-15.
 #[inline]
 pub fn reciprocal46(len: u32) -> i64 {
-    let k = len.leading_zeros(); // 1..=23
+    if len > 1 << 14 {
+        // 2^46 = 2^14 · 2^32 with 2^14 < len: the quotient fits 32 bits.
+        return i64::from(div_rem_below(1 << 14, 0, len).0);
+    }
+    let k = len.leading_zeros(); // 18..=23, or 1..=17 only at 2^14
     let r = reciprocal62(len << (k - 1)) as i64;
     // 2^46 / len = 2^(45 + k) / L = r · 2^(k − 17).
     if k <= 17 {
@@ -295,6 +314,7 @@ pub fn ratio16(n: u64, d: u64) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::vec::Vec;
 
     #[test]
     fn reciprocal46_is_within_its_bound() {
@@ -310,6 +330,129 @@ mod tests {
                 got <= exact && exact - got <= (exact >> 26) + 1,
                 "{len}: {got} vs {exact}"
             );
+        }
+    }
+
+    #[test]
+    fn reciprocal46_is_the_exact_quotient_from_2_to_the_14() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let lens = (0..200_000)
+            .map(|_| (next() >> 33) as u32)
+            .filter(|l| *l >= 1 << 14)
+            .chain((1u32 << 14..1 << 16).step_by(3))
+            .chain((14..31).flat_map(|b| [(1u32 << b) - 1, 1 << b, (1 << b) + 1]))
+            .chain([(1 << 31) - 1, (1 << 31) - 2, 46_341, 65_535, 65_537]);
+        for len in lens {
+            assert_eq!(reciprocal46(len), (1i64 << 46) / i64::from(len), "{len}");
+        }
+    }
+
+    #[test]
+    fn normalizable_is_whether_normalized_gives_a_vector() {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let small = |r: u64| (r % 769) as i32 - 384;
+        let mut vectors: Vec<Vec3> = (0..100_000)
+            .map(|_| Vec3::from_bits(small(next()), small(next() >> 16), small(next() >> 32)))
+            .collect();
+        vectors.extend((0..20_000).map(|_| {
+            let [a, b, c] = [next(), next(), next()].map(|r| (r >> (40 + r % 24)) as i32);
+            Vec3::from_bits(a, -b, c)
+        }));
+        for c in [0, 1, 255, 256, 257, 1 << 16, -(1 << 16), 1 << 28] {
+            vectors.extend([
+                Vec3::from_bits(c, 0, 0),
+                Vec3::from_bits(0, c, 0),
+                Vec3::from_bits(c, c, c),
+            ]);
+        }
+        for v in vectors {
+            assert_eq!(v.normalizable(), v.normalized().is_some(), "{v:?}");
+        }
+    }
+
+    #[test]
+    fn narrow_bits_is_the_clamped_shift() {
+        let wide = |v: i64| (v >> 16).clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
+        let mut x = 0xd1b5_4a32_d192_ed03u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let edges = (40..63).flat_map(|b| {
+            let p = 1i64 << b;
+            [p - 1, p, p + 1, -p - 1, -p, -p + 1]
+        });
+        let values = (0..200_000)
+            .map(|_| (next() as i64) >> (next() % 40))
+            .chain(edges)
+            .chain([0, -1, 1, i64::MAX, i64::MIN, (1 << 47) - 1, -(1 << 47)]);
+        for v in values {
+            assert_eq!(narrow_bits(v), wide(v), "{v}");
+        }
+    }
+
+    /// Raw I32F32 values: random magnitudes of every size, and the edges of each power of 2.
+    fn wide_values() -> Vec<i64> {
+        let mut x = 0x6a09_e667_f3bc_c908u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let edges = (0..63).flat_map(|b| {
+            let p = 1i64 << b;
+            [p - 1, p, p + 1, -p - 1, -p, -p + 1]
+        });
+        (0..200_000)
+            .map(|_| (next() as i64) >> (next() % 63))
+            .chain(edges)
+            .chain([0, i64::MAX, i64::MIN])
+            .collect()
+    }
+
+    #[test]
+    fn narrow_is_the_checked_shift() {
+        for v in wide_values() {
+            let want = i32::try_from(v >> 16).ok().map(I16F16::from_bits);
+            assert_eq!(narrow(I32F32::from_bits(v)), want, "{v}");
+        }
+    }
+
+    #[test]
+    fn sqrt_is_the_64_bit_form() {
+        // The form before the high-word shift: 64-bit leading zeros, shift and result.
+        let wide = |bits: i64| {
+            if bits <= 0 {
+                return 0;
+            }
+            let bits = bits as u64;
+            let high = 64 - bits.leading_zeros();
+            let shift = if high > 32 { (high - 31) & !1 } else { 0 };
+            let shift = if high > 32 && (bits >> shift) > u64::from(u32::MAX) {
+                shift + 2
+            } else {
+                shift
+            };
+            let root = u64::from(isqrt32((bits >> shift) as u32)) << (shift / 2);
+            root.min(i32::MAX as u64) as i32
+        };
+        for v in wide_values() {
+            assert_eq!(sqrt(I32F32::from_bits(v)).to_bits(), wide(v), "{v}");
         }
     }
 
