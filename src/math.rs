@@ -106,6 +106,18 @@ fn mul_wide_in_halves(a: i32, b: i32) -> i64 {
     (((ah * bh) as i64) << 32) + (cross << 16) + low
 }
 
+/// `a · b` for an `a` that fits `i64` times `b`, where the product does not overflow: on
+/// cores without a wide multiply ([`NO_WIDE_MULTIPLY`]) [`mul_wide`] when `a` fits 32 bits
+/// (the `i64` multiply is a call there), elsewhere the `i64` multiply. The same value either
+/// way (test `narrow_products_are_exact`).
+#[inline]
+pub(crate) fn mul_i64_i32(a: i64, b: i32) -> i64 {
+    match i32::try_from(a) {
+        Ok(a) if NO_WIDE_MULTIPLY => mul_wide(a, b),
+        _ => a * b as i64,
+    }
+}
+
 /// `(a · b) mod 2^64` for `0 <= b < 2^16`, as `a.wrapping_mul(b as i64)`: on cores without a
 /// wide multiply ([`NO_WIDE_MULTIPLY`]) from three 32-bit multiplies (`a`'s low word in two
 /// 16-bit halves and its high word, each times `b`, whose products fit 32 bits), elsewhere
@@ -267,6 +279,135 @@ pub(crate) fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
     let q0 = digit(un21, un0);
     let r = (un21 << 16 | un0).wrapping_sub(q0.wrapping_mul(v)) >> s;
     (q1 << 16 | q0, r)
+}
+
+/// `a · b` for unsigned 32-bit factors: on cores without a wide multiply
+/// ([`NO_WIDE_MULTIPLY`]) from four 32-bit multiplies of 16-bit halves, elsewhere the `u64`
+/// multiply (`umull`). The same value either way (test `narrow_products_are_exact`).
+#[inline]
+fn mul_wide_u32(a: u32, b: u32) -> u64 {
+    if NO_WIDE_MULTIPLY {
+        mul_wide_u32_in_halves(a, b)
+    } else {
+        a as u64 * b as u64
+    }
+}
+
+/// [`mul_wide_u32`] from 32-bit multiplies, on every target (tested on the host too):
+/// `a·b = ah·bh·2^32 + (ah·bl + al·bh)·2^16 + al·bl`, each product of 16-bit halves.
+#[inline]
+fn mul_wide_u32_in_halves(a: u32, b: u32) -> u64 {
+    let (ah, al) = (a >> 16, a & 0xFFFF);
+    let (bh, bl) = (b >> 16, b & 0xFFFF);
+    let cross = (ah * bl) as u64 + (al * bh) as u64;
+    (((ah * bh) as u64) << 32) + (cross << 16) + (al * bl) as u64
+}
+
+/// A 32-bit divisor `D >= 1` prepared for several divisions: one reciprocal, then every
+/// quotient from multiplies and at most two corrections, exactly `u64` division's quotient and
+/// remainder ([`div_rem_u64_u32`]'s). On cores without a divider (Cortex-M0) a 64 / 32-bit
+/// division costs three calls of the software 32-bit division, the reciprocal two.
+///
+/// The step is Möller and Granlund's (“Improved division by invariant integers”, 2011,
+/// Algorithm 4). Why it is exact, with `β = 2^32`, `d = D·2^s` normalized (`β/2 <= d < β`),
+/// `ν = ⌊(β² − 1) / d⌋ = β + v` (`0 <= v < β`) and `U = u1·β + u0` with `u1 < d`:
+///
+/// - `ν·d <= β² − 1 < ν·d + d`, so `k = β² − ν·d` lies in `[1, d]`; and `ν·u1 + u0 < β²`
+///   (as `ν·u1 <= (β² − 1)(d − 1) / d < β² − β`), so it is two words `q1·β + q0`.
+/// - The candidate `q̃ = q1 + 1` has the remainder `r̃ = U − q̃·d`, and substituting
+///   `q1·β = ν·u1 + u0 − q0` gives `β·r̃ = u1·k + u0·(β − d) + (q0 − β)·d`.
+/// - Below: `β·r̃ >= (q0 − β)·d >= −β·d`, so `r̃ >= −d`; and `r̃ = q0 − β` would need
+///   `(q0 − β)(β − d) = u1·k + u0·(β − d) >= 0`, whose left side is negative: `r̃ > q0 − β`.
+/// - Above: `β·r̃ <= (d − 1)·d + (β − 1)(β − d) + (q0 − β)·d < (β − d)² + q0·d <= M·β`
+///   with `M = max(β − d, q0) < β`: `r̃ < M`.
+///
+/// Only `r = r̃ mod β` is computed (32-bit wrapping, as is `q̃`: the final quotient is below `β`,
+/// so its value mod `β` is the value). If `r̃ < 0`, then `r = r̃ + β > q0`: the first
+/// correction (`q̃ − 1`, `r + d`) applies and leaves `r̃ + d` in `[0, d)`, the second does not.
+/// If `0 <= r̃ <= q0`, the first does not apply and `r̃ < M < β <= 2d`: the second (`q̃ + 1`,
+/// `r − d`) applies exactly when `r̃ >= d`. If `r̃ > q0 >= 0`, then `M = β − d`, so
+/// `r̃ < β − d <= d`; the first gives `r̃ + d` in `[d, β)` (no wrap) and the second undoes it.
+/// In every case the result is `⌊U / d⌋` and `U mod d`.
+///
+/// A 64-bit `n` is divided as `n·2^s = n2·β² + n1·β + n0` (`n2 < 2^s <= β/2 <= d`): one step for
+/// the quotient's high word, one for its low word; `n mod D` is the last remainder `/ 2^s`.
+/// Test `reciprocal_division_is_exact`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Divisor32 {
+    /// `D·2^shift`, top bit set.
+    d: u32,
+    /// `⌊(2^64 − 1) / d⌋ − 2^32`.
+    v: u32,
+    shift: u32,
+}
+
+impl Divisor32 {
+    /// The divisor `d` (`0` is taken as 1).
+    #[inline]
+    pub(crate) fn new(d: u32) -> Self {
+        let d = d.max(1);
+        let shift = d.leading_zeros();
+        let d = d << shift;
+        // ν − β = ⌊((β − 1 − d)·β + β − 1) / d⌋, a quotient below β (β − 1 − d < d).
+        let v = if cfg!(target_pointer_width = "64") {
+            (u64::MAX / d as u64) as u32
+        } else {
+            div_rem_below(!d, u32::MAX, d).0
+        };
+        Divisor32 { d, v, shift }
+    }
+
+    /// `(⌊(u1·2^32 + u0) / d⌋, remainder)` for `u1 < d` (the normalized divisor).
+    #[inline]
+    fn step(&self, u1: u32, u0: u32) -> (u32, u32) {
+        let p = mul_wide_u32(self.v, u1) + (((u1 as u64) << 32) | u0 as u64);
+        let (q1, q0) = ((p >> 32) as u32, p as u32);
+        let mut q = q1.wrapping_add(1);
+        let mut r = u0.wrapping_sub(q.wrapping_mul(self.d));
+        if r > q0 {
+            q = q.wrapping_sub(1);
+            r = r.wrapping_add(self.d);
+        }
+        if r >= self.d {
+            q = q.wrapping_add(1);
+            r -= self.d;
+        }
+        (q, r)
+    }
+
+    /// `(n / D, n % D)`, as [`div_rem_u64_u32`]`(n, D)`.
+    #[inline]
+    pub(crate) fn div_rem(&self, n: u64) -> (u64, u32) {
+        let s = self.shift;
+        let (hi, lo) = ((n >> 32) as u32, n as u32);
+        // n·2^s in three words (32-bit shifts: a 64-bit shift is a call on ARMv6-M).
+        let (n2, n1) = if s == 0 {
+            (0, hi)
+        } else {
+            (hi >> (32 - s), hi << s | lo >> (32 - s))
+        };
+        // A quotient that fits 32 bits (the usual case) needs only the second step.
+        let (q_hi, r1) = if n2 == 0 && n1 < self.d {
+            (0, n1)
+        } else {
+            self.step(n2, n1)
+        };
+        let (q_lo, r) = self.step(r1, lo << s);
+        (((q_hi as u64) << 32) | q_lo as u64, r >> s)
+    }
+
+    /// `n.div_euclid(D)`, as [`floor_div_i64`]`(n, D)`.
+    #[inline]
+    pub(crate) fn floor_div(&self, n: i64) -> i64 {
+        let (q, r) = self.div_rem(n.unsigned_abs());
+        // As in `floor_div_i64`: the quotient of a negative n fits i64 when negated.
+        let q = q as i64;
+        if n >= 0 {
+            q
+        } else {
+            q.wrapping_neg() - (r != 0) as i64
+        }
+    }
 }
 
 /// ⌊√v⌋ for a 32-bit integer: [`isqrt32_newton`] where the target divides 32-bit integers in
@@ -525,6 +666,20 @@ mod tests {
                 let want = c as i64 * d as i64;
                 assert_eq!(mul_wide_in_halves(c, d), want, "{c} * {d}");
                 assert_eq!(mul_wide(c, d), want, "{c} * {d}");
+                let (c, d) = (c as u32, d as u32);
+                let want = c as u64 * d as u64;
+                assert_eq!(mul_wide_u32_in_halves(c, d), want, "{c} * {d}");
+                assert_eq!(mul_wide_u32(c, d), want, "{c} * {d}");
+            }
+            let b = d;
+            // Factors on both sides of 2^31 whose products fit i64.
+            for a in [
+                a >> 32,
+                a >> (x % 32 + 32),
+                c as i64,
+                (a >> 33) + i32::MAX as i64,
+            ] {
+                assert_eq!(mul_i64_i32(a, b), a * b as i64, "{a} * {b}");
             }
             for b in [(x >> 48) as u16, 0, 1, u16::MAX, (x >> 20) as u16 & 0x7FF] {
                 let want = a.wrapping_mul(b as i64);
@@ -588,6 +743,79 @@ mod tests {
             for d in [1i64, 2, 3, u32::MAX as i64, 1 << 32, i64::MAX] {
                 assert_eq!(floor_div_i64(n, d), n.div_euclid(d), "{n} / {d}");
             }
+        }
+    }
+
+    #[test]
+    fn reciprocal_division_is_exact() {
+        let ns = [
+            0u64,
+            1,
+            2,
+            u32::MAX as u64,
+            1 << 32,
+            (1 << 32) + 1,
+            1 << 63,
+            u64::MAX,
+            u64::MAX - 1,
+        ];
+        let ds = [
+            1u32,
+            2,
+            3,
+            7,
+            0xFFFF,
+            0x1_0000,
+            0x7FFF_FFFF,
+            0x8000_0000,
+            0x8000_0001,
+            u32::MAX - 1,
+            u32::MAX,
+        ];
+        let check = |n: u64, by: &Divisor32, d: u32| {
+            let want = (n / d as u64, (n % d as u64) as u32);
+            assert_eq!(by.div_rem(n), want, "{n} / {d}");
+            let n = n as i64;
+            assert_eq!(by.floor_div(n), n.div_euclid(d as i64), "{n} / {d}");
+            assert_eq!(by.floor_div(n), floor_div_i64(n, d as i64), "{n} / {d}");
+        };
+        for d in ds {
+            let by = Divisor32::new(d);
+            for n in ns {
+                // Each boundary, and multiples of d and their neighbours near it.
+                for n in [
+                    n,
+                    n.wrapping_sub(n % d as u64),
+                    n.wrapping_sub(n % d as u64 + 1),
+                ] {
+                    check(n, &by, d);
+                }
+            }
+        }
+        assert_eq!(Divisor32::new(0).div_rem(12345), (12345, 0));
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..400_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let d = (((x >> 7) as u32) >> ((x >> 40) % 32)).max(1);
+            let by = Divisor32::new(d);
+            // The 32-bit targets' reciprocal (the host divides `u64`).
+            assert_eq!(div_rem_below(!by.d, u32::MAX, by.d).0, by.v, "{d}");
+            check(x >> (x % 64), &by, d);
+            // Quotients and remainders at the word boundaries: n = q·d + r with chosen q, r.
+            let q = (x >> 20) & 0xFFFF_FFFF;
+            for r in [0, 1, d - 1, (x % d as u64) as u32] {
+                check(q * d as u64 + r as u64, &by, d);
+                check(
+                    (q << 32).wrapping_mul(d as u64).wrapping_add(r as u64),
+                    &by,
+                    d,
+                );
+            }
+            // Divisors of the depth plane (twice a triangle's area) and the projection (2w).
+            let small = ((x >> 33) as u32 % (1 << ((x >> 1) % 24 + 1))).max(1) * 2;
+            check(x >> (x % 64), &Divisor32::new(small), small);
         }
     }
 

@@ -14,7 +14,7 @@
 //! * Depth `q = near / w` in I2F30: `near · 2^30 < 2^61`.
 
 use crate::depth::Depth;
-use crate::math::floor_div_i64;
+use crate::math::{floor_div_i64, mul_wide};
 use crate::vertex::EyePoint;
 use fixed::types::I16F16;
 
@@ -45,7 +45,7 @@ impl<const S: u32> SubPx<S> {
 /// so that a scale between 2^-40 and 2^25 keeps 24 significant bits in integer arithmetic.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Scale {
-    mantissa: i64,
+    mantissa: i32,
     shift: u32,
 }
 
@@ -63,7 +63,7 @@ impl Scale {
             shift += 1;
         }
         Some(Scale {
-            mantissa: m as i64,
+            mantissa: m as i32,
             shift,
         })
     }
@@ -71,7 +71,8 @@ impl Scale {
     /// `floor(self · v)` for `|v| <= 2^31`.
     #[inline]
     pub fn apply(self, v: i32) -> i64 {
-        (self.mantissa * v as i64) >> self.shift
+        // The mantissa is below 2^25: a 32 × 32 → 64-bit product (no call on ARMv6-M).
+        mul_wide(self.mantissa, v) >> self.shift
     }
 }
 

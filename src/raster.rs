@@ -27,7 +27,7 @@
 //! solved in i128 once per triangle and stepped in i64 (depth) or i32 (colour).
 
 use crate::depth::Depth;
-use crate::math::{floor_div_i64, mul_i64_u16, mul_wide};
+use crate::math::{floor_div_i64, mul_i64_i32, mul_i64_u16, mul_wide, Divisor32};
 use crate::project::ScreenVertex;
 use core::cmp::Ordering;
 use fixed::types::I16F16;
@@ -70,10 +70,12 @@ impl EdgeWalk {
         // c = pq + ceil(m' / den) with m' = dy·pr + t·step_rem, and 0 <= m' < 2·den when the
         // row is the first at or below `a` (0 <= t < 2^(S+1)), the case of every triangle walk:
         // the quotient is then 0, 1 or 2, found by comparison instead of a second division.
+        // The products fit i64 (|t| < 2^34, factors below 2^25); `mul_i64_i32` keeps them off
+        // the 64-bit multiply call on ARMv6-M when `t` fits 32 bits, as it does on screen.
         let t = (((2 * row as i64) + 1) << S) - 2 * a.1 as i64;
-        let p = 2 * a.0 as i64 - (1i64 << S) + t * step as i64;
+        let p = 2 * a.0 as i64 - (1i64 << S) + mul_i64_i32(t, step);
         let den = (dy as i64) << (S + 1);
-        let m = (dy as i64) * (p & ((1i64 << (S + 1)) - 1)) + t * step_rem as i64 + den - 1;
+        let m = mul_i64_i32(p & ((1i64 << (S + 1)) - 1), dy) + mul_i64_i32(t, step_rem) + den - 1;
         let (k, r) = if (0..3 * den).contains(&m) {
             let k = (m >= den) as i64 + (m >= 2 * den) as i64;
             (k, m - k * den)
@@ -382,7 +384,7 @@ impl PlaneSolver {
             num_x = -num_x;
             num_y = -num_y;
         }
-        let area = self.area.max(1);
+        let div = RoundDivisor::new(self.area);
         let px = 1i64.checked_shl(self.sub_bits + 1 + extra)?;
         let to_ref = num_x
             .checked_mul(self.to_ref.0)?
@@ -390,12 +392,45 @@ impl PlaneSolver {
         let scale = 1i64.checked_shl(extra)?;
         let value = f0
             .checked_mul(scale)?
-            .checked_add(round_div_i64(to_ref.checked_mul(scale)?, area)?)?;
+            .checked_add(div.round_div(to_ref.checked_mul(scale)?)?)?;
         Some(Plane {
             value,
-            dx: round_div_i64(num_x.checked_mul(px)?, area)?,
-            dy: round_div_i64(num_y.checked_mul(px)?, area)?,
+            dx: div.round_div(num_x.checked_mul(px)?)?,
+            dy: div.round_div(num_y.checked_mul(px)?)?,
         })
+    }
+}
+
+/// [`round_div_i64`] by one divisor `d` several times (a plane's three quotients by its
+/// triangle's area): where `2d` fits 32 bits, one reciprocal ([`Divisor32`]) and multiplies
+/// for each quotient instead of a 64 / 32-bit division each. The same quotients (test
+/// `round_divisor_equals_round_div`).
+#[derive(Clone, Copy, Debug)]
+struct RoundDivisor {
+    d: i64,
+    by: Option<Divisor32>,
+}
+
+impl RoundDivisor {
+    /// The divisor `d` (`d < 1` is taken as 1).
+    #[inline]
+    fn new(d: i64) -> Self {
+        let d = d.max(1);
+        let by = d
+            .checked_mul(2)
+            .and_then(|d2| u32::try_from(d2).ok())
+            .map(Divisor32::new);
+        RoundDivisor { d, by }
+    }
+
+    /// `round_div_i64(n, d)`. Always inlined: as a call it measured slower on thumbv6m and
+    /// thumbv7em (docs/speed.md, item 10).
+    #[inline(always)]
+    fn round_div(&self, n: i64) -> Option<i64> {
+        match self.by {
+            Some(by) => Some(by.floor_div(n.checked_mul(2)?.checked_add(self.d)?)),
+            None => round_div_i64(n, self.d),
+        }
     }
 }
 
@@ -776,6 +811,71 @@ mod tests {
             let f = |v: u64| (v as i64) >> (v % 40 + 24);
             let (a, b, c, d) = (f(next()), f(next()), f(next()), f(next()));
             assert_eq!(cross_diff(a, b, c, d), wide(a, b, c, d), "{a} {b} {c} {d}");
+        }
+    }
+
+    /// One reciprocal of the area gives every quotient `round_div_i64` gives, `None` included.
+    #[test]
+    fn round_divisor_equals_round_div() {
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let areas = [
+            i64::MIN,
+            -1,
+            0,
+            1,
+            2,
+            3,
+            (1 << 31) - 1,
+            1 << 31,
+            (1 << 31) + 1,
+            i64::MAX / 2,
+            i64::MAX,
+        ];
+        let numerators = [
+            i64::MIN,
+            i64::MIN + 1,
+            i64::MIN / 2,
+            i64::MIN / 2 - 1,
+            -1,
+            0,
+            1,
+            i64::MAX / 2 - 1,
+            i64::MAX / 2,
+            i64::MAX / 2 + 1,
+            i64::MAX,
+        ];
+        let check = |n: i64, d: i64| {
+            assert_eq!(
+                RoundDivisor::new(d).round_div(n),
+                round_div_i64(n, d),
+                "{n} / {d}"
+            );
+        };
+        for d in areas {
+            for n in numerators {
+                check(n, d);
+                // Halves: numerators whose quotient is exactly k + ½ or just either side.
+                for k in [-3i64, 0, 5] {
+                    let half = k.wrapping_mul(d).wrapping_add(d / 2);
+                    for n in [half - 1, half, half + 1] {
+                        check(n, d);
+                    }
+                }
+            }
+        }
+        for _ in 0..200_000 {
+            // Twice an area from 1 to 2^33 (both sides of the reciprocal's limit), numerators
+            // of every size and sign.
+            let d = (next() >> (next() % 64).max(31)) as i64;
+            let n = (next() as i64) >> (next() % 64);
+            check(n, d);
+            check(n.wrapping_mul(d) / 2, d);
         }
     }
 

@@ -238,8 +238,9 @@ pub(crate) fn fill_span<P: RowPixel, S: Shading, Z: DepthFormat, K>(
     let span = SpanDepth { x0: l, y, q, dq };
     let (l, r) = (l as usize, r as usize);
     // One test for both rows (which then need none of their own), and slices of one length,
-    // so the fill's loop counts one of them.
-    if l < r && r <= depth.len() && r <= pixels.len() {
+    // so the fill's loop counts one of them. `walk_row` passes only non-empty spans (an empty
+    // one would fill nothing), so `l < r` is not tested again.
+    if r <= depth.len() && r <= pixels.len() {
         if let (Some(d), Some(p)) = (depth.get_mut(l..r), pixels.get_mut(l..r)) {
             return S::fill(&t.payload, span, d, p);
         }
