@@ -38,6 +38,9 @@ fn main() {
     // `examples/trace.rs` with `--cfg scanline3d_trace_only="pure"` renders that frame alone
     // (`cargo xtask profile trace` profiles each mode apart).
     println!("cargo::rustc-check-cfg=cfg(scanline3d_trace_only, values(\"pure\", \"hybrid\"))");
+    // `examples/hsr_table.rs` with `--cfg scanline3d_hsr_traced_only` runs the tracer's levels
+    // alone, without the rasterizers' table.
+    println!("cargo::rustc-check-cfg=cfg(scanline3d_hsr_traced_only)");
     if std::env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
         return;
     }

@@ -296,6 +296,8 @@ mod firmware {
         measure::calibrate()?;
         calibrate_long()?;
         println!("summary static_ram {}", measure::static_ram());
+        // `--cfg scanline3d_hsr_traced_only`: the tracer's levels alone (minutes less on QEMU).
+        #[cfg(not(scanline3d_hsr_traced_only))]
         hsr::for_each(&mut Table)?;
         trace_levels()
     }

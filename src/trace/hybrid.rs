@@ -12,7 +12,9 @@
 //! A ray through a pixel that hits an object meets it inside the object's padded box, whose
 //! projection contains the pixel centre up to the direction's rounding (below 2^-14 radians,
 //! far below the margin's pixels), so the candidates include every object the pure tracer
-//! could find: the first hit, and so the pixel, is the pure tracer's.
+//! could find: the first hit, and so the pixel, is the pure tracer's. Where many rectangles
+//! pile up (a dense mesh), a group of a row's columns walks the hierarchy instead, which finds
+//! the same first hit at less cost (`walk_groups`).
 //!
 //! Memory: `bounds` needs one [`ScreenBound`] (12 bytes) per visible object, `active` one per
 //! object spanning a row. When either is too small the rows concerned fall back to the pure
@@ -31,6 +33,48 @@ use fixed::types::{I16F16, I8F24};
 /// Pixels added on each side of a projected box: covers the truncation to whole pixels and the
 /// rounding of ray directions and of the projection (f32, relative error near 2^-20).
 pub const MARGIN: i32 = 2;
+
+/// Groups of columns a row is split into to choose each group's primary search.
+const GROUPS: usize = 16;
+/// Most active rectangles a row may have for its pixels to scan them: each pixel compares its
+/// column with every one (chosen by measuring the method table's traced meshes on thumbv7em;
+/// docs/tracing.md).
+const MAX_LIVE: usize = 128;
+/// Most rectangles reaching into a group of columns for its pixels to test the rectangles
+/// covering them rather than walk the hierarchy, whose front-to-back walk skips what lies
+/// behind the first hits (measured as [`MAX_LIVE`]).
+const MAX_COVER: u16 = 16;
+
+/// The group of columns column `x` of a row `width` pixels wide belongs to.
+fn group(x: u16, width: u16) -> usize {
+    usize::from(x) * GROUPS / usize::from(width.max(1))
+}
+
+/// Per group of columns of a row, whether its primary rays walk the hierarchy instead of
+/// testing the row's active rectangles `live` (always when the row could not be `scanned`);
+/// `None` when no group does (a row of at most [`MAX_COVER`] rectangles, such as the
+/// classic's, at no cost per pixel). Either search finds the same first hit; this only picks
+/// the cheaper one.
+fn walk_groups(live: &[ScreenBound], width: u16, scanned: bool) -> Option<[bool; GROUPS]> {
+    if !scanned || live.len() > MAX_LIVE {
+        return Some([true; GROUPS]);
+    }
+    if live.len() <= usize::from(MAX_COVER) {
+        return None;
+    }
+    let mut cover = [0u16; GROUPS];
+    for b in live {
+        for c in cover
+            .iter_mut()
+            .take(group(b.x1, width) + 1)
+            .skip(group(b.x0, width))
+        {
+            *c += 1;
+        }
+    }
+    let walk = cover.map(|c| c > MAX_COVER);
+    walk.contains(&true).then_some(walk)
+}
 
 /// The pixel rectangle an object may be seen in (inclusive bounds).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -569,15 +613,29 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             if scanned && row_lists.is_none() {
                 stats.shadow_fallback_rows += 1;
             }
-            for x in 0..self.camera().width {
-                if scanned && !live.iter().any(|b| b.x0 <= x && x <= b.x1) {
+            let width = self.camera().width;
+            let walk = walk_groups(live, width, scanned);
+            for x in 0..width {
+                if walk.is_some_and(|w| w.get(group(x, width)).copied().unwrap_or(true)) {
+                    let (p, mut s) =
+                        self.trace_with(x, y, &mut cache, row_lists, |ray, t_min, t_max, stats| {
+                            self.nearest(ray, u32::MAX, t_min, t_max, stats)
+                        });
+                    if scanned {
+                        s.walked_primary_rays = 1;
+                    }
+                    stats.add(&s);
+                    pixel(context, x, &p);
+                    continue;
+                }
+                if !live.iter().any(|b| b.x0 <= x && x <= b.x1) {
                     // No object can be seen here: the background, without the primary ray
                     // (which would have made no test and spawned nothing).
                     stats.primary_rays += 1;
                     pixel(context, x, &self.background_pixel(x, y));
                     continue;
                 }
-                let (p, s) = if scanned {
+                let (p, s) =
                     self.trace_with(x, y, &mut cache, row_lists, |ray, t_min, t_max, stats| {
                         let mut search = Nearest::new(u32::MAX, t_min, t_max);
                         for (i, b) in live.iter().enumerate() {
@@ -591,10 +649,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                             }
                         }
                         search.finish(stats)
-                    })
-                } else {
-                    self.trace_pixel_cached(x, y, &mut cache)
-                };
+                    });
                 stats.add(&s);
                 pixel(context, x, &p);
             }
@@ -797,5 +852,129 @@ mod tests {
             v(a.cos(), 0.0, a.sin())
         });
         assert!(!convex(&star, 1));
+    }
+
+    #[test]
+    fn groups_walk_where_rectangles_pile_up() {
+        let rect = |x0, x1| ScreenBound {
+            object: 0,
+            x0,
+            x1,
+            y0: 0,
+            y1: 0,
+        };
+        // 160 columns: groups of 10.
+        let mut live = [rect(0, 0); MAX_LIVE + 1];
+        for (i, b) in live.iter_mut().enumerate().take(usize::from(MAX_COVER) + 1) {
+            // Over groups 1 and 2, the last one over group 3 too.
+            *b = rect(
+                10 + i as u16 % 2,
+                25 + 10 * u16::from(i == usize::from(MAX_COVER)),
+            );
+        }
+        let some = usize::from(MAX_COVER) + 1;
+        let walk = walk_groups(&live[..some], 160, true).unwrap();
+        assert_eq!(walk[..4], [false, true, true, false]);
+        assert!(walk[4..].iter().all(|w| !w));
+        assert_eq!(walk_groups(&live[..some - 1], 160, true), None);
+        // Over the limit in number but spread out: no group walks.
+        let spread: [ScreenBound; 20] = core::array::from_fn(|i| rect(8 * i as u16, 8 * i as u16));
+        assert_eq!(walk_groups(&spread, 160, true), None);
+        assert_eq!(
+            walk_groups(&live, 160, true),
+            Some([true; GROUPS]),
+            "a long row"
+        );
+        assert_eq!(
+            walk_groups(&[], 160, false),
+            Some([true; GROUPS]),
+            "not scanned"
+        );
+        assert_eq!(group(159, 160), GROUPS - 1);
+    }
+
+    /// A pile of triangles on the left (its groups walk the hierarchy) and a few on the right
+    /// (tested from the rectangles), with a light: every pixel of the hybrid frame is the pure
+    /// tracer's, and both searches were taken.
+    #[test]
+    fn hybrid_frame_with_walked_groups_is_the_pure_frame() {
+        use crate::trace::bvh::{self, BvhNode};
+        use crate::trace::scene::Light;
+        use crate::trace::shape::Triangle;
+        let triangle = |x: f64, y: f64, z: f64, s: f64| Object {
+            shape: Shape::Triangle(
+                Triangle::new([v(x, y, z), v(x + s, y, z), v(x, y + s, z + 0.3)]).unwrap(),
+            ),
+            material: 0,
+        };
+        let mut objects = [triangle(0.0, 0.0, 0.0, 1.0); 24];
+        for (i, o) in objects.iter_mut().enumerate() {
+            let k = i as f64;
+            *o = if i < 20 {
+                // The pile: overlapping, at depths a tenth apart.
+                triangle(-2.5 + 0.05 * k, -1.0 + 0.04 * k, -0.1 * k, 1.5)
+            } else {
+                triangle(0.8 + 0.3 * (k - 20.0), -0.5, 0.5, 0.6)
+            };
+        }
+        let grey = Colour::new([I16F16::from_num(0.5); 3]).unwrap();
+        let materials = [Material::new(grey, [I16F16::ONE; 4], I16F16::ONE).unwrap()];
+        let lights = [Light::directional(v(0.3, 1.0, 0.6), I16F16::from_num(0.8)).unwrap()];
+        let node = BvhNode {
+            min: Vec3::ZERO,
+            max: Vec3::ZERO,
+            index: 0,
+            count: 0,
+            axis: 0,
+        };
+        let mut nodes = [node; 48];
+        let mut items = [0u32; 24];
+        let (n, m, bounded) = bvh::build(&objects, &mut nodes, &mut items).unwrap();
+        let scene = Scene::new(
+            &objects,
+            &materials,
+            &lights,
+            Colour::BLACK,
+            I16F16::ONE / 4,
+        )
+        .unwrap()
+        .with_bvh(&nodes[..n], &items[..m], bounded)
+        .unwrap();
+        let camera = TraceCamera::new(
+            [0.0, 0.0, 5.0],
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            60.0,
+            0.1,
+            100.0,
+            48,
+            32,
+        )
+        .unwrap();
+        let tracer = Tracer::<4>::new(&scene, &camera, TraceOptions::default());
+        let mut bounds = [ScreenBound::default(); 24];
+        let mut active = [ScreenBound::default(); 24];
+        let mut shadow = [ShadowCandidate::default(); 24];
+        let mut pixels = 0;
+        let stats = tracer
+            .hybrid_frame(
+                &mut bounds,
+                &mut active,
+                &mut shadow,
+                &mut pixels,
+                |pixels, x, p| {
+                    *pixels += 1;
+                    let y = (*pixels - 1) / 48;
+                    assert_eq!(*p, tracer.trace_pixel(x, y as u16).0, "({x}, {y})");
+                },
+                |_, _, _| Ok::<(), ()>(()),
+            )
+            .unwrap();
+        assert_eq!(pixels, 48 * 32);
+        assert_eq!(stats.fallback_rows, 0);
+        assert!(
+            stats.walked_primary_rays > 0 && stats.walked_primary_rays < stats.primary_rays / 2,
+            "{stats:?}"
+        );
     }
 }

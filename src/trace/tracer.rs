@@ -89,6 +89,9 @@ pub struct TraceStats {
     /// candidate lists, because the candidate buffer was full or a visible object is
     /// unbounded (same image, more work); rows counted in `fallback_rows` are not counted again.
     pub shadow_fallback_rows: u16,
+    /// Hybrid mode: primary rays that walked the hierarchy because their row, or their group of
+    /// columns, had more screen rectangles than scanning them pays for (same hit).
+    pub walked_primary_rays: u32,
     /// Most pending rays on the stack at once.
     pub peak_stack: u16,
     /// Rows handed to the sink.
@@ -113,6 +116,7 @@ impl TraceStats {
         self.shadow_cache_hits += o.shadow_cache_hits;
         self.fallback_rows += o.fallback_rows;
         self.shadow_fallback_rows += o.shadow_fallback_rows;
+        self.walked_primary_rays += o.walked_primary_rays;
         self.peak_stack = self.peak_stack.max(o.peak_stack);
     }
 }
@@ -432,7 +436,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
 
     /// The nearest object along `ray` (which starts on object `from`) with `t` in
     /// `[t_min, t_max)`.
-    fn nearest(
+    pub(crate) fn nearest(
         &self,
         ray: &Ray,
         from: u32,

@@ -214,7 +214,7 @@ fn sim_trace_renders_in_hybrid_mode() {
 
 /// The method table's traced scene (100 triangles, 240×240: about 7 s in debug): the hybrid
 /// variant gives the frame of the variant with shadows, as `cargo xtask hsr-table` and its
-/// firmware run them.
+/// firmware run them, with some groups of columns walking the hierarchy and some not.
 #[test]
 fn the_method_tables_hybrid_frame_is_the_shadow_frame() {
     use scanline3d_sim::hsr::traced::{self, Variant};
@@ -239,4 +239,10 @@ fn the_method_tables_hybrid_frame_is_the_shadow_frame() {
     let (hybrid, h) = frame(Variant::Hybrid);
     assert_eq!(shadows, hybrid);
     assert_eq!((s.rays(), h.fallback_rows), (h.rays(), 0));
+    // Both primary searches ran: the hierarchy's walk where the triangles' rectangles pile
+    // up, the rectangles elsewhere.
+    assert!(
+        h.walked_primary_rays > 0 && h.walked_primary_rays < h.primary_rays,
+        "{h:?}"
+    );
 }
