@@ -236,7 +236,7 @@ fn normalize_by(v: [i32; 3], len: i32) -> Option<[i32; 3]> {
 /// ⌊2^46 / `len`⌋ (1/length in 30 fraction bits for a raw I16F16 length) for `len` in
 /// [2^8, 2^31), without a 64-bit division. Above 2^14 (a length over 1/4, every direction the
 /// tracer normalises but the shortest) it is the exact quotient from two 16-bit digits of 32-bit
-/// divisions ([`div_rem_below`]: about half the instructions of [`reciprocal62`]'s Newton
+/// divisions (`math::div_rem_below`: about half the instructions of [`reciprocal62`]'s Newton
 /// steps). Below, `len` shifted to L in [2^30, 2^31), then [`reciprocal62`] scaled back by the
 /// shift: exact at 2^14; under it the low `k − 17` bits of 2^(45 + k) / L are zero, a relative
 /// error below 2^-25 (tested), far under the square root's 2^-15.
