@@ -445,8 +445,9 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         }
     }
 
-    /// The nearest object along `ray` (which starts on object `from`) with `t` in
-    /// `[t_min, t_max)`.
+    /// The nearest object along `ray` (which starts on object `from`; `u32::MAX` for a primary
+    /// ray) with `t` in `[t_min, t_max)`: through the scene's structure, except that a
+    /// reflected or refracted ray in a scene of at most [`FEW_OBJECTS`] tests every object.
     pub(crate) fn nearest(
         &self,
         ray: &Ray,
