@@ -617,14 +617,17 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             let walk = walk_groups(live, width, scanned);
             for x in 0..width {
                 if walk.is_some_and(|w| w.get(group(x, width)).copied().unwrap_or(true)) {
-                    let (p, mut s) =
-                        self.trace_with(x, y, &mut cache, row_lists, |ray, t_min, t_max, stats| {
-                            self.nearest(ray, u32::MAX, t_min, t_max, stats)
-                        });
+                    let p = self.trace_with(
+                        x,
+                        y,
+                        &mut cache,
+                        row_lists,
+                        &mut stats,
+                        |ray, t_min, t_max, stats| self.nearest(ray, u32::MAX, t_min, t_max, stats),
+                    );
                     if scanned {
-                        s.walked_primary_rays = 1;
+                        stats.walked_primary_rays += 1;
                     }
-                    stats.add(&s);
                     pixel(context, x, &p);
                     continue;
                 }
@@ -635,8 +638,13 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                     pixel(context, x, &self.background_pixel(x, y));
                     continue;
                 }
-                let (p, s) =
-                    self.trace_with(x, y, &mut cache, row_lists, |ray, t_min, t_max, stats| {
+                let p = self.trace_with(
+                    x,
+                    y,
+                    &mut cache,
+                    row_lists,
+                    &mut stats,
+                    |ray, t_min, t_max, stats| {
                         let mut search = Nearest::new(u32::MAX, t_min, t_max);
                         for (i, b) in live.iter().enumerate() {
                             if b.x0 <= x && x <= b.x1 {
@@ -649,8 +657,8 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                             }
                         }
                         search.finish(stats)
-                    });
-                stats.add(&s);
+                    },
+                );
                 pixel(context, x, &p);
             }
             row_done(context, y, stats.dropped_rays == dropped_before)?;

@@ -44,6 +44,12 @@ pub const DEFAULT_MAX_DEPTH: u8 = 4;
 /// Default weight threshold: a secondary ray whose weight is below 1/256 is not traced.
 pub const DEFAULT_THRESHOLD: I16F16 = I16F16::from_bits(1 << 8);
 
+/// Most objects a scene may have for its reflected and refracted rays to test every object
+/// instead of walking the hierarchy: the walk's set-up (the direction's reciprocals) and box
+/// tests cost more than a few object tests (the classic's 3 objects: docs/tracing.md). Either
+/// search finds the same hit (the nearest-hit rule does not depend on the order).
+const FEW_OBJECTS: usize = 4;
+
 /// The termination rules a frame uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TraceOptions {
@@ -289,8 +295,14 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         for y in 0..self.camera.height {
             let dropped_before = stats.dropped_rays;
             for (x, pixel) in (0..self.camera.width).zip(row.iter_mut()) {
-                let (p, s) = self.trace_pixel_cached(x, y, &mut cache);
-                stats.add(&s);
+                let p = self.trace_with(
+                    x,
+                    y,
+                    &mut cache,
+                    None,
+                    &mut stats,
+                    |ray, t_min, t_max, stats| self.nearest(ray, u32::MAX, t_min, t_max, stats),
+                );
                 *pixel = P::from_shade(p.colour, p.id.unwrap_or(u32::MAX));
             }
             sink.write_row(Row {
@@ -319,9 +331,16 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         row: u16,
         cache: &mut ShadowCache,
     ) -> (PixelTrace, TraceStats) {
-        self.trace_with(column, row, cache, None, |ray, t_min, t_max, stats| {
-            self.nearest(ray, u32::MAX, t_min, t_max, stats)
-        })
+        let mut stats = TraceStats::default();
+        let p = self.trace_with(
+            column,
+            row,
+            cache,
+            None,
+            &mut stats,
+            |ray, t_min, t_max, stats| self.nearest(ray, u32::MAX, t_min, t_max, stats),
+        );
+        (p, stats)
     }
 
     /// The scene traced.
@@ -338,19 +357,18 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     /// `[t_min, t_max)`; everything after the primary hit is the same for every mode, except
     /// that with `row_shadows` the shadow rays starting in the row's region (those from the
     /// primary hit, and from deeper hits that lie there) test the row's candidate lists instead
-    /// of walking the hierarchy (same answers).
+    /// of walking the hierarchy (same answers). The pixel's counts are added to `stats` (the
+    /// frame's, not a pixel's own: no per-pixel record to clear and add up).
     pub(crate) fn trace_with(
         &self,
         column: u16,
         row: u16,
         cache: &mut ShadowCache,
         row_shadows: Option<&RowShadows<'_>>,
+        stats: &mut TraceStats,
         mut first_hit: impl FnMut(&Ray, I16F16, I16F16, &mut TraceStats) -> Option<Hit>,
-    ) -> (PixelTrace, TraceStats) {
-        let mut stats = TraceStats {
-            primary_rays: 1,
-            ..TraceStats::default()
-        };
+    ) -> PixelTrace {
+        stats.primary_rays += 1;
         let mut out = PixelTrace {
             colour: Rgb888::new(0, 0, 0),
             id: None,
@@ -360,7 +378,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         };
         let raw = self.camera.pixel_direction(column, row);
         let Some((dir, len)) = raw.normalized_with_length() else {
-            return (out, stats);
+            return out;
         };
         // Eye depth = t / len (the raw direction has unit forward component).
         let primary = Ray {
@@ -385,22 +403,15 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         while let Some((ray, (t_min, t_max))) = next.take() {
             let is_primary = ray.depth == 0;
             let hit = if is_primary {
-                first_hit(&ray.ray, t_min, t_max, &mut stats)
+                first_hit(&ray.ray, t_min, t_max, stats)
             } else {
-                self.nearest(&ray.ray, ray.from, t_min, t_max, &mut stats)
+                self.nearest(&ray.ray, ray.from, t_min, t_max, stats)
             };
             match hit {
                 None => add_weighted(&mut sum, &self.scene.background, ray.weight),
                 Some(hit) => {
-                    let (shadow, material) = self.shade(
-                        &ray,
-                        hit,
-                        &mut sum,
-                        &mut stack,
-                        cache,
-                        row_shadows,
-                        &mut stats,
-                    );
+                    let (shadow, material) =
+                        self.shade(&ray, hit, &mut sum, &mut stack, cache, row_shadows, stats);
                     if is_primary {
                         out.id = Some(hit.object);
                         out.depth = hit.t.checked_div(len).unwrap_or(I16F16::MAX);
@@ -413,7 +424,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             next = stack.pop().map(|p| (p, (EPSILON, I16F16::MAX)));
         }
         out.colour = to_rgb888(&sum);
-        (out, stats)
+        out
     }
 
     /// What [`trace_with`](Self::trace_with) gives pixel (`column`, `row`) when its primary ray
@@ -434,8 +445,9 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         }
     }
 
-    /// The nearest object along `ray` (which starts on object `from`) with `t` in
-    /// `[t_min, t_max)`.
+    /// The nearest object along `ray` (which starts on object `from`; `u32::MAX` for a primary
+    /// ray) with `t` in `[t_min, t_max)`: through the scene's structure, except that a
+    /// reflected or refracted ray in a scene of at most [`FEW_OBJECTS`] tests every object.
     pub(crate) fn nearest(
         &self,
         ray: &Ray,
@@ -456,12 +468,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                     Some(search.offer(scene, id, ray))
                 });
             }
-            (None, None) => {
-                for id in 0..scene.objects.len() as u32 {
-                    search.offer(scene, id, ray);
-                }
-            }
-            (None, Some(bvh)) => {
+            (None, Some(bvh)) if from == u32::MAX || scene.objects.len() > FEW_OBJECTS => {
                 for id in bvh.unbounded() {
                     search.offer(scene, *id, ray);
                 }
@@ -469,6 +476,12 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 stats.box_tests += bvh.walk(ray, t_min, limit, |id, _| {
                     Some(search.offer(scene, id, ray))
                 });
+            }
+            // No structure, or a reflected or refracted ray in a scene of a few objects.
+            (None, _) => {
+                for id in 0..scene.objects.len() as u32 {
+                    search.offer(scene, id, ray);
+                }
             }
         }
         search.finish(stats)
@@ -1038,6 +1051,102 @@ mod tests {
             refract(v(0.0, -1.0, 0.0), n, I16F16::ONE, glass),
             Some(v(0.0, -1.0, 0.0))
         );
+    }
+
+    /// In a scene of a few objects a reflected or refracted ray tests every object instead of
+    /// walking the hierarchy: the same nearest hit as the walk, from every object's surface.
+    #[test]
+    fn few_objects_find_the_walks_hit() {
+        use crate::trace::bvh::{self, BvhNode};
+        let floor = [
+            v(-4.0, 0.0, -4.0),
+            v(-4.0, 0.0, 4.0),
+            v(4.0, 0.0, 4.0),
+            v(4.0, 0.0, -4.0),
+        ];
+        let objects = [
+            Object {
+                shape: Shape::Sphere(Sphere::new(v(-1.1, 1.0, -0.5), f(1.0)).unwrap()),
+                material: 0,
+            },
+            Object {
+                shape: Shape::Sphere(Sphere::new(v(1.2, 0.9, 1.0), f(0.9)).unwrap()),
+                material: 0,
+            },
+            Object {
+                shape: Shape::Polygon(Polygon::new(&floor).unwrap()),
+                material: 0,
+            },
+        ];
+        assert!(objects.len() <= FEW_OBJECTS);
+        let node = BvhNode {
+            min: Vec3::ZERO,
+            max: Vec3::ZERO,
+            index: 0,
+            count: 0,
+            axis: 0,
+        };
+        let (mut nodes, mut items) = ([node; 8], [0u32; 3]);
+        let (n, m, bounded) = bvh::build(&objects, &mut nodes, &mut items).unwrap();
+        let materials = [material(0.5, 0.5)];
+        let scene = Scene::new(&objects, &materials, &[], Colour::BLACK, f(0.5))
+            .unwrap()
+            .with_bvh(&nodes[..n], &items[..m], bounded)
+            .unwrap();
+        let camera = TraceCamera::new(
+            [0.0, 3.0, 7.0],
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            50.0,
+            0.1,
+            100.0,
+            1,
+            1,
+        )
+        .unwrap();
+        let tracer = Tracer::<5>::new(&scene, &camera, TraceOptions::default());
+        let bvh = scene.bvh.as_ref().unwrap();
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 40) as f32 / (1u32 << 24) as f32 * 2.0 - 1.0
+        };
+        let mut hits = 0;
+        for k in 0..20_000 {
+            let from = k % 3;
+            // A point on object `from`'s surface (the floor's, or a sphere's along a direction).
+            let origin = match from {
+                2 => v(4.0 * next(), 0.0, 4.0 * next()),
+                _ => {
+                    let Shape::Sphere(s) = objects[from as usize].shape else {
+                        unreachable!()
+                    };
+                    let d = v(next(), next(), next()).normalized().unwrap();
+                    s.centre.along(d, s.radius)
+                }
+            };
+            let Some(dir) = v(next(), next(), next()).normalized() else {
+                continue;
+            };
+            let ray = Ray { origin, dir };
+            let mut stats = TraceStats::default();
+            let few = tracer.nearest(&ray, from, EPSILON, I16F16::MAX, &mut stats);
+            assert_eq!((stats.box_tests, stats.intersection_tests), (0, 3));
+            let mut walk = Nearest::new(from, EPSILON, I16F16::MAX);
+            bvh.walk(&ray, EPSILON, I16F16::MAX, |id, _| {
+                Some(walk.offer(&scene, id, &ray))
+            });
+            let walked = walk.finish(&mut stats);
+            assert_eq!(
+                few.map(|h| (h.t, h.object)),
+                walked.map(|h| (h.t, h.object)),
+                "{ray:?} from {from}"
+            );
+            hits += usize::from(few.is_some());
+        }
+        assert!(hits > 5_000, "{hits}");
     }
 
     #[test]
