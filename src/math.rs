@@ -151,7 +151,7 @@ fn mul_i64_u16_in_words(a: i64, b: u16) -> i64 {
 /// every target.
 pub(crate) fn cosine_i64(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
     // |s_i| <= 2^30: each fits `i32`, so the products below are 32 × 32 → 64 bits.
-    let s = fit_bits(v, 30)?.map(|c| c as i32);
+    let s = fit_bits(v, 30)?;
     let len = isqrt_u64(s.iter().map(|&c| mul_wide(c, c) as u64).sum());
     if len == 0 {
         return None;
@@ -177,7 +177,7 @@ pub(crate) fn cosine_i64(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
 /// `Dh·2^14 / (r+1) = (Dh / r)·2^14 − (Dh / r)·2^14 / (r+1) > A·2^14 − (A+1)`.
 /// Test `lambert_bounds_hold`.
 pub(crate) fn lambert_bounds_i64(v: [i64; 3], unit: [i32; 3]) -> Option<(i32, i32)> {
-    let s = fit_bits(v, 30)?.map(|c| c as i32);
+    let s = fit_bits(v, 30)?;
     let dot: i64 = (0..3).map(|k| mul_wide(s[k], unit[k])).sum();
     if dot <= 0 {
         return Some((0, 0));
@@ -537,10 +537,16 @@ fn isqrt_u62(n: u64) -> u64 {
 }
 
 /// `v` shifted (left or right, the same for every component) so that its largest component
-/// has exactly `bits` significant bits (`2^(bits-1) <= max |c| <= 2^bits`); `None` for the zero
-/// vector. Scaling small vectors up keeps the integer square root of `|v|²`, which truncates,
-/// within a relative 2^(1-bits) of the true length.
-pub(crate) fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i64; 3]> {
+/// has exactly `bits` significant bits (`2^(bits-1) <= max |c| <= 2^bits`), for `bits <= 30`;
+/// `None` for the zero vector. Scaling small vectors up keeps the integer square root of
+/// `|v|²`, which truncates, within a relative 2^(1-bits) of the true length.
+///
+/// The components fit `i32`, so both shifts are taken there: a right shift keeps only the low
+/// word of the 64-bit one, and a left shift starts from a component below 2^bits (test
+/// `fit_bits_equals_the_64_bit_shifts`).
+#[inline]
+pub(crate) fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i32; 3]> {
+    debug_assert!(bits <= 30, "fit_bits to {bits} bits");
     // The or of the magnitudes has the largest one's length, for less than their maximum.
     let max = v.iter().fold(0, |m, c| m | c.unsigned_abs());
     if max == 0 {
@@ -548,9 +554,13 @@ pub(crate) fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i64; 3]> {
     }
     let len = 64 - max.leading_zeros();
     Some(if len > bits {
-        v.map(|c| c >> (len - bits))
+        // |c >> s| <= 2^bits.
+        let s = len - bits;
+        v.map(|c| (c >> s) as i32)
     } else {
-        v.map(|c| c << (bits - len))
+        // |c| < 2^len <= 2^bits, and so is the result.
+        let s = bits - len;
+        v.map(|c| (c as i32) << s)
     })
 }
 
@@ -606,7 +616,7 @@ impl NormalPrecision for NarrowNormals {
 /// has 15 bits (so `|v|²` is below `3 · 2^30`, a `u32`) and `unit` is taken to 15 bits. The result
 /// is in I2F30 bits with its low 15 bits zero.
 pub(crate) fn cosine_i32(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
-    let s = fit_bits(v, 15)?.map(|c| c as i32);
+    let s = fit_bits(v, 15)?;
     let len = s.iter().map(|&c| (c * c) as u32).sum::<u32>().isqrt();
     if len == 0 {
         return None;
@@ -816,6 +826,55 @@ mod tests {
             // Divisors of the depth plane (twice a triangle's area) and the projection (2w).
             let small = ((x >> 33) as u32 % (1 << ((x >> 1) % 24 + 1))).max(1) * 2;
             check(x >> (x % 64), &Divisor32::new(small), small);
+        }
+    }
+
+    /// `fit_bits` gives the components the 64-bit shifts it replaced gave: every length of
+    /// the largest component (powers of two and their neighbours, either sign, each in any
+    /// place), and random vectors, to 15 and 30 bits.
+    #[test]
+    fn fit_bits_equals_the_64_bit_shifts() {
+        let wide = |v: [i64; 3], bits: u32| -> Option<[i32; 3]> {
+            let max = v.iter().fold(0, |m, c| m | c.unsigned_abs());
+            if max == 0 {
+                return None;
+            }
+            let len = 64 - max.leading_zeros();
+            let v = if len > bits {
+                v.map(|c| c >> (len - bits))
+            } else {
+                v.map(|c| c << (bits - len))
+            };
+            Some(v.map(|c| c as i32))
+        };
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for bits in [15, 30] {
+            assert_eq!(fit_bits([0; 3], bits), None);
+            for k in 0..63 {
+                for m in [(1i64 << k) - 1, 1 << k, (1 << k) + 1] {
+                    for m in [m, -m, i64::MIN, i64::MAX] {
+                        for v in [
+                            [m, 0, 0],
+                            [1, m, -1],
+                            [-3, 5, m],
+                            [m, m, m],
+                            [m, m.wrapping_neg(), m >> 1],
+                        ] {
+                            assert_eq!(fit_bits(v, bits), wide(v, bits), "{v:?} to {bits}");
+                        }
+                    }
+                }
+            }
+            for _ in 0..300_000 {
+                let v = [0; 3].map(|_| (next() as i64) >> (next() % 64));
+                assert_eq!(fit_bits(v, bits), wide(v, bits), "{v:?} to {bits}");
+            }
         }
     }
 

@@ -348,7 +348,7 @@ impl Lighting {
     /// sum below 3 · 2^60. No normalization here: the cosine divides by the length once.
     fn normal_to_world(&self, n: [i64; 3]) -> Option<[i64; 3]> {
         // |n_k| <= 2^30 fits `i32`: 32 × 32 → 64-bit products.
-        let n = fit_bits(n, 30)?.map(|c| c as i32);
+        let n = fit_bits(n, 30)?;
         Some(
             self.normal_matrix
                 .map(|row| (0..3).map(|k| mul_wide(row[k], n[k])).sum()),

@@ -250,7 +250,7 @@ impl TangentColumn {
             if largest < 1 << 18 {
                 return None;
             }
-            fit_bits(t, 30)
+            fit_bits(t, 30).map(|t| t.map(i64::from))
         };
         let (a, b) = (tangent(hu)?, tangent(hv)?);
         let n = [
