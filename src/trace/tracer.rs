@@ -44,10 +44,11 @@ pub const DEFAULT_MAX_DEPTH: u8 = 4;
 /// Default weight threshold: a secondary ray whose weight is below 1/256 is not traced.
 pub const DEFAULT_THRESHOLD: I16F16 = I16F16::from_bits(1 << 8);
 
-/// Most objects a scene may have for its reflected and refracted rays to test every object
-/// instead of walking the hierarchy: the walk's set-up (the direction's reciprocals) and box
-/// tests cost more than a few object tests (the classic's 3 objects: docs/tracing.md). Either
-/// search finds the same hit (the nearest-hit rule does not depend on the order).
+/// Most objects a scene may have for every ray (primary, reflected, refracted, shadow) to test
+/// every object instead of walking the hierarchy: the walk's set-up (the direction's
+/// reciprocals) and box tests cost more than a few object tests (the classic's 3 objects:
+/// docs/tracing.md). Either search finds the same hit (the nearest-hit rule does not depend on
+/// the order) and the same blocker or none.
 const FEW_OBJECTS: usize = 4;
 
 /// The termination rules a frame uses.
@@ -468,7 +469,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                     Some(search.offer(scene, id, ray))
                 });
             }
-            (None, Some(bvh)) if from == u32::MAX || scene.objects.len() > FEW_OBJECTS => {
+            (None, Some(bvh)) if scene.objects.len() > FEW_OBJECTS => {
                 for id in bvh.unbounded() {
                     search.offer(scene, *id, ray);
                 }
@@ -477,7 +478,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                     Some(search.offer(scene, id, ray))
                 });
             }
-            // No structure, or a reflected or refracted ray in a scene of a few objects.
+            // No structure, or a scene of a few objects.
             (None, _) => {
                 for id in 0..scene.objects.len() as u32 {
                     search.offer(scene, id, ray);
@@ -551,15 +552,15 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                     });
                 }
             }
-            (None, None, None) => {
-                let _ = (0..self.scene.objects.len() as u32).any(&mut blocks);
-            }
-            (None, None, Some(bvh)) => {
+            (None, None, Some(bvh)) if self.scene.objects.len() > FEW_OBJECTS => {
                 if !bvh.unbounded().iter().any(|id| blocks(*id)) {
                     stats.box_tests += bvh.walk(ray, EPSILON, t_max, |id, limit| {
                         (!blocks(id)).then_some(limit)
                     });
                 }
+            }
+            (None, None, _) => {
+                let _ = (0..self.scene.objects.len() as u32).any(&mut blocks);
             }
         }
         stats.intersection_tests += tests;
