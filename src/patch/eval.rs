@@ -20,11 +20,23 @@ use fixed::types::I16F16;
 pub(crate) type Hom = [i64; 4];
 
 /// `a + (b − a)·t` for a parameter `t` in [0, 1] (I16F16 bits), rounded to nearest: exact
-/// at `t = 0` and `t = 1`.
+/// at `t = 0` and `t = 1`. Only the first `LANES` components are computed, the rest are `a`'s:
+/// with 3, callers interpolate between equal weights, which the formula maps to themselves.
 #[inline(always)]
-fn lerp(a: Hom, b: Hom, t: u32) -> Hom {
+fn lerp<const LANES: usize>(a: Hom, b: Hom, t: u32) -> Hom {
     let t = t as i64;
-    [0, 1, 2, 3].map(|k| a[k] + (((b[k] - a[k]) * t + (1 << 15)) >> 16))
+    let mut out = a;
+    for ((o, &a), &b) in out.iter_mut().zip(&a).zip(&b).take(LANES) {
+        *o = a + (((b - a) * t + (1 << 15)) >> 16);
+    }
+    out
+}
+
+/// Whether the cubic `q` has one weight throughout (every curve of a polynomial patch): then
+/// every de Casteljau step keeps that weight, and three lanes of work give the same bits.
+#[inline(always)]
+fn one_weight(q: &[Hom; 4]) -> bool {
+    q.iter().all(|p| p[3] == q[0][3])
 }
 
 /// The blossom `f(t₀, t₁, t₂)` of the cubic with control points `q`: de Casteljau with a
@@ -33,39 +45,69 @@ fn lerp(a: Hom, b: Hom, t: u32) -> Hom {
 /// `[a, b]`.
 #[inline]
 fn blossom(q: [Hom; 4], t: [u32; 3]) -> Hom {
+    if one_weight(&q) {
+        blossom_in::<3>(q, t)
+    } else {
+        blossom_in::<4>(q, t)
+    }
+}
+
+/// [`blossom`] in `LANES` lanes.
+#[inline(always)]
+fn blossom_in<const LANES: usize>(q: [Hom; 4], t: [u32; 3]) -> Hom {
     let [a, b, c, d] = q;
-    let (ab, bc, cd) = (lerp(a, b, t[0]), lerp(b, c, t[0]), lerp(c, d, t[0]));
-    let (abc, bcd) = (lerp(ab, bc, t[1]), lerp(bc, cd, t[1]));
-    lerp(abc, bcd, t[2])
+    let l = lerp::<LANES>;
+    let (ab, bc, cd) = (l(a, b, t[0]), l(b, c, t[0]), l(c, d, t[0]));
+    let (abc, bcd) = (l(ab, bc, t[1]), l(bc, cd, t[1]));
+    l(abc, bcd, t[2])
 }
 
 /// The control points of the piece of cubic `q` over `[a, b]`: the blossoms at `(a,a,a)`,
 /// `(a,a,b)`, `(a,b,b)`, `(b,b,b)`, bit for bit as [`blossom`] computes them, with the
 /// de Casteljau steps they have in common done once (16 interpolations instead of 24).
 #[inline]
-fn sub_curve(q: [Hom; 4], [a, b]: [u32; 2]) -> [Hom; 4] {
+fn sub_curve(q: [Hom; 4], ab: [u32; 2]) -> [Hom; 4] {
+    if one_weight(&q) {
+        sub_curve_in::<3>(q, ab)
+    } else {
+        sub_curve_in::<4>(q, ab)
+    }
+}
+
+/// [`sub_curve`] in `LANES` lanes.
+#[inline(always)]
+fn sub_curve_in<const LANES: usize>(q: [Hom; 4], [a, b]: [u32; 2]) -> [Hom; 4] {
     let [p0, p1, p2, p3] = q;
-    let (ab, bc, cd) = (lerp(p0, p1, a), lerp(p1, p2, a), lerp(p2, p3, a));
-    let (abc, bcd) = (lerp(ab, bc, a), lerp(bc, cd, a));
-    let (abc_b, bcd_b) = (lerp(ab, bc, b), lerp(bc, cd, b));
+    let l = lerp::<LANES>;
+    let (ab, bc, cd) = (l(p0, p1, a), l(p1, p2, a), l(p2, p3, a));
+    let (abc, bcd) = (l(ab, bc, a), l(bc, cd, a));
+    let (abc_b, bcd_b) = (l(ab, bc, b), l(bc, cd, b));
     [
-        lerp(abc, bcd, a),
-        lerp(abc, bcd, b),
-        lerp(abc_b, bcd_b, b),
-        blossom(q, [b; 3]),
+        l(abc, bcd, a),
+        l(abc, bcd, b),
+        l(abc_b, bcd_b, b),
+        blossom_in::<LANES>(q, [b; 3]),
     ]
 }
 
 /// The point at `t` of the cubic `q` and its derivative `q'(t)`.
 #[inline]
 fn point_and_tangent(q: [Hom; 4], t: u32) -> (Hom, Hom) {
+    if one_weight(&q) {
+        point_and_tangent_in::<3>(q, t)
+    } else {
+        point_and_tangent_in::<4>(q, t)
+    }
+}
+
+/// [`point_and_tangent`] in `LANES` lanes (the derivative's weight, a difference, in all four).
+#[inline(always)]
+fn point_and_tangent_in<const LANES: usize>(q: [Hom; 4], t: u32) -> (Hom, Hom) {
     let [a, b, c, d] = q;
-    let (ab, bc, cd) = (lerp(a, b, t), lerp(b, c, t), lerp(c, d, t));
-    let (abc, bcd) = (lerp(ab, bc, t), lerp(bc, cd, t));
-    (
-        lerp(abc, bcd, t),
-        [0, 1, 2, 3].map(|k| 3 * (bcd[k] - abc[k])),
-    )
+    let l = lerp::<LANES>;
+    let (ab, bc, cd) = (l(a, b, t), l(b, c, t), l(c, d, t));
+    let (abc, bcd) = (l(ab, bc, t), l(bc, cd, t));
+    (l(abc, bcd, t), [0, 1, 2, 3].map(|k| 3 * (bcd[k] - abc[k])))
 }
 
 /// The point at `t` of a boundary curve, computed the same way whichever end the caller
@@ -324,6 +366,44 @@ mod tests {
             let e = [-y, -x, 1.0];
             let cos = (n[0] * e[0] + n[1] * e[1] + n[2] * e[2]) / (len(n) * len(e));
             assert!(cos > 0.9999, "{u} {v}: {cos}");
+        }
+    }
+
+    #[test]
+    fn three_lanes_give_the_four_lanes_bits() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |bits: u32| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> (64 - bits)) as i64 - (1 << (bits - 1))
+        };
+        // Components below 2^32 bits, weights 1/16 to 16 (2^12 to 2^20 bits).
+        let extremes = [-(1i64 << 32) + 1, -1, 0, 1, (1 << 32) - 1];
+        for case in 0..20_000 {
+            let w = (next(21) + (1 << 20)).clamp(1 << 12, 1 << 20);
+            let mut c = |k: usize| match case % 4 {
+                0 => extremes[(k + case / 4) % extremes.len()],
+                _ => next(33),
+            };
+            let q: [Hom; 4] = [0, 1, 2, 3].map(|j| [c(j), c(j + 1), c(j + 2), w]);
+            let t = (next(18) + (1 << 17)).clamp(0, 1 << 16) as u32;
+            for t in [t, 0, 1, 32768, 65535, 65536] {
+                let ts = [t, t / 2, PARAM_ONE - t];
+                assert_eq!(blossom_in::<3>(q, ts), blossom_in::<4>(q, ts), "{q:?} {t}");
+                assert_eq!(blossom(q, ts), blossom_in::<4>(q, ts));
+                let ab = [t / 3, t];
+                assert_eq!(sub_curve(q, ab), sub_curve_in::<4>(q, ab), "{q:?} {t}");
+                let (p, d) = point_and_tangent(q, t);
+                assert_eq!((p, d), point_and_tangent_in::<4>(q, t), "{q:?} {t}");
+                // A derivative curve's weights are all 0.
+                let dq = q.map(|p| [p[0], p[1], p[2], 0]);
+                assert_eq!(blossom(dq, ts), blossom_in::<4>(dq, ts));
+                // Rational: the four-lane path.
+                let mut r = q;
+                r[2][3] += 1;
+                assert_eq!(blossom(r, ts), blossom_in::<4>(r, ts));
+            }
         }
     }
 
