@@ -8,7 +8,7 @@
 //! (about 100 for flat shading).
 //! See [`PatchWorkspace::BYTES`].
 
-use super::eval::{dehomogenize, Hom, Net};
+use super::eval::{dehomogenize, Column, Hom, Net, TangentColumn};
 use super::tessellate::{self, Levels, ScreenNet, Uv};
 use super::trim::{self, Cut};
 use super::{PatchModel, Tolerance};
@@ -642,24 +642,29 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         let v = |j: u8| tessellate::grid(j as u32, levels.v);
         let at = |i: u8, j: u8| [u(i), v(j)];
         // Interior points only (0 < u, v < 1), where `Net::point` evaluates on columns too.
-        let columns = (is[0]..=is[1]).map(|i| {
-            (
-                net.column(u(i)),
-                S::PER_VERTEX.then(|| net.tangent_column(u(i))),
-            )
-        });
-        let columns: Vec<_, { BLOCK + 1 }> = gather(columns);
-        let centres = (is[0]..is[1])
-            .map(|i| (!S::PER_VERTEX).then(|| net.tangent_column((u(i) + u(i + 1)) / 2)));
-        let centres: Vec<_, BLOCK> = gather(centres);
+        // Each column pushed as made: written once, not copied through an iterator.
+        let mut columns: Vec<Column, { BLOCK + 1 }> = Vec::new();
+        // Gouraud: tangents along each column, for vertex normals; flat: along each column
+        // of cell centres, for face normals.
+        let mut tangents: Vec<TangentColumn, { BLOCK + 1 }> = Vec::new();
+        let mut centres: Vec<TangentColumn, BLOCK> = Vec::new();
+        // (Room for the block's columns: the pushes never fail.)
+        for i in is[0]..=is[1] {
+            let _ = columns.push(net.column(u(i)));
+            if S::PER_VERTEX {
+                let _ = tangents.push(net.tangent_column(u(i)));
+            } else if i < is[1] {
+                let _ = centres.push(net.tangent_column((u(i) + u(i + 1)) / 2));
+            }
+        }
         // Row `j`'s points, written in place (rows of vertices are not copied).
         let points = |this: &Self, row: &mut Vec<Vertex, { BLOCK + 1 }>, j: u8| {
             row.clear();
-            for ((column, tangents), i) in columns.iter().zip(is[0]..=is[1]) {
-                let n = tangents
-                    .as_ref()
-                    .map(|t| t.normal(v(j)).or_else(|| net.normal(u(i), v(j))));
-                // Room for the block's columns: never fails.
+            for (k, (column, i)) in columns.iter().zip(is[0]..=is[1]).enumerate() {
+                let n = S::PER_VERTEX.then(|| {
+                    let t = tangents.get(k).and_then(|t| t.normal(v(j)));
+                    t.or_else(|| net.normal(u(i), v(j)))
+                });
                 let _ = row.push(this.vertex_at::<S>(patch, column.point(v(j)), n));
             }
         };
@@ -669,7 +674,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         points(self, below, js[0]);
         for j in js[0]..js[1] {
             points(self, above, j + 1);
-            for ((k, i), centre) in (is[0]..is[1]).enumerate().zip(&centres) {
+            for (k, i) in (is[0]..is[1]).enumerate() {
                 let (Some(a), Some(b), Some(c), Some(d)) = (
                     below.get(k),
                     below.get(k + 1),
@@ -679,7 +684,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                     break;
                 };
                 let corners = [a, b, c, d];
-                let face = match centre {
+                let face = match centres.get(k) {
                     Some(t) => {
                         let (uc, vc) = ((u(i) + u(i + 1)) / 2, (v(j) + v(j + 1)) / 2);
                         self.lit(patch, t.normal(vc).or_else(|| net.normal(uc, vc)))
@@ -891,17 +896,6 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize> RowPieces<SU
             }
         }
     }
-}
-
-/// The first `N` items of `items` (callers pass at most `N`), without `collect`'s panic
-/// when there are more.
-fn gather<T, const N: usize>(items: impl Iterator<Item = T>) -> Vec<T, N> {
-    let mut out = Vec::new();
-    for item in items.take(N) {
-        // Room for `N`: never fails.
-        let _ = out.push(item);
-    }
-    out
 }
 
 /// Something with a value for each side of the surface.
