@@ -19,24 +19,55 @@ use fixed::types::I16F16;
 /// A homogeneous point `(ω·x, ω·y, ω·z, ω)`, each component I48F16 bits in an `i64`.
 pub(crate) type Hom = [i64; 4];
 
-/// `a + (b − a)·t` for a parameter `t` in [0, 1] (I16F16 bits), rounded to nearest: exact
-/// at `t = 0` and `t = 1`. Only the first `LANES` components are computed, the rest are `a`'s:
-/// with 3, callers interpolate between equal weights, which the formula maps to themselves.
-#[inline(always)]
-fn lerp<const LANES: usize>(a: Hom, b: Hom, t: u32) -> Hom {
-    let t = t as i64;
-    let mut out = a;
-    for ((o, &a), &b) in out.iter_mut().zip(&a).zip(&b).take(LANES) {
-        *o = a + (((b - a) * t + (1 << 15)) >> 16);
-    }
-    out
+/// What de Casteljau interpolates: the coordinate lanes of homogeneous points, or weights.
+trait Lerp: Copy {
+    /// `a + (b − a)·t` for a parameter `t` in [0, 1] (I16F16 bits), rounded to nearest:
+    /// exact at `t = 0` and `t = 1`.
+    fn lerp(self, b: Self, t: u32) -> Self;
+    /// `3·(b − a)`: a cubic's derivative from its last de Casteljau pair.
+    fn slope(self, b: Self) -> Self;
 }
 
-/// Whether the cubic `q` has one weight throughout (every curve of a polynomial patch): then
-/// every de Casteljau step keeps that weight, and three lanes of work give the same bits.
+/// The formula, one lane.
 #[inline(always)]
-fn one_weight(q: &[Hom; 4]) -> bool {
-    q.iter().all(|p| p[3] == q[0][3])
+fn lerp(a: i64, b: i64, t: u32) -> i64 {
+    a + (((b - a) * t as i64 + (1 << 15)) >> 16)
+}
+
+/// Weights alone.
+impl Lerp for i64 {
+    #[inline(always)]
+    fn lerp(self, b: i64, t: u32) -> i64 {
+        lerp(self, b, t)
+    }
+    #[inline(always)]
+    fn slope(self, b: i64) -> i64 {
+        3 * (b - self)
+    }
+}
+
+/// The three coordinate lanes only; the weight lane is `self`'s, carried unchanged. The lanes
+/// are independent, so the callers below take weights from the curve's one weight (which
+/// every step keeps: a polynomial patch's curves) or interpolate them alone.
+impl Lerp for Hom {
+    #[inline(always)]
+    fn lerp(self, b: Hom, t: u32) -> Hom {
+        let [x, y, z, w] = self;
+        [lerp(x, b[0], t), lerp(y, b[1], t), lerp(z, b[2], t), w]
+    }
+    #[inline(always)]
+    fn slope(self, b: Hom) -> Hom {
+        [0, 1, 2, 3].map(|k| 3 * (b[k] - self[k]))
+    }
+}
+
+/// The weights of cubic `q`, or `None` if it has one weight throughout (then every
+/// de Casteljau step keeps it, and [`Lerp`] for [`Hom`] carries it: three lanes of work).
+#[inline(always)]
+fn weights(q: &[Hom; 4]) -> Option<[i64; 4]> {
+    let [a, b, c, d] = q.map(|p| p[3]);
+    // (Compared lane by lane: an array comparison calls `memcmp`.)
+    (a != b || a != c || a != d).then_some([a, b, c, d])
 }
 
 /// The blossom `f(t₀, t₁, t₂)` of the cubic with control points `q`: de Casteljau with a
@@ -45,21 +76,20 @@ fn one_weight(q: &[Hom; 4]) -> bool {
 /// `[a, b]`.
 #[inline]
 fn blossom(q: [Hom; 4], t: [u32; 3]) -> Hom {
-    if one_weight(&q) {
-        blossom_in::<3>(q, t)
-    } else {
-        blossom_in::<4>(q, t)
+    let mut p = blossom_of(q, t);
+    if let Some(w) = weights(&q) {
+        p[3] = blossom_of(w, t);
     }
+    p
 }
 
-/// [`blossom`] in `LANES` lanes.
+/// [`blossom`] of [`Lerp`] values.
 #[inline(always)]
-fn blossom_in<const LANES: usize>(q: [Hom; 4], t: [u32; 3]) -> Hom {
+fn blossom_of<L: Lerp>(q: [L; 4], t: [u32; 3]) -> L {
     let [a, b, c, d] = q;
-    let l = lerp::<LANES>;
-    let (ab, bc, cd) = (l(a, b, t[0]), l(b, c, t[0]), l(c, d, t[0]));
-    let (abc, bcd) = (l(ab, bc, t[1]), l(bc, cd, t[1]));
-    l(abc, bcd, t[2])
+    let (ab, bc, cd) = (a.lerp(b, t[0]), b.lerp(c, t[0]), c.lerp(d, t[0]));
+    let (abc, bcd) = (ab.lerp(bc, t[1]), bc.lerp(cd, t[1]));
+    abc.lerp(bcd, t[2])
 }
 
 /// The control points of the piece of cubic `q` over `[a, b]`: the blossoms at `(a,a,a)`,
@@ -67,47 +97,47 @@ fn blossom_in<const LANES: usize>(q: [Hom; 4], t: [u32; 3]) -> Hom {
 /// de Casteljau steps they have in common done once (16 interpolations instead of 24).
 #[inline]
 fn sub_curve(q: [Hom; 4], ab: [u32; 2]) -> [Hom; 4] {
-    if one_weight(&q) {
-        sub_curve_in::<3>(q, ab)
-    } else {
-        sub_curve_in::<4>(q, ab)
+    let mut s = sub_curve_of(q, ab);
+    if let Some(w) = weights(&q) {
+        for (p, w) in s.iter_mut().zip(sub_curve_of(w, ab)) {
+            p[3] = w;
+        }
     }
+    s
 }
 
-/// [`sub_curve`] in `LANES` lanes.
+/// [`sub_curve`] of [`Lerp`] values.
 #[inline(always)]
-fn sub_curve_in<const LANES: usize>(q: [Hom; 4], [a, b]: [u32; 2]) -> [Hom; 4] {
+fn sub_curve_of<L: Lerp>(q: [L; 4], [a, b]: [u32; 2]) -> [L; 4] {
     let [p0, p1, p2, p3] = q;
-    let l = lerp::<LANES>;
-    let (ab, bc, cd) = (l(p0, p1, a), l(p1, p2, a), l(p2, p3, a));
-    let (abc, bcd) = (l(ab, bc, a), l(bc, cd, a));
-    let (abc_b, bcd_b) = (l(ab, bc, b), l(bc, cd, b));
+    let (ab, bc, cd) = (p0.lerp(p1, a), p1.lerp(p2, a), p2.lerp(p3, a));
+    let (abc, bcd) = (ab.lerp(bc, a), bc.lerp(cd, a));
+    let (abc_b, bcd_b) = (ab.lerp(bc, b), bc.lerp(cd, b));
     [
-        l(abc, bcd, a),
-        l(abc, bcd, b),
-        l(abc_b, bcd_b, b),
-        blossom_in::<LANES>(q, [b; 3]),
+        abc.lerp(bcd, a),
+        abc.lerp(bcd, b),
+        abc_b.lerp(bcd_b, b),
+        blossom_of(q, [b; 3]),
     ]
 }
 
 /// The point at `t` of the cubic `q` and its derivative `q'(t)`.
 #[inline]
 fn point_and_tangent(q: [Hom; 4], t: u32) -> (Hom, Hom) {
-    if one_weight(&q) {
-        point_and_tangent_in::<3>(q, t)
-    } else {
-        point_and_tangent_in::<4>(q, t)
+    let (mut p, mut d) = point_and_tangent_of(q, t);
+    if let Some(w) = weights(&q) {
+        (p[3], d[3]) = point_and_tangent_of(w, t);
     }
+    (p, d)
 }
 
-/// [`point_and_tangent`] in `LANES` lanes (the derivative's weight, a difference, in all four).
+/// [`point_and_tangent`] of [`Lerp`] values (for [`Hom`], one weight gives slope 0).
 #[inline(always)]
-fn point_and_tangent_in<const LANES: usize>(q: [Hom; 4], t: u32) -> (Hom, Hom) {
+fn point_and_tangent_of<L: Lerp>(q: [L; 4], t: u32) -> (L, L) {
     let [a, b, c, d] = q;
-    let l = lerp::<LANES>;
-    let (ab, bc, cd) = (l(a, b, t), l(b, c, t), l(c, d, t));
-    let (abc, bcd) = (l(ab, bc, t), l(bc, cd, t));
-    (l(abc, bcd, t), [0, 1, 2, 3].map(|k| 3 * (bcd[k] - abc[k])))
+    let (ab, bc, cd) = (a.lerp(b, t), b.lerp(c, t), c.lerp(d, t));
+    let (abc, bcd) = (ab.lerp(bc, t), bc.lerp(cd, t));
+    (abc.lerp(bcd, t), abc.slope(bcd))
 }
 
 /// The point at `t` of a boundary curve, computed the same way whichever end the caller
@@ -369,8 +399,35 @@ mod tests {
         }
     }
 
+    /// The four-lane forms the evaluation had before the weight lane was split off.
+    mod four_lanes {
+        use super::Hom;
+
+        fn lerp(a: Hom, b: Hom, t: u32) -> Hom {
+            let t = t as i64;
+            [0, 1, 2, 3].map(|k| a[k] + (((b[k] - a[k]) * t + (1 << 15)) >> 16))
+        }
+
+        pub fn blossom(q: [Hom; 4], t: [u32; 3]) -> Hom {
+            let [a, b, c, d] = q;
+            let (ab, bc, cd) = (lerp(a, b, t[0]), lerp(b, c, t[0]), lerp(c, d, t[0]));
+            let (abc, bcd) = (lerp(ab, bc, t[1]), lerp(bc, cd, t[1]));
+            lerp(abc, bcd, t[2])
+        }
+
+        pub fn point_and_tangent(q: [Hom; 4], t: u32) -> (Hom, Hom) {
+            let [a, b, c, d] = q;
+            let (ab, bc, cd) = (lerp(a, b, t), lerp(b, c, t), lerp(c, d, t));
+            let (abc, bcd) = (lerp(ab, bc, t), lerp(bc, cd, t));
+            (
+                lerp(abc, bcd, t),
+                [0, 1, 2, 3].map(|k| 3 * (bcd[k] - abc[k])),
+            )
+        }
+    }
+
     #[test]
-    fn three_lanes_give_the_four_lanes_bits() {
+    fn split_lanes_give_the_four_lanes_bits() {
         let mut seed = 0x2545_f491_4f6c_dd1du64;
         let mut next = |bits: u32| {
             seed ^= seed << 13;
@@ -386,23 +443,27 @@ mod tests {
                 0 => extremes[(k + case / 4) % extremes.len()],
                 _ => next(33),
             };
-            let q: [Hom; 4] = [0, 1, 2, 3].map(|j| [c(j), c(j + 1), c(j + 2), w]);
+            let one: [Hom; 4] = [0, 1, 2, 3].map(|j| [c(j), c(j + 1), c(j + 2), w]);
+            // Rational: weights that differ; a derivative curve: weights all 0.
+            let mut rational = one;
+            for p in &mut rational {
+                p[3] = (next(21) + (1 << 20)).clamp(1 << 12, 1 << 20);
+            }
+            rational[2][3] = w + 1;
+            let derivative = one.map(|p| [p[0], p[1], p[2], 0]);
             let t = (next(18) + (1 << 17)).clamp(0, 1 << 16) as u32;
-            for t in [t, 0, 1, 32768, 65535, 65536] {
-                let ts = [t, t / 2, PARAM_ONE - t];
-                assert_eq!(blossom_in::<3>(q, ts), blossom_in::<4>(q, ts), "{q:?} {t}");
-                assert_eq!(blossom(q, ts), blossom_in::<4>(q, ts));
-                let ab = [t / 3, t];
-                assert_eq!(sub_curve(q, ab), sub_curve_in::<4>(q, ab), "{q:?} {t}");
-                let (p, d) = point_and_tangent(q, t);
-                assert_eq!((p, d), point_and_tangent_in::<4>(q, t), "{q:?} {t}");
-                // A derivative curve's weights are all 0.
-                let dq = q.map(|p| [p[0], p[1], p[2], 0]);
-                assert_eq!(blossom(dq, ts), blossom_in::<4>(dq, ts));
-                // Rational: the four-lane path.
-                let mut r = q;
-                r[2][3] += 1;
-                assert_eq!(blossom(r, ts), blossom_in::<4>(r, ts));
+            for q in [one, rational, derivative] {
+                for t in [t, 0, 1, 32768, 65535, 65536] {
+                    let ts = [t, t / 2, PARAM_ONE - t];
+                    assert_eq!(blossom(q, ts), four_lanes::blossom(q, ts), "{q:?} {t}");
+                    let [a, b] = [t / 3, t];
+                    let pieces = [[a, a, a], [a, a, b], [a, b, b], [b, b, b]];
+                    let ab = [a, b];
+                    let want = pieces.map(|ts| four_lanes::blossom(q, ts));
+                    assert_eq!(sub_curve(q, ab), want, "{q:?} {t}");
+                    let want = four_lanes::point_and_tangent(q, t);
+                    assert_eq!(point_and_tangent(q, t), want, "{q:?} {t}");
+                }
             }
         }
     }
