@@ -387,7 +387,15 @@ impl Lighting {
     // 1,264 B instead of 1,192 B, over the 4 KiB RAM budget with the workspace.
     #[inline(never)]
     pub fn face_color<N: NormalPrecision>(&self, base: Rgb888, v: [&Vertex; 3]) -> Rgb888 {
-        let Some(w) = self.normal_to_world(face_normal(v)) else {
+        self.cross_product_color::<N>(base, face_normal(v))
+    }
+
+    /// `shade(base, self.cross_product::<N>(n))`, mostly without the exact cosine, as
+    /// [`Self::face_color`] (which is this for the face's normal). Test
+    /// `cross_product_color_equals_the_shaded_cross_product`.
+    #[inline]
+    pub fn cross_product_color<N: NormalPrecision>(&self, base: Rgb888, n: [i64; 3]) -> Rgb888 {
+        let Some(w) = self.normal_to_world(n) else {
             return shade(base, self.ambient);
         };
         let Some((lo, hi)) = N::lambert_bounds(w, self.direction) else {
@@ -711,6 +719,49 @@ mod tests {
         }
         // The bounds decide almost every face (a few in a hundred need the exact cosine).
         assert!(exact_needed < 200_000 / 20, "{exact_needed}");
+    }
+
+    #[test]
+    fn cross_product_color_equals_the_shaded_cross_product() {
+        use crate::math::{NarrowNormals, WideNormals};
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for case in 0..20_000u32 {
+            let r = |next: &mut dyn FnMut() -> u64| (next() >> 40) as f32 / (1u64 << 24) as f32;
+            let light = Light::new(
+                [r(&mut next) - 0.5, r(&mut next) - 0.5, 1.0],
+                r(&mut next) * 0.5,
+                r(&mut next) * 0.5 + 0.5,
+            )
+            .unwrap();
+            let model = Transform::rotation_y(r(&mut next) * 6.0)
+                .then_after(&Transform::rotation_x(r(&mut next) * 6.0))
+                .then_after(&Transform::scale([r(&mut next) + 0.5, 1.0, 2.0]));
+            let l = Lighting::new(&light, &model);
+            // Components of every size up to ±2^62, zero and the extremes among them.
+            let bits = 1 + case % 62;
+            let mut c = || match next() % 16 {
+                0 => 0,
+                1 => 1 << 62,
+                2 => -(1 << 62),
+                _ => (next() as i64) >> (63 - bits),
+            };
+            let n = [c(), c(), c()];
+            let base = Rgb888::new(next() as u8, next() as u8, next() as u8);
+            let wide = shade(base, l.cross_product::<WideNormals>(n));
+            assert_eq!(l.cross_product_color::<WideNormals>(base, n), wide, "{n:?}");
+            let narrow = shade(base, l.cross_product::<NarrowNormals>(n));
+            assert_eq!(
+                l.cross_product_color::<NarrowNormals>(base, n),
+                narrow,
+                "{n:?}"
+            );
+        }
     }
 
     #[test]

@@ -8,7 +8,7 @@
 //! (about 100 for flat shading).
 //! See [`PatchWorkspace::BYTES`].
 
-use super::eval::{dehomogenize, Hom, Net};
+use super::eval::{dehomogenize, Column, Hom, Net, TangentColumn};
 use super::tessellate::{self, Levels, ScreenNet, Uv};
 use super::trim::{self, Cut};
 use super::{PatchModel, Tolerance};
@@ -16,6 +16,7 @@ use crate::arithmetic::Arithmetic;
 use crate::cache::CachedVertex;
 use crate::clip::{ClipVertex, Clipped, Clipping};
 use crate::depth::Depth;
+use crate::math::floor_div_i64;
 use crate::options::RenderOptions;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{color_channels, first_row, signed_area, xy, TriangleWalk};
@@ -24,7 +25,7 @@ use crate::scene::{Camera, Light, Transform};
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
 use crate::stats::{CapacityKind, FrameStats, RenderError};
-use crate::vertex::{shade, EyePoint, Lighting, ModelView, TransformPrecision};
+use crate::vertex::{EyePoint, Lighting, ModelView, TransformPrecision};
 use crate::workspace::SpanZBuffer;
 use embedded_graphics::pixelcolor::Rgb888;
 use fixed::types::I16F16;
@@ -412,9 +413,9 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         let (nx, ny) = ((d[2] - d[3]) / 2, (d[5] - d[4]) / 2);
         let cx = (self.vp.width as i64) << SUB;
         let cy = (self.vp.height as i64) << SUB;
-        // w > near > 0 here; `checked_` keeps the render path free of panics.
-        let div = |n: i64| n.checked_div_euclid(2 * w);
-        Some([div(cx * w + 2 * nx)?, div(cy * w - 2 * ny)?])
+        // w > near > 0 here, so `floor_div_i64` is `div_euclid` (by 32-bit divisions).
+        let div = |n: i64| floor_div_i64(n, 2 * w);
+        Some([div(cx * w + 2 * nx), div(cy * w - 2 * ny)])
     }
 
     /// The projected control points of `net`.
@@ -457,19 +458,15 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
     fn lit(&self, patch: u16, n: Option<[i64; 3]>) -> Sides<Rgb888> {
         let base = self.model.color(patch as usize);
         let n = n.unwrap_or([0; 3]);
-        let front = shade(
-            base,
-            self.lighting.cross_product::<<A as Arithmetic>::Normals>(n),
-        );
+        let color = |n| {
+            self.lighting
+                .cross_product_color::<<A as Arithmetic>::Normals>(base, n)
+        };
+        let front = color(n);
         let back = if self.cull {
             front
         } else {
-            let reversed = n.map(|c| c.saturating_neg());
-            shade(
-                base,
-                self.lighting
-                    .cross_product::<<A as Arithmetic>::Normals>(reversed),
-            )
+            color(n.map(|c| c.saturating_neg()))
         };
         Sides { front, back }
     }
@@ -571,7 +568,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
             self.trimmed::<S>(patch, net, uv, face, row, f);
             return;
         }
-        self.draw(patch, cv, face, row, f);
+        self.draw(patch, cv.each_ref(), face, row, f);
     }
 
     /// Draws the parts of triangle `uv` of `patch` that its trims keep: faces cut in
@@ -600,7 +597,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                 if let Some((q, w)) = previous {
                     // Collinear in (u, v): no area to draw.
                     if tessellate::area2(first, q, p) != 0 {
-                        self.draw(patch, [apex, w, v], face, row, f);
+                        self.draw(patch, [&apex, &w, &v], face, row, f);
                     }
                 }
                 previous = Some((p, v));
@@ -645,34 +642,40 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         let v = |j: u8| tessellate::grid(j as u32, levels.v);
         let at = |i: u8, j: u8| [u(i), v(j)];
         // Interior points only (0 < u, v < 1), where `Net::point` evaluates on columns too.
-        let columns = (is[0]..=is[1]).map(|i| {
-            (
-                net.column(u(i)),
-                S::PER_VERTEX.then(|| net.tangent_column(u(i))),
-            )
-        });
-        let columns: Vec<_, { BLOCK + 1 }> = gather(columns);
-        let centres = (is[0]..is[1])
-            .map(|i| (!S::PER_VERTEX).then(|| net.tangent_column((u(i) + u(i + 1)) / 2)));
-        let centres: Vec<_, BLOCK> = gather(centres);
-        let points = |this: &Self, j: u8| -> Vec<Vertex, { BLOCK + 1 }> {
-            let vertices = columns
-                .iter()
-                .zip(is[0]..=is[1])
-                .map(|((column, tangents), i)| {
-                    let n = tangents
-                        .as_ref()
-                        .map(|t| t.normal(v(j)).or_else(|| net.normal(u(i), v(j))));
-                    this.vertex_at::<S>(patch, column.point(v(j)), n)
+        // Each column pushed as made: written once, not copied through an iterator.
+        let mut columns: Vec<Column, { BLOCK + 1 }> = Vec::new();
+        // Gouraud: tangents along each column, for vertex normals; flat: along each column
+        // of cell centres, for face normals.
+        let mut tangents: Vec<TangentColumn, { BLOCK + 1 }> = Vec::new();
+        let mut centres: Vec<TangentColumn, BLOCK> = Vec::new();
+        // (Room for the block's columns: the pushes never fail.)
+        for i in is[0]..=is[1] {
+            let _ = columns.push(net.column(u(i)));
+            if S::PER_VERTEX {
+                let _ = tangents.push(net.tangent_column(u(i)));
+            } else if i < is[1] {
+                let _ = centres.push(net.tangent_column((u(i) + u(i + 1)) / 2));
+            }
+        }
+        // Row `j`'s points, written in place (rows of vertices are not copied).
+        let points = |this: &Self, row: &mut Vec<Vertex, { BLOCK + 1 }>, j: u8| {
+            row.clear();
+            for (k, (column, i)) in columns.iter().zip(is[0]..=is[1]).enumerate() {
+                let n = S::PER_VERTEX.then(|| {
+                    let t = tangents.get(k).and_then(|t| t.normal(v(j)));
+                    t.or_else(|| net.normal(u(i), v(j)))
                 });
-            gather(vertices)
+                let _ = row.push(this.vertex_at::<S>(patch, column.point(v(j)), n));
+            }
         };
         let trims = self.trims(patch);
-        let mut below = points(self, js[0]);
+        let (mut first, mut second) = (Vec::new(), Vec::new());
+        let (mut below, mut above) = (&mut first, &mut second);
+        points(self, below, js[0]);
         for j in js[0]..js[1] {
-            let above = points(self, j + 1);
-            for ((k, i), centre) in (is[0]..is[1]).enumerate().zip(&centres) {
-                let (Some(&a), Some(&b), Some(&c), Some(&d)) = (
+            points(self, above, j + 1);
+            for (k, i) in (is[0]..is[1]).enumerate() {
+                let (Some(a), Some(b), Some(c), Some(d)) = (
                     below.get(k),
                     below.get(k + 1),
                     above.get(k + 1),
@@ -681,7 +684,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                     break;
                 };
                 let corners = [a, b, c, d];
-                let face = match centre {
+                let face = match centres.get(k) {
                     Some(t) => {
                         let (uc, vc) = ((u(i) + u(i + 1)) / 2, (v(j) + v(j + 1)) / 2);
                         self.lit(patch, t.normal(vc).or_else(|| net.normal(uc, vc)))
@@ -701,7 +704,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                     }
                 }
             }
-            below = above;
+            core::mem::swap(&mut below, &mut above);
         }
     }
 
@@ -710,19 +713,17 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
     fn draw(
         &mut self,
         patch: u16,
-        t: [Vertex; 3],
+        t: [&Vertex; 3],
         face: Sides<Rgb888>,
         row: usize,
         f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
-        let back = shows_back(&t);
+        let back = shows_back(t);
         let face = if back { face.back } else { face.front };
-        let cv = t.map(|v| ClipVertex {
-            p: v.p,
-            color: if back { v.color.back } else { v.color.front },
-        });
-        self.stats.frame.triangles_in += 1;
-        let vp = self.vp;
+        let color = |v: &Vertex| if back { v.color.back } else { v.color.front };
+        // Borrowed field by field, not copied: this runs once per triangle.
+        let (vp, cull, stats) = (&self.vp, self.cull, &mut self.stats);
+        stats.frame.triangles_in += 1;
         let project = |c: &ClipVertex| vp.project_as::<A::Projection>(&c.p, c.color, true);
         let mut emit = |s: [ScreenVertex<SUB>; 3], stats: &mut PatchStats| {
             let area = signed_area(&s);
@@ -730,7 +731,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
             if area == 0 {
                 return;
             }
-            if self.cull && area > 0 {
+            if cull && area > 0 {
                 stats.frame.culled += 1;
                 return;
             }
@@ -747,24 +748,22 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
             stats.frame.bucketed += 1;
             f(&s, face, patch as u32, 0);
         };
-        let mut stats = self.stats;
         // Inside every clip plane: the screen positions projected once per vertex, as the
         // clipper's path below would project them.
-        let screen = [0, 1, 2].map(|k| {
-            let (v, c) = (t.get(k)?, cv.get(k)?);
-            v.screen.screen::<SUB>(c.color)
-        });
-        if let [Some(a), Some(b), Some(c)] = screen {
-            emit([a, b, c], &mut stats);
-            self.stats = stats;
+        if let [Some(a), Some(b), Some(c)] = t.map(|v| v.screen.screen::<SUB>(color(v))) {
+            emit([a, b, c], stats);
             return;
         }
-        match C::clip(&vp, &cv, &mut self.polygon) {
+        let cv = t.map(|v| ClipVertex {
+            p: v.p,
+            color: color(v),
+        });
+        match C::clip(vp, &cv, &mut self.polygon) {
             Clipped::Outside => stats.frame.rejected += 1,
             Clipped::Skipped => stats.frame.unclipped += 1,
             Clipped::Inside => {
                 if let [Some(a), Some(b), Some(c)] = cv.each_ref().map(project) {
-                    emit([a, b, c], &mut stats);
+                    emit([a, b, c], stats);
                 }
             }
             Clipped::Polygon => {
@@ -772,13 +771,12 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                 let mut fan = self.polygon.as_ref().iter().filter_map(project);
                 if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
                     for c in fan {
-                        emit([a, b, c], &mut stats);
+                        emit([a, b, c], stats);
                         b = c;
                     }
                 }
             }
         }
-        self.stats = stats;
     }
 
     /// A whole patch's first row has come: choose its levels, file each side of its boundary
@@ -900,17 +898,6 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize> RowPieces<SU
     }
 }
 
-/// The first `N` items of `items` (callers pass at most `N`), without `collect`'s panic
-/// when there are more.
-fn gather<T, const N: usize>(items: impl Iterator<Item = T>) -> Vec<T, N> {
-    let mut out = Vec::new();
-    for item in items.take(N) {
-        // Room for `N`: never fails.
-        let _ = out.push(item);
-    }
-    out
-}
-
 /// Something with a value for each side of the surface.
 #[derive(Clone, Copy, Debug)]
 struct Sides<T> {
@@ -931,7 +918,7 @@ struct Vertex {
 /// `(b − a) × (c − a)` (in `(x, y, −w)`, counter-clockwise = front) points away from the eye.
 /// Coordinates are cut to 22 bits first, so the cross product is below 2^47 and its dot
 /// product with a point below 2^70 (`i128`).
-fn shows_back(t: &[Vertex; 3]) -> bool {
+fn shows_back(t: [&Vertex; 3]) -> bool {
     let v = t.map(|v| [v.p.x, v.p.y, v.p.w].map(|c| (c.to_bits() >> 8) as i64));
     let v = v.map(|p| [p[0], p[1], -p[2]]);
     let d = |a: [i64; 3], b: [i64; 3]| [b[0] - a[0], b[1] - a[1], b[2] - a[2]];

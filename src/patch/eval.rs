@@ -19,12 +19,55 @@ use fixed::types::I16F16;
 /// A homogeneous point `(ω·x, ω·y, ω·z, ω)`, each component I48F16 bits in an `i64`.
 pub(crate) type Hom = [i64; 4];
 
-/// `a + (b − a)·t` for a parameter `t` in [0, 1] (I16F16 bits), rounded to nearest: exact
-/// at `t = 0` and `t = 1`.
+/// What de Casteljau interpolates: the coordinate lanes of homogeneous points, or weights.
+trait Lerp: Copy {
+    /// `a + (b − a)·t` for a parameter `t` in [0, 1] (I16F16 bits), rounded to nearest:
+    /// exact at `t = 0` and `t = 1`.
+    fn lerp(self, b: Self, t: u32) -> Self;
+    /// `3·(b − a)`: a cubic's derivative from its last de Casteljau pair.
+    fn slope(self, b: Self) -> Self;
+}
+
+/// The formula, one lane.
 #[inline(always)]
-fn lerp(a: Hom, b: Hom, t: u32) -> Hom {
-    let t = t as i64;
-    [0, 1, 2, 3].map(|k| a[k] + (((b[k] - a[k]) * t + (1 << 15)) >> 16))
+fn lerp(a: i64, b: i64, t: u32) -> i64 {
+    a + (((b - a) * t as i64 + (1 << 15)) >> 16)
+}
+
+/// Weights alone.
+impl Lerp for i64 {
+    #[inline(always)]
+    fn lerp(self, b: i64, t: u32) -> i64 {
+        lerp(self, b, t)
+    }
+    #[inline(always)]
+    fn slope(self, b: i64) -> i64 {
+        3 * (b - self)
+    }
+}
+
+/// The three coordinate lanes only; the weight lane is `self`'s, carried unchanged. The lanes
+/// are independent, so the callers below take weights from the curve's one weight (which
+/// every step keeps: a polynomial patch's curves) or interpolate them alone.
+impl Lerp for Hom {
+    #[inline(always)]
+    fn lerp(self, b: Hom, t: u32) -> Hom {
+        let [x, y, z, w] = self;
+        [lerp(x, b[0], t), lerp(y, b[1], t), lerp(z, b[2], t), w]
+    }
+    #[inline(always)]
+    fn slope(self, b: Hom) -> Hom {
+        [0, 1, 2, 3].map(|k| 3 * (b[k] - self[k]))
+    }
+}
+
+/// The weights of cubic `q`, or `None` if it has one weight throughout (then every
+/// de Casteljau step keeps it, and [`Lerp`] for [`Hom`] carries it: three lanes of work).
+#[inline(always)]
+fn weights(q: &[Hom; 4]) -> Option<[i64; 4]> {
+    let [a, b, c, d] = q.map(|p| p[3]);
+    // (Compared lane by lane: an array comparison calls `memcmp`.)
+    (a != b || a != c || a != d).then_some([a, b, c, d])
 }
 
 /// The blossom `f(t₀, t₁, t₂)` of the cubic with control points `q`: de Casteljau with a
@@ -33,39 +76,68 @@ fn lerp(a: Hom, b: Hom, t: u32) -> Hom {
 /// `[a, b]`.
 #[inline]
 fn blossom(q: [Hom; 4], t: [u32; 3]) -> Hom {
+    let mut p = blossom_of(q, t);
+    if let Some(w) = weights(&q) {
+        p[3] = blossom_of(w, t);
+    }
+    p
+}
+
+/// [`blossom`] of [`Lerp`] values.
+#[inline(always)]
+fn blossom_of<L: Lerp>(q: [L; 4], t: [u32; 3]) -> L {
     let [a, b, c, d] = q;
-    let (ab, bc, cd) = (lerp(a, b, t[0]), lerp(b, c, t[0]), lerp(c, d, t[0]));
-    let (abc, bcd) = (lerp(ab, bc, t[1]), lerp(bc, cd, t[1]));
-    lerp(abc, bcd, t[2])
+    let (ab, bc, cd) = (a.lerp(b, t[0]), b.lerp(c, t[0]), c.lerp(d, t[0]));
+    let (abc, bcd) = (ab.lerp(bc, t[1]), bc.lerp(cd, t[1]));
+    abc.lerp(bcd, t[2])
 }
 
 /// The control points of the piece of cubic `q` over `[a, b]`: the blossoms at `(a,a,a)`,
 /// `(a,a,b)`, `(a,b,b)`, `(b,b,b)`, bit for bit as [`blossom`] computes them, with the
 /// de Casteljau steps they have in common done once (16 interpolations instead of 24).
 #[inline]
-fn sub_curve(q: [Hom; 4], [a, b]: [u32; 2]) -> [Hom; 4] {
+fn sub_curve(q: [Hom; 4], ab: [u32; 2]) -> [Hom; 4] {
+    let mut s = sub_curve_of(q, ab);
+    if let Some(w) = weights(&q) {
+        for (p, w) in s.iter_mut().zip(sub_curve_of(w, ab)) {
+            p[3] = w;
+        }
+    }
+    s
+}
+
+/// [`sub_curve`] of [`Lerp`] values.
+#[inline(always)]
+fn sub_curve_of<L: Lerp>(q: [L; 4], [a, b]: [u32; 2]) -> [L; 4] {
     let [p0, p1, p2, p3] = q;
-    let (ab, bc, cd) = (lerp(p0, p1, a), lerp(p1, p2, a), lerp(p2, p3, a));
-    let (abc, bcd) = (lerp(ab, bc, a), lerp(bc, cd, a));
-    let (abc_b, bcd_b) = (lerp(ab, bc, b), lerp(bc, cd, b));
+    let (ab, bc, cd) = (p0.lerp(p1, a), p1.lerp(p2, a), p2.lerp(p3, a));
+    let (abc, bcd) = (ab.lerp(bc, a), bc.lerp(cd, a));
+    let (abc_b, bcd_b) = (ab.lerp(bc, b), bc.lerp(cd, b));
     [
-        lerp(abc, bcd, a),
-        lerp(abc, bcd, b),
-        lerp(abc_b, bcd_b, b),
-        blossom(q, [b; 3]),
+        abc.lerp(bcd, a),
+        abc.lerp(bcd, b),
+        abc_b.lerp(bcd_b, b),
+        blossom_of(q, [b; 3]),
     ]
 }
 
 /// The point at `t` of the cubic `q` and its derivative `q'(t)`.
 #[inline]
 fn point_and_tangent(q: [Hom; 4], t: u32) -> (Hom, Hom) {
+    let (mut p, mut d) = point_and_tangent_of(q, t);
+    if let Some(w) = weights(&q) {
+        (p[3], d[3]) = point_and_tangent_of(w, t);
+    }
+    (p, d)
+}
+
+/// [`point_and_tangent`] of [`Lerp`] values (for [`Hom`], one weight gives slope 0).
+#[inline(always)]
+fn point_and_tangent_of<L: Lerp>(q: [L; 4], t: u32) -> (L, L) {
     let [a, b, c, d] = q;
-    let (ab, bc, cd) = (lerp(a, b, t), lerp(b, c, t), lerp(c, d, t));
-    let (abc, bcd) = (lerp(ab, bc, t), lerp(bc, cd, t));
-    (
-        lerp(abc, bcd, t),
-        [0, 1, 2, 3].map(|k| 3 * (bcd[k] - abc[k])),
-    )
+    let (ab, bc, cd) = (a.lerp(b, t), b.lerp(c, t), c.lerp(d, t));
+    let (abc, bcd) = (ab.lerp(bc, t), bc.lerp(cd, t));
+    (abc.lerp(bcd, t), abc.slope(bcd))
 }
 
 /// The point at `t` of a boundary curve, computed the same way whichever end the caller
@@ -324,6 +396,75 @@ mod tests {
             let e = [-y, -x, 1.0];
             let cos = (n[0] * e[0] + n[1] * e[1] + n[2] * e[2]) / (len(n) * len(e));
             assert!(cos > 0.9999, "{u} {v}: {cos}");
+        }
+    }
+
+    /// The four-lane forms the evaluation had before the weight lane was split off.
+    mod four_lanes {
+        use super::Hom;
+
+        fn lerp(a: Hom, b: Hom, t: u32) -> Hom {
+            let t = t as i64;
+            [0, 1, 2, 3].map(|k| a[k] + (((b[k] - a[k]) * t + (1 << 15)) >> 16))
+        }
+
+        pub fn blossom(q: [Hom; 4], t: [u32; 3]) -> Hom {
+            let [a, b, c, d] = q;
+            let (ab, bc, cd) = (lerp(a, b, t[0]), lerp(b, c, t[0]), lerp(c, d, t[0]));
+            let (abc, bcd) = (lerp(ab, bc, t[1]), lerp(bc, cd, t[1]));
+            lerp(abc, bcd, t[2])
+        }
+
+        pub fn point_and_tangent(q: [Hom; 4], t: u32) -> (Hom, Hom) {
+            let [a, b, c, d] = q;
+            let (ab, bc, cd) = (lerp(a, b, t), lerp(b, c, t), lerp(c, d, t));
+            let (abc, bcd) = (lerp(ab, bc, t), lerp(bc, cd, t));
+            (
+                lerp(abc, bcd, t),
+                [0, 1, 2, 3].map(|k| 3 * (bcd[k] - abc[k])),
+            )
+        }
+    }
+
+    #[test]
+    fn split_lanes_give_the_four_lanes_bits() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |bits: u32| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> (64 - bits)) as i64 - (1 << (bits - 1))
+        };
+        // Components below 2^32 bits, weights 1/16 to 16 (2^12 to 2^20 bits).
+        let extremes = [-(1i64 << 32) + 1, -1, 0, 1, (1 << 32) - 1];
+        for case in 0..20_000 {
+            let w = (next(21) + (1 << 20)).clamp(1 << 12, 1 << 20);
+            let mut c = |k: usize| match case % 4 {
+                0 => extremes[(k + case / 4) % extremes.len()],
+                _ => next(33),
+            };
+            let one: [Hom; 4] = [0, 1, 2, 3].map(|j| [c(j), c(j + 1), c(j + 2), w]);
+            // Rational: weights that differ; a derivative curve: weights all 0.
+            let mut rational = one;
+            for p in &mut rational {
+                p[3] = (next(21) + (1 << 20)).clamp(1 << 12, 1 << 20);
+            }
+            rational[2][3] = w + 1;
+            let derivative = one.map(|p| [p[0], p[1], p[2], 0]);
+            let t = (next(18) + (1 << 17)).clamp(0, 1 << 16) as u32;
+            for q in [one, rational, derivative] {
+                for t in [t, 0, 1, 32768, 65535, 65536] {
+                    let ts = [t, t / 2, PARAM_ONE - t];
+                    assert_eq!(blossom(q, ts), four_lanes::blossom(q, ts), "{q:?} {t}");
+                    let [a, b] = [t / 3, t];
+                    let pieces = [[a, a, a], [a, a, b], [a, b, b], [b, b, b]];
+                    let ab = [a, b];
+                    let want = pieces.map(|ts| four_lanes::blossom(q, ts));
+                    assert_eq!(sub_curve(q, ab), want, "{q:?} {t}");
+                    let want = four_lanes::point_and_tangent(q, t);
+                    assert_eq!(point_and_tangent(q, t), want, "{q:?} {t}");
+                }
+            }
         }
     }
 

@@ -108,7 +108,7 @@ fn main() -> ExitCode {
             Some(result) => result,
             None => {
                 eprintln!(
-                    "usage: cargo xtask test | package | firmware | trace | metaball | metaball-trade | patch | patch-trade | lean | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | profile trace [pure|hybrid] [TARGET] | speed [before|after|doc] | fuzz [SECONDS]"
+                    "usage: cargo xtask test | package | firmware | trace | metaball | metaball-trade | patch | patch-trade | lean | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | profile trace [pure|hybrid] [TARGET] | profile patch [TARGET] | speed [before|after|doc] | fuzz [SECONDS]"
                 );
                 return ExitCode::from(2);
             }
@@ -165,6 +165,12 @@ fn host_task(task: &str) -> Option<Result<(), String>> {
                 .find(|a| a.as_str() != target)
                 .map_or("pure", String::as_str);
             install().and_then(|_| profile::profile_trace(mode, target))
+        }
+        "profile" if std::env::args().nth(2).as_deref() == Some("patch") => {
+            let target = std::env::args()
+                .nth(3)
+                .unwrap_or_else(|| "thumbv7em-none-eabihf".into());
+            install().and_then(|_| profile::profile_patch(&target))
         }
         "profile" => {
             let variant = std::env::args().nth(2).unwrap_or_else(|| "balanced".into());

@@ -9,7 +9,8 @@
 //! keeps debug info). `cargo xtask profile trace [pure|hybrid] [TARGET]` does the same for the
 //! traced firmware's frame in one mode (thumbv7em unless a TARGET is named), and also prints per
 //! symbol the functions inlined into it (which separates, say, the shadow rays' walk in `shade`
-//! from the nearest-hit walk in `nearest`). The log goes through a named pipe, never to disk.
+//! from the nearest-hit walk in `nearest`). `cargo xtask profile patch [TARGET]` profiles the
+//! patch firmware's teapot frames. The log goes through a named pipe, never to disk.
 
 use crate::tradeoff::{build_example_with_cfgs, run_on_qemu_with, CORPUS};
 use crate::{root, step};
@@ -180,12 +181,22 @@ pub fn profile_trace(mode: &str, target: &str) -> Result<(), String> {
     })
 }
 
+/// `cargo xtask profile patch [TARGET]`: the patch firmware's teapot frames (tolerance
+/// 0.5 px), profiled like a trade-off variant (thumbv7em unless a TARGET is named).
+pub fn profile_patch(target: &str) -> Result<(), String> {
+    step(&format!("patch firmware (teapot, 0.5 px) for {target}"));
+    let elf = build_example_with_cfgs("patch", Some(target), &[], None)?;
+    profile_elf(target, &elf, "patch", |l| l.starts_with("frame "))
+}
+
 /// Per block start, its instruction count and last instruction; per executed block, its count.
 #[derive(Default)]
 struct Counts {
     blocks: HashMap<u64, (u64, u64)>,
     per_function: HashMap<u64, u64>,
     per_site: HashMap<u64, u64>,
+    /// Per call site, the built-ins' instructions alone.
+    builtin_site: HashMap<u64, u64>,
     total: u64,
     builtin: u64,
 }
@@ -216,6 +227,7 @@ fn count_blocks(log: impl BufRead, syms: &[(u64, u64, String)]) -> Result<Counts
             *c.per_function.entry(pc).or_default() += len;
             if is_builtin {
                 c.builtin += len;
+                *c.builtin_site.entry(caller).or_default() += len;
             } else {
                 caller = last;
             }
@@ -325,6 +337,19 @@ fn profile_elf(
     by_line.sort_by_key(|l| std::cmp::Reverse(l.1));
     println!("\nsource lines, with the built-ins they call:");
     for (line, n) in by_line.iter().take(40) {
+        println!("{:6.2} %  {line}", percent(*n, total));
+    }
+    let mut builtin_sites: HashMap<String, u64> = HashMap::new();
+    for (site, n) in &c.builtin_site {
+        let (line, inlined) = lines.get(site).map_or(("", "?"), |(l, f)| (l.as_str(), f.as_str()));
+        *builtin_sites
+            .entry(format!("{line} ({})", short_name(inlined)))
+            .or_default() += n;
+    }
+    let mut builtin_sites: Vec<_> = builtin_sites.into_iter().collect();
+    builtin_sites.sort_by_key(|l| std::cmp::Reverse(l.1));
+    println!("\nthe built-ins alone, by the source line that called them:");
+    for (line, n) in builtin_sites.iter().take(20) {
         println!("{:6.2} %  {line}", percent(*n, total));
     }
     let mut by_inlined: Vec<_> = by_inlined.into_iter().collect();
