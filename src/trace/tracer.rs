@@ -447,8 +447,8 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     }
 
     /// The nearest object along `ray` (which starts on object `from`; `u32::MAX` for a primary
-    /// ray) with `t` in `[t_min, t_max)`: through the scene's structure, except that a
-    /// reflected or refracted ray in a scene of at most [`FEW_OBJECTS`] tests every object.
+    /// ray) with `t` in `[t_min, t_max)`: through the scene's structure, except that in a scene
+    /// of at most [`FEW_OBJECTS`] every ray tests every object.
     pub(crate) fn nearest(
         &self,
         ray: &Ray,
@@ -1054,8 +1054,8 @@ mod tests {
         );
     }
 
-    /// In a scene of a few objects a reflected or refracted ray tests every object instead of
-    /// walking the hierarchy: the same nearest hit as the walk, from every object's surface.
+    /// In a scene of a few objects a ray tests every object instead of walking the hierarchy:
+    /// the same nearest hit as the walk, from every object's surface.
     #[test]
     fn few_objects_find_the_walks_hit() {
         use crate::trace::bvh::{self, BvhNode};
