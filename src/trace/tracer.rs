@@ -1076,9 +1076,8 @@ mod tests {
             x
         };
         let recomputed = |n: &Nearest| {
-            n.best.map_or(n.t_max, |b| {
-                b.t.saturating_add(I16F16::DELTA).min(n.t_max)
-            })
+            n.best
+                .map_or(n.t_max, |b| b.t.saturating_add(I16F16::DELTA).min(n.t_max))
         };
         for round in 0..20_000 {
             let t_max = match round % 4 {
