@@ -177,6 +177,9 @@ pub(crate) struct Nearest {
     best: Option<Hit>,
     t_min: I16F16,
     t_max: I16F16,
+    /// [`limit`](Self::limit), kept up to date when `best` changes rather than recomputed
+    /// from it on every offer.
+    limit: I16F16,
     from: u32,
     tests: u32,
 }
@@ -188,6 +191,7 @@ impl Nearest {
             best: None,
             t_min,
             t_max,
+            limit: t_max,
             from,
             tests: 0,
         }
@@ -196,15 +200,22 @@ impl Nearest {
     /// The exclusive bound an object's `t` must stay below to matter: `t_max`, or once
     /// something is hit one step above its `t` (a tie may still win on its id).
     pub(crate) fn limit(&self) -> I16F16 {
-        self.best.map_or(self.t_max, |b| {
-            b.t.saturating_add(I16F16::DELTA).min(self.t_max)
-        })
+        self.limit
+    }
+
+    /// Keeps `t` on object `id` if it is nearer (or as near, on a smaller id) than the best.
+    #[inline]
+    fn keep(&mut self, t: I16F16, id: u32) {
+        if self.best.is_none_or(|b| t < b.t || id < b.object) {
+            self.best = Some(Hit { t, object: id });
+            self.limit = t.saturating_add(I16F16::DELTA).min(self.t_max);
+        }
     }
 
     /// Tests object `id` of `scene` and keeps it if it is nearer; returns the new limit.
     pub(crate) fn offer(&mut self, scene: &Scene<'_>, id: u32, ray: &Ray) -> I16F16 {
         self.tests += 1;
-        let limit = self.limit();
+        let limit = self.limit;
         let t = scene.objects.get(id as usize).and_then(|object| {
             if id == self.from {
                 object.shape.hit_from_surface(ray, self.t_min, limit)
@@ -213,26 +224,21 @@ impl Nearest {
             }
         });
         if let Some(t) = t {
-            if self.best.is_none_or(|b| t < b.t || id < b.object) {
-                self.best = Some(Hit { t, object: id });
-            }
+            self.keep(t, id);
         }
-        self.limit()
+        self.limit
     }
 
     /// [`offer`](Self::offer) for a primary ray (`from` is none) known to meet planar object
     /// `id` inside its outline if it meets its plane: the point-in-polygon test is skipped.
     pub(crate) fn offer_inside_outline(&mut self, scene: &Scene<'_>, id: u32, ray: &Ray) {
         self.tests += 1;
-        let limit = self.limit();
         let t = scene
             .objects
             .get(id as usize)
-            .and_then(|object| object.shape.hit_inside_outline(ray, self.t_min, limit));
+            .and_then(|object| object.shape.hit_inside_outline(ray, self.t_min, self.limit));
         if let Some(t) = t {
-            if self.best.is_none_or(|b| t < b.t || id < b.object) {
-                self.best = Some(Hit { t, object: id });
-            }
+            self.keep(t, id);
         }
     }
 
@@ -636,7 +642,10 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         let local = Colour(material.colour.0.map(|c| mul(c, factor)));
         add_weighted(sum, &local, pending.weight);
 
-        if pending.depth >= self.options.max_depth {
+        // A diffuse surface (KR = KT = 0) spawns nothing, as the pushes below would decide:
+        // skipped before building the reflected direction (most hits are on the floor).
+        let diffuse_only = material.kr == I16F16::ZERO && material.kt == I16F16::ZERO;
+        if pending.depth >= self.options.max_depth || diffuse_only {
             return (shadow, index);
         }
         let reflected = reflect(ray.dir, normal);
@@ -1052,6 +1061,44 @@ mod tests {
             refract(v(0.0, -1.0, 0.0), n, I16F16::ONE, glass),
             Some(v(0.0, -1.0, 0.0))
         );
+    }
+
+    /// The limit kept by `Nearest::keep` is the one recomputed from the best hit (the form it
+    /// replaced), over random offers below the limit (as every test returns) and at the ends
+    /// of the range.
+    #[test]
+    fn kept_limit_is_the_recomputed_one() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let recomputed = |n: &Nearest| {
+            n.best
+                .map_or(n.t_max, |b| b.t.saturating_add(I16F16::DELTA).min(n.t_max))
+        };
+        for round in 0..20_000 {
+            let t_max = match round % 4 {
+                0 => I16F16::MAX,
+                _ => I16F16::from_bits((next() >> 33) as i32 + 2),
+            };
+            let t_min = I16F16::from_bits((next() % 4) as i32);
+            let mut n = Nearest::new(u32::MAX, t_min, t_max);
+            assert_eq!(n.limit(), recomputed(&n));
+            for _ in 0..(next() % 6) {
+                let span = (n.limit().to_bits() - t_min.to_bits()).max(1) as u64;
+                let t = match next() % 8 {
+                    // Just below the limit: a tie with the best hit, or the top of the range.
+                    0 => n.limit().to_bits() - 1,
+                    _ => t_min.to_bits() + (next() % span) as i32,
+                };
+                let t = I16F16::from_bits(t.max(t_min.to_bits()));
+                n.keep(t, (next() % 5) as u32);
+                assert_eq!(n.limit(), recomputed(&n), "round {round}");
+            }
+        }
     }
 
     /// In a scene of a few objects a ray tests every object instead of walking the hierarchy:
