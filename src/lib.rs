@@ -100,6 +100,8 @@
 
 #[cfg(test)]
 extern crate std;
+#[cfg(test)]
+mod test_rng;
 
 pub mod arithmetic;
 pub mod cache;

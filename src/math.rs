@@ -659,13 +659,11 @@ mod tests {
 
     #[test]
     fn narrow_products_are_exact() {
-        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
         let edges = [0i64, 1, -1, i64::MAX, i64::MIN, u32::MAX as i64, -(1 << 32)];
         assert_eq!(mul_wide_in_halves(i32::MIN, i32::MIN), 1 << 62);
         for k in 0..400_000u64 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            let x = rng.next_u64();
             let a = match k % 4 {
                 0 => x as i64,
                 1 => (x as i64) >> (x % 64),
@@ -731,11 +729,9 @@ mod tests {
                 check(n, d);
             }
         }
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
         for _ in 0..400_000 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            let x = rng.next_u64();
             let n = x >> (x % 64);
             let d = ((x >> 7) as u32) >> ((x >> 40) % 32);
             check(n, d.max(1));
@@ -803,11 +799,9 @@ mod tests {
             }
         }
         assert_eq!(Divisor32::new(0).div_rem(12345), (12345, 0));
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
         for _ in 0..400_000 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            let x = rng.next_u64();
             let d = (((x >> 7) as u32) >> ((x >> 40) % 32)).max(1);
             let by = Divisor32::new(d);
             // The 32-bit targets' reciprocal (the host divides `u64`).
@@ -847,13 +841,8 @@ mod tests {
             };
             Some(v.map(|c| c as i32))
         };
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
+        let mut next = || rng.next_u64();
         for bits in [15, 30] {
             assert_eq!(fit_bits([0; 3], bits), None);
             for k in 0..63 {
@@ -881,11 +870,9 @@ mod tests {
     #[test]
     fn square_root_is_exact() {
         // Perfect squares and their neighbours at every size, and pseudo-random values.
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
         for k in 0..200_000u64 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            let x = rng.next_u64();
             let root = (k * 20_000 + (x >> 44)) % (1 << 31);
             for n in [
                 root * root,
@@ -914,11 +901,9 @@ mod tests {
 
     /// Pseudo-random integer vectors at every scale from a few units to 2^62.
     fn vectors(count: usize) -> impl Iterator<Item = [i64; 3]> {
-        let mut x = 0x9e37_79b9u64;
+        let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9u64);
         let mut next = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            let x = rng.next_u64();
             (x as i64) >> (x % 62) as u32
         };
         (0..count).map(move |_| [next(), next(), next()])

@@ -331,11 +331,9 @@ pub(crate) mod tests {
                 assert_eq!(floor_div(n, d), n.div_euclid(d), "{n} / {d}");
             }
         }
-        let mut x = 0x1F83_D9AB_FB41_BD6Bu64;
+        let mut rng = crate::test_rng::XorShift64::new(0x1F83_D9AB_FB41_BD6Bu64);
         for _ in 0..100_000 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            let x = rng.next_u64();
             let n = (x as i64) >> (x % 40 + 1);
             let d = ((x >> 20) % (1 << (x % 36 + 1))) as i64 + 1;
             assert_eq!(floor_div(n, d), n.div_euclid(d), "{n} / {d}");
@@ -404,11 +402,9 @@ pub(crate) mod tests {
 
     #[test]
     fn reciprocal_projection_stays_within_its_bound() {
-        let mut x = 0x1234_5678u32;
+        let mut rng = crate::test_rng::XorShift32::new(0x1234_5678u32);
         let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
+            let x = rng.next_u32();
             x as f64 / u32::MAX as f64
         };
         for (sub, vp) in [

@@ -770,13 +770,8 @@ mod tests {
             i64::MAX / 2,
             i64::MAX / 2 + 1,
         ];
-        let mut x = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x9E37_79B9_7F4A_7C15u64);
+        let mut next = || rng.next_u64();
         for &d in &dens {
             for &n in &edges {
                 for n in [n, -n, n + 1, n - 1] {
@@ -817,13 +812,8 @@ mod tests {
     /// One reciprocal of the area gives every quotient `round_div_i64` gives, `None` included.
     #[test]
     fn round_divisor_equals_round_div() {
-        let mut x = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_F491_4F6C_DD1Du64);
+        let mut next = move || rng.next_u64();
         let areas = [
             i64::MIN,
             -1,
@@ -904,13 +894,8 @@ mod tests {
                 dy: sat(div(ny * px)),
             }
         }
-        let mut x = 0x5851_F42D_4C95_7F2Du64;
-        let mut next = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x5851_F42D_4C95_7F2Du64);
+        let mut next = move || rng.next_u64();
         let mut fast = 0;
         for i in 0..20_000 {
             // Coordinates from a pixel's worth to the guard band's ±2^22 sub-pixels.
@@ -970,13 +955,8 @@ mod tests {
                 e.step();
             }
         }
-        let mut x = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_F491_4F6C_DD1Du64);
+        let mut next = || rng.next_u64();
         let lim = 1i64 << 22;
         for i in 0..40_000 {
             // Coordinates from tiny to the ±2^22 limit.
@@ -1120,13 +1100,8 @@ mod tests {
     fn walked_span_start_equals_span_start() {
         // Planes of any value and gradients (wrapping included), stepped down 40 rows from a
         // random first row, against the direct evaluation at every column tried.
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
+        let mut next = || rng.next_u64();
         for case in 0..5_000 {
             let r = next();
             let scale = (r % 64) as u32;

@@ -474,7 +474,7 @@ mod tests {
     #[test]
     fn q30_rounds_exactly_like_f64() {
         let reference = |v: f32| libm::rint(v as f64 * (1u64 << 30) as f64) as i32;
-        let mut x = 0x1234_5678u32;
+        let mut rng = crate::test_rng::XorShift32::new(0x1234_5678);
         let mut values = std::vec![0.0, -0.0, 0.5, -1.0, 1.999_999_9, 2.0, -2.0, 1e-10, 3.7e-9];
         values.extend([
             f32::NAN,
@@ -484,10 +484,8 @@ mod tests {
             f32::MIN_POSITIVE,
         ]);
         for _ in 0..200_000 {
-            // xorshift: bit patterns across all exponents, plus values in the useful range.
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
+            // Bit patterns across all exponents, plus values in the useful range.
+            let x = rng.next_u32();
             values.push(f32::from_bits(x));
             values.push((x as f32 / u32::MAX as f32) * 4.0 - 2.0);
         }
@@ -523,11 +521,9 @@ mod tests {
 
     #[test]
     fn transform_in_words_equals_the_64_bit_one() {
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
         let mut next = |bits: u32| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            let x = rng.next_u64();
             (x as i64 >> (64 - bits)) as i32
         };
         for case in 0..200_000 {
@@ -577,11 +573,9 @@ mod tests {
         let view = crate::scene::Camera::look_at([3.0, 2.0, 5.0], [0.0; 3], [0.0, 1.0, 0.0])
             .unwrap()
             .world_to_eye;
-        let mut x = 0x2545_f491u32;
+        let mut rng = crate::test_rng::XorShift32::new(0x2545_f491u32);
         let mut next = |range: f32| {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
+            let x = rng.next_u32();
             (x as f32 / u32::MAX as f32 * 2.0 - 1.0) * range
         };
         for &(extent, scale) in &[(1.0f32, 1.0f32), (0.01, 3.0), (100.0, 0.5), (1000.0, 2.0)] {
@@ -653,11 +647,9 @@ mod tests {
     #[test]
     fn shade_in_words_equals_shade() {
         let wide = |c: u8, i: u32| (((c as i64 * i as i64) + (1 << 29)) >> 30).clamp(0, 255);
-        let mut x = 0x2545_f491u32;
+        let mut rng = crate::test_rng::XorShift32::new(0x2545_f491u32);
         for step in 0..400_000u32 {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
+            let x = rng.next_u32();
             // Every intensity near each channel's rounding points, and random ones.
             let i = match step % 2 {
                 0 => x % ((1 << 30) + 1),
@@ -679,11 +671,9 @@ mod tests {
     #[test]
     fn face_color_equals_the_shaded_face() {
         use crate::math::{NarrowNormals, WideNormals};
-        let mut x = 0x9e37_79b9u32;
+        let mut rng = crate::test_rng::XorShift32::new(0x9e37_79b9u32);
         let mut next = |range: f32| {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
+            let x = rng.next_u32();
             (x as f32 / u32::MAX as f32 * 2.0 - 1.0) * range
         };
         let mut exact_needed = 0;
@@ -724,13 +714,8 @@ mod tests {
     #[test]
     fn cross_product_color_equals_the_shaded_cross_product() {
         use crate::math::{NarrowNormals, WideNormals};
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
+        let mut next = || rng.next_u64();
         for case in 0..20_000u32 {
             let r = |next: &mut dyn FnMut() -> u64| (next() >> 40) as f32 / (1u64 << 24) as f32;
             let light = Light::new(

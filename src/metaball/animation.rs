@@ -226,13 +226,8 @@ mod tests {
 
     #[test]
     fn interpolation_is_the_exact_value_rounded_once() {
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
+        let mut next = || rng.next_u64();
         for _ in 0..20_000 {
             let coord = |r: u64| ((r % 2_000_001) as f64 / 1e6 - 1.0) * 63.9;
             let f0 = (next() % 1000) as u32;

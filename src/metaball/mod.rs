@@ -441,11 +441,9 @@ mod tests {
 
     #[test]
     fn mul_is_fixeds_product() {
-        let mut x = 0x1234_5678_9abc_def1u64;
+        let mut rng = crate::test_rng::XorShift64::new(0x1234_5678_9abc_def1u64);
         let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            let x = rng.next_u64();
             // Magnitudes from 2^-32 to 2^15, both signs.
             (x as i64) >> (x % 48)
         };

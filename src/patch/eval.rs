@@ -428,11 +428,9 @@ mod tests {
 
     #[test]
     fn split_lanes_give_the_four_lanes_bits() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
         let mut next = |bits: u32| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
+            let seed = rng.next_u64();
             (seed >> (64 - bits)) as i64 - (1 << (bits - 1))
         };
         // Components below 2^32 bits, weights 1/16 to 16 (2^12 to 2^20 bits).

@@ -103,13 +103,8 @@ mod tests {
     #[test]
     fn the_panic_free_sort_sorts_like_the_standard_one() {
         // Lengths on both sides of the switch to heapsort, with and without repeated keys.
-        let mut seed = 0x2545_f491_u32;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 17;
-            seed ^= seed << 5;
-            seed
-        };
+        let mut rng = crate::test_rng::XorShift32::new(0x2545_f491_u32);
+        let mut next = move || rng.next_u32();
         for len in (0..=40).chain([255, 1000]) {
             for range in [4, 1 << 20] {
                 let v: Vec<(u32, usize)> = (0..len).map(|i| (next() % range, i)).collect();

@@ -832,13 +832,8 @@ mod tests {
 
     #[test]
     fn ior_ratio_is_checked_div() {
-        let mut x = 0x853c_49e6_748f_ea9bu64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x853c_49e6_748f_ea9bu64);
+        let mut next = || rng.next_u64();
         let mut pairs: std::vec::Vec<(i32, i32)> = (0..200_000)
             .map(|_| {
                 let (a, b) = (next(), next());
@@ -1068,13 +1063,8 @@ mod tests {
     /// of the range.
     #[test]
     fn kept_limit_is_the_recomputed_one() {
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
+        let mut next = || rng.next_u64();
         let recomputed = |n: &Nearest| {
             n.best
                 .map_or(n.t_max, |b| b.t.saturating_add(I16F16::DELTA).min(n.t_max))
@@ -1154,11 +1144,9 @@ mod tests {
         .unwrap();
         let tracer = Tracer::<5>::new(&scene, &camera, TraceOptions::default());
         let bvh = scene.bvh.as_ref().unwrap();
-        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
         let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            let x = rng.next_u64();
             (x >> 40) as f32 / (1u32 << 24) as f32 * 2.0 - 1.0
         };
         let mut hits = 0;

@@ -335,13 +335,8 @@ mod tests {
 
     #[test]
     fn reciprocal46_is_the_exact_quotient_from_2_to_the_14() {
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
+        let mut next = || rng.next_u64();
         let lens = (0..200_000)
             .map(|_| (next() >> 33) as u32)
             .filter(|l| *l >= 1 << 14)
@@ -355,13 +350,8 @@ mod tests {
 
     #[test]
     fn normalizable_is_whether_normalized_gives_a_vector() {
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
+        let mut next = || rng.next_u64();
         let small = |r: u64| (r % 769) as i32 - 384;
         let mut vectors: Vec<Vec3> = (0..100_000)
             .map(|_| Vec3::from_bits(small(next()), small(next() >> 16), small(next() >> 32)))
@@ -385,13 +375,8 @@ mod tests {
     #[test]
     fn narrow_bits_is_the_clamped_shift() {
         let wide = |v: i64| (v >> 16).clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
-        let mut x = 0xd1b5_4a32_d192_ed03u64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0xd1b5_4a32_d192_ed03u64);
+        let mut next = || rng.next_u64();
         let edges = (40..63).flat_map(|b| {
             let p = 1i64 << b;
             [p - 1, p, p + 1, -p - 1, -p, -p + 1]
@@ -407,13 +392,8 @@ mod tests {
 
     /// Raw I32F32 values: random magnitudes of every size, and the edges of each power of 2.
     fn wide_values() -> Vec<i64> {
-        let mut x = 0x6a09_e667_f3bc_c908u64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x6a09_e667_f3bc_c908u64);
+        let mut next = || rng.next_u64();
         let edges = (0..63).flat_map(|b| {
             let p = 1i64 << b;
             [p - 1, p, p + 1, -p - 1, -p, -p + 1]
@@ -458,13 +438,8 @@ mod tests {
 
     #[test]
     fn ratio16_is_within_its_bound() {
-        let mut x = 0x1234_5678_9abc_def1u64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x1234_5678_9abc_def1u64);
+        let mut next = || rng.next_u64();
         for _ in 0..200_000 {
             let n = next() >> (17 + next() % 40);
             let d = (next() >> (30 + next() % 34)).max(1);
