@@ -27,7 +27,10 @@
 //! solved in i128 once per triangle and stepped in i64 (depth) or i32 (colour).
 
 use crate::depth::Depth;
-use crate::math::{floor_div_i64, mul_i64_i32, mul_i64_u16, mul_wide, Divisor32, NO_WIDE_MULTIPLY};
+use crate::math::{
+    floor_div_i64, mul_i64_i32, mul_i64_u16, mul_wide, Divisor32, NO_HARDWARE_DIVIDE,
+    NO_WIDE_MULTIPLY,
+};
 use crate::project::ScreenVertex;
 use core::cmp::Ordering;
 use fixed::types::I16F16;
@@ -56,13 +59,22 @@ impl EdgeWalk {
     /// `None` if the edge is horizontal or upside down.
     pub fn new<const S: u32>(a: (i32, i32), b: (i32, i32), row: i32) -> Option<EdgeWalk> {
         // Doubled differences are below 2^24, so the slope's quotient and remainder take one
-        // 32-bit division (a single SDIV, or a 32-bit library call on thumbv6m).
+        // 32-bit division (a single SDIV, or a 32-bit library call on thumbv6m, which a steep
+        // edge skips).
         let dx = 2 * (b.0 - a.0);
         let dy = 2 * (b.1 - a.1);
         if dy <= 0 {
             return None;
         }
-        let (step, step_rem) = (dx.div_euclid(dy), dx.rem_euclid(dy));
+        let slope = if NO_HARDWARE_DIVIDE {
+            steep_slope(dx, dy)
+        } else {
+            None
+        };
+        let (step, step_rem) = match slope {
+            Some(s) => s,
+            None => (dx.div_euclid(dy), dx.rem_euclid(dy)),
+        };
         // Edge x at the row centre is ax + t·dx/dy with t = yc − ay.
         let t = (((2 * row as i64) + 1) << S) - 2 * a.1 as i64;
         let placed = if NO_WIDE_MULTIPLY {
@@ -98,6 +110,22 @@ impl EdgeWalk {
             self.rem -= self.dy;
             self.x = self.x.wrapping_add(1);
         }
+    }
+}
+
+/// The slope `dx / dy` (`dy > 0`) as floor quotient and remainder for a steep edge,
+/// `|dx| < dy`, whose quotient is 0 or −1: found by one comparison, without the division
+/// (a library call where the core has no divider, [`NO_HARDWARE_DIVIDE`]). `None` for a
+/// shallower edge. The same pair as `(dx.div_euclid(dy), dx.rem_euclid(dy))` (test
+/// `steep_slope_equals_the_division`).
+#[inline]
+fn steep_slope(dx: i32, dy: i32) -> Option<(i32, i32)> {
+    if dx.unsigned_abs() >= dy.unsigned_abs() {
+        None
+    } else if dx >= 0 {
+        Some((0, dx))
+    } else {
+        Some((-1, dx + dy))
     }
 }
 
@@ -1056,6 +1084,43 @@ mod tests {
             check::<0>(a, b, first(0) + offset);
             check::<4>(a, b, first(4) + offset);
             check::<8>(a, b, first(8) + offset);
+        }
+    }
+
+    /// The steep slope's quotient and remainder are the division's, for every `|dx| < dy`, and
+    /// it declines every shallower edge.
+    #[test]
+    fn steep_slope_equals_the_division() {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut pairs = std::vec![
+            (0, 1),
+            (-1, 2),
+            (1, 2),
+            (-2, 2),
+            (2, 2),
+            (i32::MIN + 1, i32::MAX)
+        ];
+        for _ in 0..100_000 {
+            let shift = (next() % 31) as u32;
+            let dy = ((next() as u32 >> 1) >> shift).max(1) as i32;
+            let dx = (next() as i32) >> (next() % 32);
+            pairs.push((dx, dy));
+            pairs.push((dx % dy, dy));
+        }
+        for (dx, dy) in pairs {
+            match steep_slope(dx, dy) {
+                Some(s) => {
+                    assert!(dx.unsigned_abs() < dy as u32, "{dx} / {dy}");
+                    assert_eq!(s, (dx.div_euclid(dy), dx.rem_euclid(dy)), "{dx} / {dy}");
+                }
+                None => assert!(dx.unsigned_abs() >= dy as u32, "{dx} / {dy}"),
+            }
         }
     }
 
