@@ -147,8 +147,17 @@ fn place_wide<const S: u32>(ax: i32, t: i64, dy: i32, step: i32, step_rem: i32) 
     let den = (dy as i64) << (S + 1);
     let m = mul_i64_i32(p & ((1i64 << (S + 1)) - 1), dy) + mul_i64_i32(t, step_rem) + den - 1;
     let (k, r) = if (0..3 * den).contains(&m) {
-        let k = (m >= den) as i64 + (m >= 2 * den) as i64;
-        (k, m - k * den)
+        // At most two subtractions (no product `k · den`).
+        let (mut k, mut r) = (0, m);
+        if r >= den {
+            r -= den;
+            k += 1;
+        }
+        if r >= den {
+            r -= den;
+            k += 1;
+        }
+        (k, r)
     } else {
         (m.div_euclid(den), m.rem_euclid(den))
     };
