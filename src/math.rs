@@ -82,6 +82,13 @@ impl MathBackend for Micromath {
 pub(crate) const NO_WIDE_MULTIPLY: bool =
     cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
 
+/// The core divides in software (ARMv6-M, as for [`NO_WIDE_MULTIPLY`]): even a 32-bit
+/// division is a call to `__aeabi_idiv` (tens of instructions), so quotients that a comparison
+/// can find are found that way there. Elsewhere (Cortex-M3/M4 `sdiv`, RV32 `M`, the host) a
+/// division is one instruction.
+pub(crate) const NO_HARDWARE_DIVIDE: bool =
+    cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
+
 /// `a · b` as `i64`: on cores without a wide multiply ([`NO_WIDE_MULTIPLY`]) from four
 /// 32-bit multiplies of 16-bit halves, elsewhere the `i64` multiply (one instruction). The
 /// same value either way (test `narrow_products_are_exact`).

@@ -27,7 +27,10 @@
 //! solved in i128 once per triangle and stepped in i64 (depth) or i32 (colour).
 
 use crate::depth::Depth;
-use crate::math::{floor_div_i64, mul_i64_i32, mul_i64_u16, mul_wide, Divisor32};
+use crate::math::{
+    floor_div_i64, mul_i64_i32, mul_i64_u16, mul_wide, Divisor32, NO_HARDWARE_DIVIDE,
+    NO_WIDE_MULTIPLY,
+};
 use crate::project::ScreenVertex;
 use core::cmp::Ordering;
 use fixed::types::I16F16;
@@ -56,37 +59,36 @@ impl EdgeWalk {
     /// `None` if the edge is horizontal or upside down.
     pub fn new<const S: u32>(a: (i32, i32), b: (i32, i32), row: i32) -> Option<EdgeWalk> {
         // Doubled differences are below 2^24, so the slope's quotient and remainder take one
-        // 32-bit division (a single SDIV, or a 32-bit library call on thumbv6m).
+        // 32-bit division (a single SDIV, or a 32-bit library call on thumbv6m, which a steep
+        // edge skips).
         let dx = 2 * (b.0 - a.0);
         let dy = 2 * (b.1 - a.1);
         if dy <= 0 {
             return None;
         }
-        let (step, step_rem) = (dx.div_euclid(dy), dx.rem_euclid(dy));
-        // Edge x at the row centre is ax + t·dx/dy with t = yc − ay. The first centre
-        // (2c + 1)·2^S at or right of it has c = ceil(num / den), where
-        // num = (ax − 2^S)·dy + t·dx and den = dy·2^(S+1). With dx = step·dy + step_rem:
-        // num = dy·p + t·step_rem, p = ax − 2^S + t·step. Splitting p = pq·2^(S+1) + pr leaves
-        // c = pq + ceil(m' / den) with m' = dy·pr + t·step_rem, and 0 <= m' < 2·den when the
-        // row is the first at or below `a` (0 <= t < 2^(S+1)), the case of every triangle walk:
-        // the quotient is then 0, 1 or 2, found by comparison instead of a second division.
-        // The products fit i64 (|t| < 2^34, factors below 2^25); `mul_i64_i32` keeps them off
-        // the 64-bit multiply call on ARMv6-M when `t` fits 32 bits, as it does on screen.
-        let t = (((2 * row as i64) + 1) << S) - 2 * a.1 as i64;
-        let p = 2 * a.0 as i64 - (1i64 << S) + mul_i64_i32(t, step);
-        let den = (dy as i64) << (S + 1);
-        let m = mul_i64_i32(p & ((1i64 << (S + 1)) - 1), dy) + mul_i64_i32(t, step_rem) + den - 1;
-        let (k, r) = if (0..3 * den).contains(&m) {
-            let k = (m >= den) as i64 + (m >= 2 * den) as i64;
-            (k, m - k * den)
+        let slope = if NO_HARDWARE_DIVIDE {
+            steep_slope(dx, dy)
         } else {
-            (m.div_euclid(den), m.rem_euclid(den))
+            None
+        };
+        let (step, step_rem) = match slope {
+            Some(s) => s,
+            None => (dx.div_euclid(dy), dx.rem_euclid(dy)),
+        };
+        // Edge x at the row centre is ax + t·dx/dy with t = yc − ay.
+        let t = (((2 * row as i64) + 1) << S) - 2 * a.1 as i64;
+        let placed = if NO_WIDE_MULTIPLY {
+            place_narrow::<S>(a.0, t, dx, dy, step, step_rem)
+        } else {
+            None
+        };
+        let (x, rem) = match placed {
+            Some(p) => p,
+            None => place_wide::<S>(a.0, t, dy, step, step_rem),
         };
         Some(EdgeWalk {
-            x: ((p >> (S + 1)) + k) as i32,
-            // The remainder's low S+1 bits never change while stepping (every increment is a
-            // multiple of 2^(S+1)), so only its high part, in [0, dy), is tracked.
-            rem: (r >> (S + 1)) as i32,
+            x,
+            rem,
             step,
             step_rem,
             dy,
@@ -109,6 +111,104 @@ impl EdgeWalk {
             self.x = self.x.wrapping_add(1);
         }
     }
+}
+
+/// The slope `dx / dy` (`dy > 0`) as floor quotient and remainder for a steep edge,
+/// `|dx| < dy`, whose quotient is 0 or −1: found by one comparison, without the division
+/// (a library call where the core has no divider, [`NO_HARDWARE_DIVIDE`]). `None` for a
+/// shallower edge. The same pair as `(dx.div_euclid(dy), dx.rem_euclid(dy))` (test
+/// `steep_slope_equals_the_division`).
+#[inline]
+fn steep_slope(dx: i32, dy: i32) -> Option<(i32, i32)> {
+    if dx.unsigned_abs() >= dy.unsigned_abs() {
+        None
+    } else if dx >= 0 {
+        Some((0, dx))
+    } else {
+        Some((-1, dx + dy))
+    }
+}
+
+/// [`EdgeWalk::new`]'s placement on the row `t` (doubled sub-pixels, from `a`'s y to the row's
+/// centre) below the edge's upper end `(ax, ·)`, with slope `dx / dy` = `step` + `step_rem / dy`:
+/// the first column at or right of the edge and the remainder's high part.
+///
+/// The first centre `(2c + 1)·2^S` at or right of the edge has c = ceil(num / den), where
+/// num = (ax − 2^S)·dy + t·dx and den = dy·2^(S+1). With dx = step·dy + step_rem:
+/// num = dy·p + t·step_rem, p = 2·ax − 2^S + t·step. Splitting p = pq·2^(S+1) + pr leaves
+/// c = pq + ceil(m' / den) with m' = dy·pr + t·step_rem, and 0 <= m' < 2·den when the row is
+/// the first at or below `a` (0 <= t < 2^(S+1)), the case of every triangle walk: the quotient
+/// is then 0, 1 or 2, found by comparison instead of a second division. The products fit i64
+/// (|t| < 2^34, factors below 2^25); `mul_i64_i32` keeps them off the 64-bit multiply call on
+/// ARMv6-M when `t` fits 32 bits, as it does on screen.
+#[inline]
+fn place_wide<const S: u32>(ax: i32, t: i64, dy: i32, step: i32, step_rem: i32) -> (i32, i32) {
+    let p = 2 * ax as i64 - (1i64 << S) + mul_i64_i32(t, step);
+    let den = (dy as i64) << (S + 1);
+    let m = mul_i64_i32(p & ((1i64 << (S + 1)) - 1), dy) + mul_i64_i32(t, step_rem) + den - 1;
+    let (k, r) = if (0..3 * den).contains(&m) {
+        // At most two subtractions (no product `k · den`).
+        let (mut k, mut r) = (0, m);
+        if r >= den {
+            r -= den;
+            k += 1;
+        }
+        if r >= den {
+            r -= den;
+            k += 1;
+        }
+        (k, r)
+    } else {
+        (m.div_euclid(den), m.rem_euclid(den))
+    };
+    (
+        ((p >> (S + 1)) + k) as i32,
+        // The remainder's low S+1 bits never change while stepping (every increment is a
+        // multiple of 2^(S+1)), so only its high part, in [0, dy), is tracked.
+        (r >> (S + 1)) as i32,
+    )
+}
+
+/// [`place_wide`] in 32-bit arithmetic, for the core without a 32 × 32 → 64-bit multiply
+/// ([`NO_WIDE_MULTIPLY`], where every `i64` product or comparison is several instructions or
+/// a call): `None` unless the row is the first centre row at or below `a`
+/// (`0 <= t < 2^(S+1)`) and `|dx|, dy < 2^(28−S)`, `|ax| < 2^28` (every on-screen edge with
+/// `S <= 4`). Then `|p| < 2^31` (`|step| <= |dx|`) and `0 <= m' + den − 1 < 3·den < 2^31`,
+/// so the same steps in `i32` give the same column and remainder (test
+/// `narrow_placement_equals_wide`).
+#[inline]
+fn place_narrow<const S: u32>(
+    ax: i32,
+    t: i64,
+    dx: i32,
+    dy: i32,
+    step: i32,
+    step_rem: i32,
+) -> Option<(i32, i32)> {
+    if S > 26 {
+        return None;
+    }
+    let limit = 1u32 << (28 - S);
+    let t = i32::try_from(t)
+        .ok()
+        .filter(|t| (0..1 << (S + 1)).contains(t))?;
+    if dx.unsigned_abs() >= limit || dy.unsigned_abs() >= limit || ax.unsigned_abs() >= 1 << 28 {
+        return None;
+    }
+    let p = 2 * ax - (1 << S) + t * step;
+    let den = dy << (S + 1);
+    let mut r = (p & ((1 << (S + 1)) - 1)) * dy + t * step_rem + den - 1;
+    let mut x = p >> (S + 1);
+    // 0 <= r < 3·den: at most two subtractions.
+    if r >= den {
+        r -= den;
+        x += 1;
+    }
+    if r >= den {
+        r -= den;
+        x += 1;
+    }
+    Some((x, r >> (S + 1)))
 }
 
 /// A triangle being walked row by row: a long edge on one side, two short edges on the other.
@@ -973,6 +1073,115 @@ mod tests {
             check::<0>(a, b, first(0) + offset);
             check::<4>(a, b, first(4) + offset);
             check::<8>(a, b, first(8) + offset);
+        }
+    }
+
+    /// The steep slope's quotient and remainder are the division's, for every `|dx| < dy`, and
+    /// it declines every shallower edge.
+    #[test]
+    fn steep_slope_equals_the_division() {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut pairs = std::vec![
+            (0, 1),
+            (-1, 2),
+            (1, 2),
+            (-2, 2),
+            (2, 2),
+            (i32::MIN + 1, i32::MAX)
+        ];
+        for _ in 0..100_000 {
+            let shift = (next() % 31) as u32;
+            let dy = ((next() as u32 >> 1) >> shift).max(1) as i32;
+            let dx = (next() as i32) >> (next() % 32);
+            pairs.push((dx, dy));
+            pairs.push((dx % dy, dy));
+        }
+        for (dx, dy) in pairs {
+            match steep_slope(dx, dy) {
+                Some(s) => {
+                    assert!(dx.unsigned_abs() < dy as u32, "{dx} / {dy}");
+                    assert_eq!(s, (dx.div_euclid(dy), dx.rem_euclid(dy)), "{dx} / {dy}");
+                }
+                None => assert!(dx.unsigned_abs() >= dy as u32, "{dx} / {dy}"),
+            }
+        }
+    }
+
+    /// The 32-bit placement gives the 64-bit one's column and remainder wherever it applies,
+    /// on random edges and on its limits, and applies to every edge of the bit budget
+    /// (coordinates within ±2^22) on its first row with 4 sub-pixel bits.
+    #[test]
+    fn narrow_placement_equals_wide() {
+        fn check<const S: u32>(ax: i32, t: i64, dx: i32, dy: i32) -> bool {
+            let (step, step_rem) = (dx.div_euclid(dy), dx.rem_euclid(dy));
+            let wide = place_wide::<S>(ax, t, dy, step, step_rem);
+            match place_narrow::<S>(ax, t, dx, dy, step, step_rem) {
+                Some(narrow) => {
+                    assert_eq!(narrow, wide, "S {S} ax {ax} t {t} dx {dx} dy {dy}");
+                    true
+                }
+                None => false,
+            }
+        }
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        // The limits: |dx|, dy up to 2^(28−S) − 1, |ax| up to 2^28 − 1, t at both ends.
+        for s in [0u32, 4, 8] {
+            let limit = (1i32 << (28 - s)) - 1;
+            for ax in [-(1 << 28) + 1, -1, 0, 1, (1 << 28) - 1] {
+                for dx in [-limit, -limit + 1, -1, 0, 1, limit - 1, limit] {
+                    for dy in [1, 2, limit - 1, limit] {
+                        for t in [0, 1, (1i64 << (s + 1)) - 1] {
+                            let applied = match s {
+                                0 => check::<0>(ax, t, dx, dy),
+                                4 => check::<4>(ax, t, dx, dy),
+                                _ => check::<8>(ax, t, dx, dy),
+                            };
+                            assert!(applied, "S {s} ax {ax} t {t} dx {dx} dy {dy}");
+                        }
+                    }
+                }
+            }
+            // Just outside: declined.
+            assert!(!check::<4>(0, 32, 2, 2));
+            assert!(!check::<4>(0, -1, 2, 2));
+            assert!(!check::<4>(0, 0, 1 << 24, 2));
+            assert!(!check::<4>(0, 0, 2, 1 << 24));
+            assert!(!check::<4>(1 << 28, 0, 2, 2));
+        }
+        let lim = 1i64 << 22;
+        for i in 0..200_000 {
+            // Edges of the bit budget, from tiny to the ±2^22 limit, on the first row below
+            // their upper end (or, one time in four, any row, where the wide path may decide).
+            let shift = (next() % 23) as u32;
+            let mut coord = || ((next() as i64).rem_euclid(2 * lim) - lim) as i32 >> shift;
+            let a = (coord(), coord());
+            let b = (coord(), coord());
+            let (dx, dy) = (2 * (b.0 - a.0), 2 * (b.1 - a.1));
+            if dy <= 0 {
+                continue;
+            }
+            let t = if i % 4 == 3 {
+                // Any row on or off screen: |t| < 2^34, the wide placement's bound.
+                (next() as i64) >> (30 + next() % 34)
+            } else {
+                (next() % 32) as i64
+            };
+            let applied = check::<4>(a.0, t, dx, dy);
+            assert!(applied || i % 4 == 3, "ax {} t {t} dx {dx} dy {dy}", a.0);
+            check::<0>(a.0, t % 2, dx, dy);
+            check::<8>(a.0, (next() % 512) as i64, dx, dy);
         }
     }
 

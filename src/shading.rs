@@ -299,6 +299,14 @@ impl Shading for Flat {
         let mut q = span.q;
         let mut written = 0;
         for (z, p) in depth.iter_mut().zip(pixels.iter_mut()) {
+            // One pixel per iteration on Arm: without this empty barrier the compiler unrolls
+            // the loop four times, which runs out of registers on Cortex-M (spills in the
+            // loop, a remainder loop, a longer entry) and costs more than it saves on the
+            // short spans of a frame (docs/speed.md, item 12). On RISC-V the unrolled loop is
+            // the cheaper one, so it is left alone there.
+            if cfg!(target_arch = "arm") {
+                core::hint::black_box(());
+            }
             // Strictly nearer wins: on an exact tie the surface drawn first keeps the pixel.
             let stored = Z::store(q);
             if stored > *z {
