@@ -1080,13 +1080,8 @@ mod tests {
     /// it declines every shallower edge.
     #[test]
     fn steep_slope_equals_the_division() {
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
+        let mut next = || rng.next_u64();
         let mut pairs = std::vec![
             (0, 1),
             (-1, 2),
@@ -1129,13 +1124,8 @@ mod tests {
                 None => false,
             }
         }
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
+        let mut next = || rng.next_u64();
         // The limits: |dx|, dy up to 2^(28−S) − 1, |ax| up to 2^28 − 1, t at both ends.
         for s in [0u32, 4, 8] {
             let limit = (1i32 << (28 - s)) - 1;
