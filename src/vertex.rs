@@ -380,9 +380,9 @@ fn face_normal(v: [&Vertex; 3]) -> [i64; 3] {
 impl Lighting {
     /// `shade(base, self.face::<N>(v))`, mostly without the exact cosine: each channel is a
     /// non-decreasing function of the Lambert term, so where the colours at both ends of
-    /// [`NormalPrecision::lambert_bounds`] agree, every term between gives that colour, the
+    /// [`NormalPrecision::lambert`] agree, every term between gives that colour, the
     /// exact one included. Else (a colour step inside the bounds, a few faces in a hundred)
-    /// the exact cosine decides. Test `face_color_equals_the_shaded_face`.
+    /// the exact term decides ([`crate::math::Lambert::exact`], from the bounds' own values). Test `face_color_equals_the_shaded_face`.
     // Not inlined: in its caller it made the lean minimal build's render stack on thumbv6m
     // 1,264 B instead of 1,192 B, over the 4 KiB RAM budget with the workspace.
     #[inline(never)]
@@ -398,14 +398,14 @@ impl Lighting {
         let Some(w) = self.normal_to_world(n) else {
             return shade(base, self.ambient);
         };
-        let Some((lo, hi)) = N::lambert_bounds(w, self.direction) else {
+        let Some(lambert) = N::lambert(w, self.direction) else {
             return shade(base, self.intensity(0)); // (the exact cosine's zero vector)
         };
-        let low = shade(base, self.intensity(lo));
-        if lo == hi || shade(base, self.intensity(hi)) == low {
+        let low = shade(base, self.intensity(lambert.lo));
+        if lambert.lo == lambert.hi || shade(base, self.intensity(lambert.hi)) == low {
             return low;
         }
-        shade(base, self.intensity_of_world_normal::<N>(w))
+        shade(base, self.intensity(lambert.exact()))
     }
 
     /// Intensity of a surface whose model-space normal is the cross product `n` of two model
@@ -709,8 +709,8 @@ mod tests {
                     let narrow = shade(base, l.face::<NarrowNormals>([&a, &b, &c]));
                     assert_eq!(l.face_color::<NarrowNormals>(base, [&a, &b, &c]), narrow);
                     let w = l.normal_to_world(face_normal([&a, &b, &c]));
-                    let bounds = w.and_then(|w| WideNormals::lambert_bounds(w, l.direction));
-                    if let Some((lo, hi)) = bounds {
+                    let bounds = w.and_then(|w| WideNormals::lambert(w, l.direction));
+                    if let Some(crate::math::Lambert { lo, hi, .. }) = bounds {
                         exact_needed +=
                             (shade(base, l.intensity(lo)) != shade(base, l.intensity(hi))) as u32;
                     }
