@@ -192,7 +192,7 @@ impl Lambert {
     }
 
     /// The term between the bounds: `lo` when the bounds are equal, else `⌊dot / ⌊√square⌋⌋`,
-    /// which is [`cosine_i64`]'s quotient for a positive dot product (its root and division
+    /// which is `cosine_i64`'s quotient for a positive dot product (its root and division
     /// of the same 30-bit vector). Test `lambert_bounds_hold`.
     #[inline]
     pub fn exact(&self) -> i32 {
