@@ -610,6 +610,62 @@ pub(crate) fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i32; 3]> {
     })
 }
 
+/// `v · 2^frac` rounded to nearest, ties to even, as `i32` bits: `fixed`'s `checked_from_num`
+/// for a fixed-point type with `frac` fractional bits (`frac <= 31`), taken from the float's
+/// bits with integer operations only (no soft-float calls on cores without an FPU). `None`
+/// for NaN, infinities and values whose rounded bits do not fit `i32`. Test
+/// `fixed_from_f32_equals_fixed`.
+pub(crate) fn fixed_from_f32(v: f32, frac: u32) -> Option<i32> {
+    let bits = v.to_bits();
+    let exp = (bits >> 23 & 0xFF) as i32;
+    if exp == 0xFF {
+        return None;
+    }
+    // |v| = m · 2^(max(exp, 1) − 150): the implicit bit for normal numbers, none for
+    // subnormal ones (exp 0).
+    let m = if exp == 0 {
+        bits & 0x7F_FFFF
+    } else {
+        bits & 0x7F_FFFF | 0x80_0000
+    };
+    let shift = exp.max(1) - 150 + frac as i32;
+    let magnitude = if shift >= 0 {
+        // m < 2^24: up to 8 more bits fit `u32`; a normal m (>= 2^23) shifted 9 or more is
+        // beyond 2^31 (and a subnormal one never shifts left for frac <= 31).
+        if shift > 8 {
+            return None;
+        }
+        m << shift
+    } else {
+        let k = shift.unsigned_abs();
+        if k > 24 {
+            // Below half a unit (m < 2^24 <= 2^(k − 1)): rounds to 0.
+            0
+        } else {
+            // Keep one more bit (the half), and whether anything below it is set.
+            let halves = m >> (k - 1);
+            let sticky = m & ((1 << (k - 1)) - 1) != 0;
+            let q = halves >> 1;
+            q + (halves & 1 != 0 && (sticky || q & 1 != 0)) as u32
+        }
+    };
+    if bits >> 31 == 0 {
+        i32::try_from(magnitude).ok()
+    } else if magnitude <= 1 << 31 {
+        // −2^31 fits: its magnitude as `i32` wraps to itself.
+        Some((magnitude as i32).wrapping_neg())
+    } else {
+        None
+    }
+}
+
+/// `v` as I16F16, rounded to nearest (ties to even) and checked: `I16F16::checked_from_num(v)`
+/// without the float operations ([`fixed_from_f32`]).
+#[inline]
+pub(crate) fn i16f16_from_f32(v: f32) -> Option<fixed::types::I16F16> {
+    fixed_from_f32(v, 16).map(fixed::types::I16F16::from_bits)
+}
+
 /// How precisely lighting takes the cosine between a normal and the light, chosen at compile
 /// time (see [`crate::arithmetic::Arithmetic`]).
 pub trait NormalPrecision:
@@ -1081,6 +1137,74 @@ mod tests {
             cosine_i32([i64::MIN + 1, 0, 0], [1 << 30, 0, 0]),
             Some(-(1 << 30))
         );
+    }
+
+    /// `fixed_from_f32` equals `fixed`'s checked conversion for 16 and 30 fractional bits
+    /// (and 0 and 31): every exponent, the rounding ties and their neighbours, the ends of the
+    /// range, zeros, subnormals, infinities and NaN.
+    #[test]
+    fn fixed_from_f32_equals_fixed() {
+        use fixed::types::{I16F16, I1F31, I2F30, I32F0};
+        let check = |v: f32| {
+            let want = [
+                I32F0::checked_from_num(v).map(|x| x.to_bits()),
+                I16F16::checked_from_num(v).map(|x| x.to_bits()),
+                I2F30::checked_from_num(v).map(|x| x.to_bits()),
+                I1F31::checked_from_num(v).map(|x| x.to_bits()),
+            ];
+            let got = [0, 16, 30, 31].map(|frac| fixed_from_f32(v, frac));
+            assert_eq!(got, want, "{v:e} ({:#x})", v.to_bits());
+            assert_eq!(i16f16_from_f32(v), I16F16::checked_from_num(v), "{v:e}");
+        };
+        let mut specials = std::vec![
+            0.0f32,
+            -0.0,
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::MAX,
+            f32::MIN,
+            f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            f32::from_bits(0x80_0001),
+            32768.0,
+            -32768.0,
+            32767.99,
+            -32768.01,
+            2.0,
+            -2.0,
+            1.0,
+            -1.0,
+            2147483648.0,
+            -2147483648.0,
+        ];
+        // Ties at every scale: (2j + 1)·2^-(frac + 1) and neighbours, for each fraction size.
+        for frac in [0i32, 16, 30, 31] {
+            for e in -40i32..40 {
+                for j in [0u32, 1, 2, 3, 0x7F_FFFF, 0xFF_FFFF] {
+                    let t = (2 * j + 1) as f32 * libm::exp2f((e - frac - 1) as f32);
+                    for v in [t, -t] {
+                        specials.extend([v, f32::from_bits(v.to_bits() + 1)]);
+                        specials.push(f32::from_bits(v.to_bits().wrapping_sub(1)));
+                    }
+                }
+            }
+        }
+        for v in specials {
+            check(v);
+        }
+        // Every exponent with random mantissas.
+        let mut x = 0x2545_f491u32;
+        for _ in 0..1_000_000 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            check(f32::from_bits(x));
+            // Concentrated on the exponents that matter (|v| from 2^-33 to 2^33).
+            let near = (x & 0x807F_FFFF) | ((94 + (x >> 23) % 67) << 23);
+            check(f32::from_bits(near));
+        }
     }
 
     #[test]

@@ -14,7 +14,7 @@
 //! * Depth `q = near / w` in I2F30: `near · 2^30 < 2^61`.
 
 use crate::depth::Depth;
-use crate::math::{floor_div_i64, mul_wide};
+use crate::math::{floor_div_i64, i16f16_from_f32, mul_wide};
 use crate::vertex::EyePoint;
 use fixed::types::I16F16;
 
@@ -121,8 +121,8 @@ impl<const S: u32> Viewport<S> {
         let sub = (1u32 << S) as f32;
         let ax = Scale::new(width as f32 * 0.5 * (focal / aspect) * sub)?;
         let ay = Scale::new(height as f32 * 0.5 * focal * sub)?;
-        let near = I16F16::checked_from_num(near)?;
-        let far = I16F16::checked_from_num(far)?;
+        let near = i16f16_from_f32(near)?;
+        let far = i16f16_from_f32(far)?;
         Some(Viewport {
             width: width as u16,
             height: height as u16,

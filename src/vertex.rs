@@ -13,7 +13,9 @@
 //!
 //! [`MAX_MODEL_COORD`]: crate::scene::MAX_MODEL_COORD
 
-use crate::math::{fit_bits, mul_wide, NormalPrecision, NO_WIDE_MULTIPLY};
+use crate::math::{
+    fit_bits, fixed_from_f32, i16f16_from_f32, mul_wide, NormalPrecision, NO_WIDE_MULTIPLY,
+};
 use crate::scene::{Light, Transform, Vertex};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::{I16F16, I2F30};
@@ -148,16 +150,15 @@ impl ModelView {
         let mut m = [[I16F16::ZERO; 3]; 3];
         let mut t = [I16F16::ZERO; 3];
         for r in 0..3 {
-            let sign = if r == 2 { -1.0 } else { 1.0 };
+            // Negating a float flips its sign bit: exactly `-1.0 * entry`.
+            let signed = |entry: f32| if r == 2 { -entry } else { entry };
             let mut bound: i64 = 0;
             for (out, &entry) in m[r].iter_mut().zip(&mv.m[r][..3]) {
-                let v =
-                    I16F16::checked_from_num(sign * entry).ok_or(TransformError::OutOfEnvelope)?;
+                let v = i16f16_from_f32(signed(entry)).ok_or(TransformError::OutOfEnvelope)?;
                 *out = v;
                 bound += (v.to_bits() as i64).abs() * max_abs_bits as i64;
             }
-            let tv =
-                I16F16::checked_from_num(sign * mv.m[r][3]).ok_or(TransformError::OutOfEnvelope)?;
+            let tv = i16f16_from_f32(signed(mv.m[r][3])).ok_or(TransformError::OutOfEnvelope)?;
             t[r] = tv;
             bound += (tv.to_bits() as i64).abs() << 16;
             if bound > MAX_EYE_COORD_BITS << 16 {
@@ -293,13 +294,19 @@ pub struct Lighting {
 
 /// `v` in I2F30 bits, rounded to nearest (ties to even, as `fixed` rounds) and saturated; NaN
 /// gives 0. Written out because `fixed`'s saturating conversion panics on NaN, and the render
-/// path must not contain a panic (`examples/panic_never.rs` checks that at link time).
+/// path must not contain a panic (`examples/panic_never.rs` checks that at link time). The
+/// rounding is [`fixed_from_f32`]'s (integer operations on the float's bits, shared with the
+/// I16F16 conversions); out of range it saturates by the sign bit, as `as i32` would.
 fn q30(v: f32) -> i32 {
-    // Scaling by 2^30 is exact in f32 (it only changes the exponent), and `rintf` of an f32 is
-    // exact too: below 2^23 the rounded integer fits the 24-bit mantissa, above it the value is
-    // already an integer. So this equals rounding in f64, without pulling f64 soft-float code
-    // into builds for cores without an FPU. `as` saturates and maps NaN to 0.
-    libm::rintf(v * (1u32 << 30) as f32) as i32
+    let bits = v.to_bits();
+    match fixed_from_f32(v, 30) {
+        Some(q) => q,
+        // NaN (an all-ones exponent and a non-zero mantissa), tested on the bits: a float
+        // comparison would be a soft-float call.
+        None if bits & 0x7FFF_FFFF > 0x7F80_0000 => 0,
+        None if bits >> 31 != 0 => i32::MIN,
+        None => i32::MAX,
+    }
 }
 
 impl Lighting {
