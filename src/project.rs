@@ -51,20 +51,39 @@ pub struct Scale {
 
 impl Scale {
     /// `None` unless `0 < v < 2^25` and finite.
+    ///
+    /// Taken from the float's bits, with integer operations only (no soft-float calls on cores
+    /// without an FPU): `v = M · 2^(e − 150)` with the 24-bit mantissa `M` (implicit bit
+    /// included) and the biased exponent `e`, so `v · 2^shift` lies in `[2^24, 2^25)` for
+    /// `shift = 151 − e`, where it is `2M` (doubling is exact). The shift is capped at 62 (a
+    /// `v` below about 2^-37): the mantissa is then `⌊v · 2^62⌋`, `M` shifted right by
+    /// `88 − e`. This is what doubling `v` in `f32` until it reaches 2^24 (at most 62 times)
+    /// and truncating gave. Test `scale_equals_doubling_in_f32`.
     pub fn new(v: f32) -> Option<Scale> {
-        if v.is_nan() || v <= 0.0 || v >= (1u32 << 25) as f32 {
+        let bits = v.to_bits();
+        // Positive (sign bit clear, not zero) and below 2^25 (biased exponent 152), which
+        // also excludes infinity and NaN.
+        if bits == 0 || bits >= 0x4C00_0000 {
             return None;
         }
-        let mut m = v;
-        let mut shift = 0u32;
-        // Doubling an f32 is exact, so the mantissa is the float's own 24 bits.
-        while m < (1u32 << 24) as f32 && shift < 62 {
-            m *= 2.0;
-            shift += 1;
-        }
-        Some(Scale {
-            mantissa: m as i32,
-            shift,
+        let e = bits >> 23;
+        // A subnormal `v` (e = 0) is `bits · 2^-149`: its mantissa shifted by 88 is 0, as is
+        // `⌊v · 2^62⌋`.
+        let m = if e == 0 {
+            bits
+        } else {
+            bits & 0x7F_FFFF | 0x80_0000
+        };
+        Some(if e >= 89 {
+            Scale {
+                mantissa: (m << 1) as i32,
+                shift: 151 - e,
+            }
+        } else {
+            Scale {
+                mantissa: m.checked_shr(88 - e).unwrap_or(0) as i32,
+                shift: 62,
+            }
         })
     }
 
@@ -446,6 +465,62 @@ pub(crate) mod tests {
                 let q = exact.q.to_bits() as f64;
                 assert!(((fast.q.to_bits() - exact.q.to_bits()).abs() as f64) <= q / 16384.0 + 1.0);
             }
+        }
+    }
+
+    /// `Scale::new` from the float's bits equals the doubling in `f32` it replaced: every
+    /// exponent (subnormals, the cap at 62, the top of the range), the rejected values, and
+    /// random floats.
+    #[test]
+    fn scale_equals_doubling_in_f32() {
+        let doubling = |v: f32| -> Option<Scale> {
+            if v.is_nan() || v <= 0.0 || v >= (1u32 << 25) as f32 {
+                return None;
+            }
+            let (mut m, mut shift) = (v, 0u32);
+            while m < (1u32 << 24) as f32 && shift < 62 {
+                m *= 2.0;
+                shift += 1;
+            }
+            Some(Scale {
+                mantissa: m as i32,
+                shift,
+            })
+        };
+        let mut values = std::vec![
+            0.0f32,
+            -0.0,
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            (1u32 << 25) as f32,
+            f32::from_bits(((1u32 << 25) as f32).to_bits() - 1),
+            (1u32 << 24) as f32,
+            -1.0,
+            1.0,
+            3.0e-5,
+        ];
+        for e in 0..=255u32 {
+            for m in [0u32, 1, 0x40_0000, 0x7F_FFFF, 0x12_3457] {
+                values.extend([
+                    f32::from_bits(e << 23 | m),
+                    f32::from_bits(1 << 31 | e << 23 | m),
+                ]);
+            }
+        }
+        let mut x = 0x1234_5678u32;
+        for _ in 0..1_000_000 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            values.push(f32::from_bits(x));
+            values.push(f32::from_bits(x & 0x4FFF_FFFF));
+        }
+        for v in values {
+            assert_eq!(Scale::new(v), doubling(v), "{v:e} ({:#x})", v.to_bits());
         }
     }
 
