@@ -371,16 +371,25 @@ impl Lighting {
 
 /// The model-space normal of a face with vertices `v` (counter-clockwise = front), not
 /// normalized: the cross product of two edges.
+///
+/// Bit budget: a validated mesh's coordinates are within ±[`MAX_MODEL_COORD`] = 2^12 units,
+/// ±2^28 in I16F16 bits, so an edge component is within ±2^29 and fits `i32`; each product
+/// of two is at most 2^58 in magnitude (a 32 × 32 → 64-bit [`mul_wide`]) and each difference
+/// of two at most 2^59, in `i64`. That is the cross product the `i64` edges gave. (Vertices
+/// outside the envelope, which no validated mesh has, wrap in the edge subtraction instead of
+/// overflowing the `i64` products; neither is meaningful.) Test `face_normal_at_the_extremes`.
+///
+/// [`MAX_MODEL_COORD`]: crate::scene::MAX_MODEL_COORD
 #[inline]
 fn face_normal(v: [&Vertex; 3]) -> [i64; 3] {
-    let d = |a: &Vertex, b: &Vertex, k: usize| b[k].to_bits() as i64 - a[k].to_bits() as i64;
+    let d = |a: &Vertex, b: &Vertex, k: usize| b[k].to_bits().wrapping_sub(a[k].to_bits());
     let e1 = [0, 1, 2].map(|k| d(v[0], v[1], k));
     let e2 = [0, 1, 2].map(|k| d(v[0], v[2], k));
-    // Coordinates within ±2^28 bits: edge components < 2^29, products < 2^58, sums < 2^59.
+    let cross = |a: i32, b: i32, c: i32, d: i32| mul_wide(a, b) - mul_wide(c, d);
     [
-        cross_diff(e1[1], e2[2], e1[2], e2[1]),
-        cross_diff(e1[2], e2[0], e1[0], e2[2]),
-        cross_diff(e1[0], e2[1], e1[1], e2[0]),
+        cross(e1[1], e2[2], e1[2], e2[1]),
+        cross(e1[2], e2[0], e1[0], e2[2]),
+        cross(e1[0], e2[1], e1[1], e2[0]),
     ]
 }
 
@@ -436,18 +445,6 @@ impl Lighting {
             None => self.ambient,
         }
     }
-}
-
-/// `a·b − c·d` as the `i64` expression gives it; on cores without a wide multiply in
-/// [`mul_wide`]s when every factor fits `i32` (a face of a validated mesh: edge components
-/// below 2^29).
-#[inline]
-fn cross_diff(a: i64, b: i64, c: i64, d: i64) -> i64 {
-    let fits = |v: i64| v as i32 as i64 == v;
-    if NO_WIDE_MULTIPLY && fits(a) && fits(b) && fits(c) && fits(d) {
-        return mul_wide(a as i32, b as i32) - mul_wide(c as i32, d as i32);
-    }
-    a * b - c * d
 }
 
 /// `base * intensity` per channel, rounded to nearest.
@@ -655,6 +652,57 @@ mod tests {
         assert_eq!(m.face::<W>([&a, &b, &c]), I2F30::from_bits(1 << 30));
         assert_eq!(m.vertex::<W>(&v(0.0, 0.0, 1.0)), I2F30::from_num(0.25));
         assert_eq!(m.vertex::<W>(&v(0.0, 0.0, -3.0)), I2F30::from_bits(1 << 30));
+    }
+
+    /// The face normal from `i32` edges equals the cross product in `i128` for vertices at
+    /// the ends of the model envelope (every corner of the ±2^28-bit cube, and edges of
+    /// ±2^29 on every axis), and for random ones inside it.
+    #[test]
+    fn face_normal_at_the_extremes() {
+        use crate::scene::MAX_MODEL_COORD;
+        let max = MAX_MODEL_COORD << 16;
+        let wide = |v: [&Vertex; 3]| -> [i64; 3] {
+            let d =
+                |a: &Vertex, b: &Vertex, k: usize| b[k].to_bits() as i128 - a[k].to_bits() as i128;
+            let e1 = [0, 1, 2].map(|k| d(v[0], v[1], k));
+            let e2 = [0, 1, 2].map(|k| d(v[0], v[2], k));
+            let n = [
+                e1[1] * e2[2] - e1[2] * e2[1],
+                e1[2] * e2[0] - e1[0] * e2[2],
+                e1[0] * e2[1] - e1[1] * e2[0],
+            ];
+            n.map(|c| i64::try_from(c).unwrap())
+        };
+        let corner =
+            |k: u32| [0, 1, 2].map(|a| Coord::from_bits(if k >> a & 1 == 0 { -max } else { max }));
+        let mut largest = 0;
+        for a in 0..8 {
+            for b in 0..8 {
+                for c in 0..8 {
+                    let v = [corner(a), corner(b), corner(c)];
+                    let n = face_normal([&v[0], &v[1], &v[2]]);
+                    assert_eq!(n, wide([&v[0], &v[1], &v[2]]), "{a} {b} {c}");
+                    largest = largest.max(n.iter().map(|c| c.unsigned_abs()).max().unwrap());
+                }
+            }
+        }
+        // Edges of ±2^29 on two axes: the products reach 2^58, and so do the components (a
+        // triangle in the cube is at most that large; 2^59 bounds the difference).
+        assert_eq!(largest, 1 << 58);
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..200_000 {
+            let v = [(); 3].map(|_| {
+                [(); 3].map(|_| {
+                    x ^= x << 13;
+                    x ^= x >> 7;
+                    x ^= x << 17;
+                    let c = (x as i32) >> (x >> 59);
+                    Coord::from_bits(c.clamp(-max, max))
+                })
+            });
+            let v = [&v[0], &v[1], &v[2]];
+            assert_eq!(face_normal(v), wide(v), "{v:?}");
+        }
     }
 
     #[test]
