@@ -108,9 +108,9 @@ pub struct Viewport<const S: u32> {
     pub near: I16F16,
     /// Far-plane distance.
     pub far: I16F16,
-    /// Guard band half-widths in sub-pixel units.
-    guard_x: i64,
-    guard_y: i64,
+    /// Guard band half-widths in sub-pixel units: at most `8 · 2048 / 2 · 2^8 = 2^21`.
+    guard_x: i32,
+    guard_y: i32,
 }
 
 /// A projected vertex: snapped screen position, depth and colour attribute.
@@ -149,25 +149,33 @@ impl<const S: u32> Viewport<S> {
             ay,
             near,
             far,
-            guard_x: ((GUARD_BAND_HALF_SCREENS * width as i64) << S) >> 1,
-            guard_y: ((GUARD_BAND_HALF_SCREENS * height as i64) << S) >> 1,
+            // Below 2^21 (size and `S` checked above), so `as i32` keeps the value.
+            guard_x: (((GUARD_BAND_HALF_SCREENS * width as i64) << S) >> 1) as i32,
+            guard_y: (((GUARD_BAND_HALF_SCREENS * height as i64) << S) >> 1) as i32,
         })
     }
 
     /// The six clip distances of an eye point: `[near, far, left, right, top, bottom]`, each
     /// `>= 0` inside. Near/far are in I16F16 bits; the guard planes in sub-pixels × w bits.
+    ///
+    /// The guard half-widths (below 2^21) and `w` fit `i32`, so `guard · w` is a 32 × 32 →
+    /// 64-bit [`mul_wide`]: on cores without a wide multiply (thumbv6m) four 32-bit
+    /// multiplies instead of a call of the 64-bit one, elsewhere the same `i64` product. Test
+    /// `clip_distances_equal_the_64_bit_products`.
     #[inline]
     pub fn clip_distances(&self, p: &EyePoint) -> [i64; 6] {
-        let w = p.w.to_bits() as i64;
+        let w = p.w.to_bits();
         let nx = self.ax.apply(p.x.to_bits());
         let ny = self.ay.apply(p.y.to_bits());
+        let (gx, gy) = (mul_wide(self.guard_x, w), mul_wide(self.guard_y, w));
+        let w = w as i64;
         [
             w - self.near.to_bits() as i64,
             self.far.to_bits() as i64 - w,
-            self.guard_x * w + nx,
-            self.guard_x * w - nx,
-            self.guard_y * w - ny,
-            self.guard_y * w + ny,
+            gx + nx,
+            gx - nx,
+            gy - ny,
+            gy + ny,
         ]
     }
 
@@ -521,6 +529,54 @@ pub(crate) mod tests {
         }
         for v in values {
             assert_eq!(Scale::new(v), doubling(v), "{v:e} ({:#x})", v.to_bits());
+        }
+    }
+
+    /// The clip distances equal the `i64` products of the guard half-widths they replaced:
+    /// the largest screen and sub-pixel bits, and eye points across the whole envelope (`w`
+    /// and `x`, `y` up to ±2^30 bits, either sign).
+    #[test]
+    fn clip_distances_equal_the_64_bit_products() {
+        fn check<const S: u32>(vp: &Viewport<S>, p: &EyePoint) {
+            let w = p.w.to_bits() as i64;
+            let (gx, gy) = (vp.guard_x as i64 * w, vp.guard_y as i64 * w);
+            let (nx, ny) = (vp.ax.apply(p.x.to_bits()), vp.ay.apply(p.y.to_bits()));
+            let want = [
+                w - vp.near.to_bits() as i64,
+                vp.far.to_bits() as i64 - w,
+                gx + nx,
+                gx - nx,
+                gy - ny,
+                gy + ny,
+            ];
+            assert_eq!(vp.clip_distances(p), want, "{p:?}");
+        }
+        let big = Viewport::<8>::new(MAX_SCREEN, MAX_SCREEN, 1.0, 1.0 / 256.0, 16384.0).unwrap();
+        assert_eq!((big.guard_x, big.guard_y), (1 << 21, 1 << 21));
+        let small = Viewport::<4>::new(240, 160, 1.7, 0.1, 100.0).unwrap();
+        let ends = [0, 1, -1, 1 << 30, -(1 << 30), i32::MAX, i32::MIN];
+        let mut x = 0x1234_5678u32;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            (x as i32) >> (x % 32)
+        };
+        for k in 0..200_000 {
+            let pick = |n: i32, k: usize| {
+                if k.is_multiple_of(3) {
+                    ends[k / 3 % 7]
+                } else {
+                    n
+                }
+            };
+            let p = EyePoint {
+                x: I16F16::from_bits(pick(next(), k)),
+                y: I16F16::from_bits(pick(next(), k / 7)),
+                w: I16F16::from_bits(pick(next(), k / 49)),
+            };
+            check(&big, &p);
+            check(&small, &p);
         }
     }
 
