@@ -170,7 +170,14 @@ pub fn clip_triangle<const S: u32>(
     let mut next: ClipPolygon = Vec::new();
     for plane in 0..6 {
         let n = out.len();
-        let dist = |i: usize| out.get(i % n).map_or(0, |v| vp.clip_distances(&v.p)[plane]);
+        // `n >= 3` and `plane < 6`, but where this closure is not inlined the compiler cannot
+        // see it: checked forms keep the panic paths out (the panic-never link check).
+        let dist = |i: usize| {
+            let v = i.checked_rem(n).and_then(|k| out.get(k));
+            v.map_or(0, |v| {
+                vp.clip_distances(&v.p).get(plane).copied().unwrap_or(0)
+            })
+        };
         if (0..n).all(|i| dist(i) >= 0) {
             continue;
         }
@@ -178,7 +185,8 @@ pub fn clip_triangle<const S: u32>(
         let mut dp = dist(n - 1);
         for i in 0..n {
             let dc = dist(i);
-            let (Some(cur), Some(prev)) = (out.get(i), out.get((i + n - 1) % n)) else {
+            let prev = (i + n - 1).checked_rem(n).and_then(|k| out.get(k));
+            let (Some(cur), Some(prev)) = (out.get(i), prev) else {
                 continue;
             };
             // Each plane adds at most one vertex to a convex polygon, so 9 slots suffice.

@@ -171,10 +171,52 @@ pub(crate) fn cosine_i64(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
     Some(if dot < 0 { -q } else { q })
 }
 
-/// Bounds `(lo, hi)` on `cosine_i64(v, unit).max(0)` (the Lambert term), without its
-/// 64-bit square root and division: `None` for the zero vector, `(0, 0)` when the dot
-/// product is not positive (the cosine is then at most 0), else an interval about `2^-14` of
-/// the cosine wide. Lighting uses it to skip the exact cosine when both ends give one colour.
+/// The Lambert term `max(0, cos)` of a normal and a unit light direction: bounds `lo <= hi`
+/// on it, cheap to compute, and what [`Lambert::exact`] needs to give the term itself from the
+/// same values (no second scaling of the normal). Made by [`NormalPrecision::lambert`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Lambert {
+    /// Lower bound on the term (I2F30 bits).
+    pub lo: i32,
+    /// Upper bound on the term (I2F30 bits); equal to `lo` when that is the term.
+    pub hi: i32,
+    /// The positive dot product of the 30-bit normal and the direction (0 if `lo == hi`).
+    dot: u64,
+    /// The 30-bit normal's squared length (0 if `lo == hi`).
+    square: u64,
+}
+
+impl Lambert {
+    /// Bounds that are the exact term.
+    #[inline]
+    fn exactly(term: i32) -> Lambert {
+        Lambert {
+            lo: term,
+            hi: term,
+            dot: 0,
+            square: 0,
+        }
+    }
+
+    /// The term between the bounds: `lo` when the bounds are equal, else `⌊dot / ⌊√square⌋⌋`,
+    /// which is `cosine_i64`'s quotient for a positive dot product (its root and division
+    /// of the same 30-bit vector). Test `lambert_bounds_hold`.
+    #[inline]
+    pub fn exact(&self) -> i32 {
+        if self.lo == self.hi {
+            return self.lo;
+        }
+        // square >= 2^58 (the largest component has 30 bits), so the root is at least 2^29
+        // and below sqrt(3)·2^30: it fits 32 bits and is non-zero.
+        let len = isqrt_u64(self.square);
+        div_rem_u64_u32(self.dot, len as u32).0 as i32
+    }
+}
+
+/// [`Lambert`] bounds on `cosine_i64(v, unit).max(0)`, without its 64-bit square root and
+/// division: `None` for the zero vector, exactly `0` when the dot product is not positive
+/// (the cosine is then at most 0), else an interval about `2^-14` of the cosine wide. Lighting
+/// uses it to skip the exact cosine when both ends give one colour.
 ///
 /// Why the bounds hold, with `s` the 30-bit vector, `S = |s|² >= 2^58`, `R = ⌊√S⌋`, the dot
 /// product `D` in `(0, 2^61)` and the exact result `q = ⌊D / R⌋`: for `S' = ⌊S / 2^30⌋`
@@ -182,23 +224,27 @@ pub(crate) fn cosine_i64(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
 /// With `Dh = ⌊D / 2^29⌋` (below 2^32) and `A = ⌊Dh / r⌋`: `q < (Dh+1)·2^14 / r <
 /// (A + 1)·2^14 + 2^14 / r`, so `q <= (A+1)·2^14`; and `q >= ⌊Dh·2^14 / (r+1)⌋`, where
 /// `Dh·2^14 / (r+1) = (Dh / r)·2^14 − (Dh / r)·2^14 / (r+1) > A·2^14 − (A+1)`.
+/// `A < 2^32 / 2^14 = 2^18`, so `A·2^14` fits `u32`, and the bounds are taken there
+/// (`(A+1)·2^14` saturating, both then capped at `i32::MAX`).
 /// Test `lambert_bounds_hold`.
-pub(crate) fn lambert_bounds_i64(v: [i64; 3], unit: [i32; 3]) -> Option<(i32, i32)> {
+pub(crate) fn lambert_i64(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
     let s = fit_bits(v, 30)?;
     let dot: i64 = (0..3).map(|k| mul_wide(s[k], unit[k])).sum();
     if dot <= 0 {
-        return Some((0, 0));
+        return Some(Lambert::exactly(0));
     }
     let square: u64 = s.iter().map(|&c| mul_wide(c, c) as u64).sum();
     // S < 3·2^60, so S' < 3·2^30; r >= 2^14 (S >= 2^58).
     let r = isqrt32((square >> 30) as u32).max(1);
-    let a = ((dot >> 29) as u32 / r) as i64;
-    let lo = ((a << 14) - a - 1).max(0);
-    let hi = (a + 1) << 14;
-    Some((
-        lo.min(i32::MAX as i64) as i32,
-        hi.min(i32::MAX as i64) as i32,
-    ))
+    let a = (dot >> 29) as u32 / r;
+    let lo = (a << 14).saturating_sub(a + 1);
+    let hi = (a + 1).saturating_mul(1 << 14);
+    Some(Lambert {
+        lo: lo.min(i32::MAX as u32) as i32,
+        hi: hi.min(i32::MAX as u32) as i32,
+        dot: dot as u64,
+        square,
+    })
 }
 
 /// `n.div_euclid(d)` (the floor of `n / d`) for `d >= 1` (`d < 1` is taken as 1), through
@@ -571,6 +617,62 @@ pub(crate) fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i32; 3]> {
     })
 }
 
+/// `v · 2^frac` rounded to nearest, ties to even, as `i32` bits: `fixed`'s `checked_from_num`
+/// for a fixed-point type with `frac` fractional bits (`frac <= 31`), taken from the float's
+/// bits with integer operations only (no soft-float calls on cores without an FPU). `None`
+/// for NaN, infinities and values whose rounded bits do not fit `i32`. Test
+/// `fixed_from_f32_equals_fixed`.
+pub(crate) fn fixed_from_f32(v: f32, frac: u32) -> Option<i32> {
+    let bits = v.to_bits();
+    let exp = (bits >> 23 & 0xFF) as i32;
+    if exp == 0xFF {
+        return None;
+    }
+    // |v| = m · 2^(max(exp, 1) − 150): the implicit bit for normal numbers, none for
+    // subnormal ones (exp 0).
+    let m = if exp == 0 {
+        bits & 0x7F_FFFF
+    } else {
+        bits & 0x7F_FFFF | 0x80_0000
+    };
+    let shift = exp.max(1) - 150 + frac as i32;
+    let magnitude = if shift >= 0 {
+        // m < 2^24: up to 8 more bits fit `u32`; a normal m (>= 2^23) shifted 9 or more is
+        // beyond 2^31 (and a subnormal one never shifts left for frac <= 31).
+        if shift > 8 {
+            return None;
+        }
+        m << shift
+    } else {
+        let k = shift.unsigned_abs();
+        if k > 24 {
+            // Below half a unit (m < 2^24 <= 2^(k − 1)): rounds to 0.
+            0
+        } else {
+            // Keep one more bit (the half), and whether anything below it is set.
+            let halves = m >> (k - 1);
+            let sticky = m & ((1 << (k - 1)) - 1) != 0;
+            let q = halves >> 1;
+            q + (halves & 1 != 0 && (sticky || q & 1 != 0)) as u32
+        }
+    };
+    if bits >> 31 == 0 {
+        i32::try_from(magnitude).ok()
+    } else if magnitude <= 1 << 31 {
+        // −2^31 fits: its magnitude as `i32` wraps to itself.
+        Some((magnitude as i32).wrapping_neg())
+    } else {
+        None
+    }
+}
+
+/// `v` as I16F16, rounded to nearest (ties to even) and checked: `I16F16::checked_from_num(v)`
+/// without the float operations ([`fixed_from_f32`]).
+#[inline]
+pub(crate) fn i16f16_from_f32(v: f32) -> Option<fixed::types::I16F16> {
+    fixed_from_f32(v, 16).map(fixed::types::I16F16::from_bits)
+}
+
 /// How precisely lighting takes the cosine between a normal and the light, chosen at compile
 /// time (see [`crate::arithmetic::Arithmetic`]).
 pub trait NormalPrecision:
@@ -579,10 +681,10 @@ pub trait NormalPrecision:
     /// Cosine between `v` (any non-zero scale) and the unit vector `unit` (I2F30 bits), in
     /// I2F30 bits; `None` for the zero vector.
     fn cosine(v: [i64; 3], unit: [i32; 3]) -> Option<i32>;
-    /// Bounds `(lo, hi)` on `cosine(v, unit).max(0)`, cheaper than it; `None` for the zero
-    /// vector.
-    fn lambert_bounds(v: [i64; 3], unit: [i32; 3]) -> Option<(i32, i32)> {
-        Self::cosine(v, unit).map(|c| (c.max(0), c.max(0)))
+    /// Bounds on `cosine(v, unit).max(0)` (the Lambert term), cheaper than it, from which
+    /// [`Lambert::exact`] gives the term; `None` for the zero vector.
+    fn lambert(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
+        Self::cosine(v, unit).map(|c| Lambert::exactly(c.max(0)))
     }
 }
 
@@ -607,8 +709,8 @@ impl NormalPrecision for WideNormals {
         cosine_i64(v, unit)
     }
     #[inline]
-    fn lambert_bounds(v: [i64; 3], unit: [i32; 3]) -> Option<(i32, i32)> {
-        lambert_bounds_i64(v, unit)
+    fn lambert(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
+        lambert_i64(v, unit)
     }
 }
 
@@ -971,10 +1073,20 @@ mod tests {
             let near = [0, 1, 2].map(|k| ((unit[k] as i64) << (i % 30)) ^ (v[k] & 0xFFF));
             for v in [v, near] {
                 let want = cosine_i64(v, unit).map(|c| c.max(0));
-                let got = lambert_bounds_i64(v, unit);
+                let got = lambert_i64(v, unit);
                 match (want, got) {
-                    (Some(q), Some((lo, hi))) => {
+                    (Some(q), Some(l)) => {
+                        let (lo, hi) = (l.lo, l.hi);
                         assert!(lo <= q && q <= hi, "{v:?}: {q} not in {lo}..={hi}");
+                        // The exact term from the bounds' own values.
+                        assert_eq!(l.exact(), q, "{v:?}");
+                        assert_eq!(WideNormals::lambert(v, unit), Some(l));
+                        let narrow = cosine_i32(v, unit).map(|c| c.max(0));
+                        let n = NarrowNormals::lambert(v, unit);
+                        assert_eq!(
+                            n.map(|n| (n.lo, n.hi, n.exact())),
+                            narrow.map(|c| (c, c, c))
+                        );
                         widest = widest.max(hi - lo);
                     }
                     (None, None) => {}
@@ -1017,6 +1129,74 @@ mod tests {
             cosine_i32([i64::MIN + 1, 0, 0], [1 << 30, 0, 0]),
             Some(-(1 << 30))
         );
+    }
+
+    /// `fixed_from_f32` equals `fixed`'s checked conversion for 16 and 30 fractional bits
+    /// (and 0 and 31): every exponent, the rounding ties and their neighbours, the ends of the
+    /// range, zeros, subnormals, infinities and NaN.
+    #[test]
+    fn fixed_from_f32_equals_fixed() {
+        use fixed::types::{I16F16, I1F31, I2F30, I32F0};
+        let check = |v: f32| {
+            let want = [
+                I32F0::checked_from_num(v).map(|x| x.to_bits()),
+                I16F16::checked_from_num(v).map(|x| x.to_bits()),
+                I2F30::checked_from_num(v).map(|x| x.to_bits()),
+                I1F31::checked_from_num(v).map(|x| x.to_bits()),
+            ];
+            let got = [0, 16, 30, 31].map(|frac| fixed_from_f32(v, frac));
+            assert_eq!(got, want, "{v:e} ({:#x})", v.to_bits());
+            assert_eq!(i16f16_from_f32(v), I16F16::checked_from_num(v), "{v:e}");
+        };
+        let mut specials = std::vec![
+            0.0f32,
+            -0.0,
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::MAX,
+            f32::MIN,
+            f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            f32::from_bits(0x80_0001),
+            32768.0,
+            -32768.0,
+            32767.99,
+            -32768.01,
+            2.0,
+            -2.0,
+            1.0,
+            -1.0,
+            2147483648.0,
+            -2147483648.0,
+        ];
+        // Ties at every scale: (2j + 1)·2^-(frac + 1) and neighbours, for each fraction size.
+        for frac in [0i32, 16, 30, 31] {
+            for e in -40i32..40 {
+                for j in [0u32, 1, 2, 3, 0x7F_FFFF, 0xFF_FFFF] {
+                    let t = (2 * j + 1) as f32 * libm::exp2f((e - frac - 1) as f32);
+                    for v in [t, -t] {
+                        specials.extend([v, f32::from_bits(v.to_bits() + 1)]);
+                        specials.push(f32::from_bits(v.to_bits().wrapping_sub(1)));
+                    }
+                }
+            }
+        }
+        for v in specials {
+            check(v);
+        }
+        // Every exponent with random mantissas.
+        let mut x = 0x2545_f491u32;
+        for _ in 0..1_000_000 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            check(f32::from_bits(x));
+            // Concentrated on the exponents that matter (|v| from 2^-33 to 2^33).
+            let near = (x & 0x807F_FFFF) | ((94 + (x >> 23) % 67) << 23);
+            check(f32::from_bits(near));
+        }
     }
 
     #[test]

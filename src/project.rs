@@ -14,7 +14,7 @@
 //! * Depth `q = near / w` in I2F30: `near · 2^30 < 2^61`.
 
 use crate::depth::Depth;
-use crate::math::{floor_div_i64, mul_wide};
+use crate::math::{floor_div_i64, i16f16_from_f32, mul_wide};
 use crate::vertex::EyePoint;
 use fixed::types::I16F16;
 
@@ -51,20 +51,39 @@ pub struct Scale {
 
 impl Scale {
     /// `None` unless `0 < v < 2^25` and finite.
+    ///
+    /// Taken from the float's bits, with integer operations only (no soft-float calls on cores
+    /// without an FPU): `v = M · 2^(e − 150)` with the 24-bit mantissa `M` (implicit bit
+    /// included) and the biased exponent `e`, so `v · 2^shift` lies in `[2^24, 2^25)` for
+    /// `shift = 151 − e`, where it is `2M` (doubling is exact). The shift is capped at 62 (a
+    /// `v` below about 2^-37): the mantissa is then `⌊v · 2^62⌋`, `M` shifted right by
+    /// `88 − e`. This is what doubling `v` in `f32` until it reaches 2^24 (at most 62 times)
+    /// and truncating gave. Test `scale_equals_doubling_in_f32`.
     pub fn new(v: f32) -> Option<Scale> {
-        if v.is_nan() || v <= 0.0 || v >= (1u32 << 25) as f32 {
+        let bits = v.to_bits();
+        // Positive (sign bit clear, not zero) and below 2^25 (biased exponent 152), which
+        // also excludes infinity and NaN.
+        if bits == 0 || bits >= 0x4C00_0000 {
             return None;
         }
-        let mut m = v;
-        let mut shift = 0u32;
-        // Doubling an f32 is exact, so the mantissa is the float's own 24 bits.
-        while m < (1u32 << 24) as f32 && shift < 62 {
-            m *= 2.0;
-            shift += 1;
-        }
-        Some(Scale {
-            mantissa: m as i32,
-            shift,
+        let e = bits >> 23;
+        // A subnormal `v` (e = 0) is `bits · 2^-149`: its mantissa shifted by 88 is 0, as is
+        // `⌊v · 2^62⌋`.
+        let m = if e == 0 {
+            bits
+        } else {
+            bits & 0x7F_FFFF | 0x80_0000
+        };
+        Some(if e >= 89 {
+            Scale {
+                mantissa: (m << 1) as i32,
+                shift: 151 - e,
+            }
+        } else {
+            Scale {
+                mantissa: m.checked_shr(88 - e).unwrap_or(0) as i32,
+                shift: 62,
+            }
         })
     }
 
@@ -89,9 +108,9 @@ pub struct Viewport<const S: u32> {
     pub near: I16F16,
     /// Far-plane distance.
     pub far: I16F16,
-    /// Guard band half-widths in sub-pixel units.
-    guard_x: i64,
-    guard_y: i64,
+    /// Guard band half-widths in sub-pixel units: at most `8 · 2048 / 2 · 2^8 = 2^21`.
+    guard_x: i32,
+    guard_y: i32,
 }
 
 /// A projected vertex: snapped screen position, depth and colour attribute.
@@ -121,8 +140,8 @@ impl<const S: u32> Viewport<S> {
         let sub = (1u32 << S) as f32;
         let ax = Scale::new(width as f32 * 0.5 * (focal / aspect) * sub)?;
         let ay = Scale::new(height as f32 * 0.5 * focal * sub)?;
-        let near = I16F16::checked_from_num(near)?;
-        let far = I16F16::checked_from_num(far)?;
+        let near = i16f16_from_f32(near)?;
+        let far = i16f16_from_f32(far)?;
         Some(Viewport {
             width: width as u16,
             height: height as u16,
@@ -130,25 +149,33 @@ impl<const S: u32> Viewport<S> {
             ay,
             near,
             far,
-            guard_x: ((GUARD_BAND_HALF_SCREENS * width as i64) << S) >> 1,
-            guard_y: ((GUARD_BAND_HALF_SCREENS * height as i64) << S) >> 1,
+            // Below 2^21 (size and `S` checked above), so `as i32` keeps the value.
+            guard_x: (((GUARD_BAND_HALF_SCREENS * width as i64) << S) >> 1) as i32,
+            guard_y: (((GUARD_BAND_HALF_SCREENS * height as i64) << S) >> 1) as i32,
         })
     }
 
     /// The six clip distances of an eye point: `[near, far, left, right, top, bottom]`, each
     /// `>= 0` inside. Near/far are in I16F16 bits; the guard planes in sub-pixels × w bits.
+    ///
+    /// The guard half-widths (below 2^21) and `w` fit `i32`, so `guard · w` is a 32 × 32 →
+    /// 64-bit [`mul_wide`]: on cores without a wide multiply (thumbv6m) four 32-bit
+    /// multiplies instead of a call of the 64-bit one, elsewhere the same `i64` product. Test
+    /// `clip_distances_equal_the_64_bit_products`.
     #[inline]
     pub fn clip_distances(&self, p: &EyePoint) -> [i64; 6] {
-        let w = p.w.to_bits() as i64;
+        let w = p.w.to_bits();
         let nx = self.ax.apply(p.x.to_bits());
         let ny = self.ay.apply(p.y.to_bits());
+        let (gx, gy) = (mul_wide(self.guard_x, w), mul_wide(self.guard_y, w));
+        let w = w as i64;
         [
             w - self.near.to_bits() as i64,
             self.far.to_bits() as i64 - w,
-            self.guard_x * w + nx,
-            self.guard_x * w - nx,
-            self.guard_y * w - ny,
-            self.guard_y * w + ny,
+            gx + nx,
+            gx - nx,
+            gy - ny,
+            gy + ny,
         ]
     }
 
@@ -442,6 +469,110 @@ pub(crate) mod tests {
                 let q = exact.q.to_bits() as f64;
                 assert!(((fast.q.to_bits() - exact.q.to_bits()).abs() as f64) <= q / 16384.0 + 1.0);
             }
+        }
+    }
+
+    /// `Scale::new` from the float's bits equals the doubling in `f32` it replaced: every
+    /// exponent (subnormals, the cap at 62, the top of the range), the rejected values, and
+    /// random floats.
+    #[test]
+    fn scale_equals_doubling_in_f32() {
+        let doubling = |v: f32| -> Option<Scale> {
+            if v.is_nan() || v <= 0.0 || v >= (1u32 << 25) as f32 {
+                return None;
+            }
+            let (mut m, mut shift) = (v, 0u32);
+            while m < (1u32 << 24) as f32 && shift < 62 {
+                m *= 2.0;
+                shift += 1;
+            }
+            Some(Scale {
+                mantissa: m as i32,
+                shift,
+            })
+        };
+        let mut values = std::vec![
+            0.0f32,
+            -0.0,
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            (1u32 << 25) as f32,
+            f32::from_bits(((1u32 << 25) as f32).to_bits() - 1),
+            (1u32 << 24) as f32,
+            -1.0,
+            1.0,
+            3.0e-5,
+        ];
+        for e in 0..=255u32 {
+            for m in [0u32, 1, 0x40_0000, 0x7F_FFFF, 0x12_3457] {
+                values.extend([
+                    f32::from_bits(e << 23 | m),
+                    f32::from_bits(1 << 31 | e << 23 | m),
+                ]);
+            }
+        }
+        let mut x = 0x1234_5678u32;
+        for _ in 0..1_000_000 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            values.push(f32::from_bits(x));
+            values.push(f32::from_bits(x & 0x4FFF_FFFF));
+        }
+        for v in values {
+            assert_eq!(Scale::new(v), doubling(v), "{v:e} ({:#x})", v.to_bits());
+        }
+    }
+
+    /// The clip distances equal the `i64` products of the guard half-widths they replaced:
+    /// the largest screen and sub-pixel bits, and eye points across the whole envelope (`w`
+    /// and `x`, `y` up to ±2^30 bits, either sign).
+    #[test]
+    fn clip_distances_equal_the_64_bit_products() {
+        fn check<const S: u32>(vp: &Viewport<S>, p: &EyePoint) {
+            let w = p.w.to_bits() as i64;
+            let (gx, gy) = (vp.guard_x as i64 * w, vp.guard_y as i64 * w);
+            let (nx, ny) = (vp.ax.apply(p.x.to_bits()), vp.ay.apply(p.y.to_bits()));
+            let want = [
+                w - vp.near.to_bits() as i64,
+                vp.far.to_bits() as i64 - w,
+                gx + nx,
+                gx - nx,
+                gy - ny,
+                gy + ny,
+            ];
+            assert_eq!(vp.clip_distances(p), want, "{p:?}");
+        }
+        let big = Viewport::<8>::new(MAX_SCREEN, MAX_SCREEN, 1.0, 1.0 / 256.0, 16384.0).unwrap();
+        assert_eq!((big.guard_x, big.guard_y), (1 << 21, 1 << 21));
+        let small = Viewport::<4>::new(240, 160, 1.7, 0.1, 100.0).unwrap();
+        let ends = [0, 1, -1, 1 << 30, -(1 << 30), i32::MAX, i32::MIN];
+        let mut x = 0x1234_5678u32;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            (x as i32) >> (x % 32)
+        };
+        for k in 0..200_000 {
+            let pick = |n: i32, k: usize| {
+                if k.is_multiple_of(3) {
+                    ends[k / 3 % 7]
+                } else {
+                    n
+                }
+            };
+            let p = EyePoint {
+                x: I16F16::from_bits(pick(next(), k)),
+                y: I16F16::from_bits(pick(next(), k / 7)),
+                w: I16F16::from_bits(pick(next(), k / 49)),
+            };
+            check(&big, &p);
+            check(&small, &p);
         }
     }
 

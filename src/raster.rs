@@ -578,6 +578,35 @@ fn round_div(n: i128, d: i64) -> i128 {
     num.div_euclid(den.max(1))
 }
 
+/// Whether the depth plane of every triangle drawn on a screen at most `max_side` pixels wide
+/// and high with `sub_bits` sub-pixel bits solves in 64 bits ([`DepthPlane::new_i64`]), when
+/// its vertices are inside every clip plane and projected with the exact division.
+///
+/// Why, with `S = sub_bits`, `M = max_side` and `E = 16·M·2^S + 2`, when `E <= 2^(20−S) − 1`
+/// (for `S = 4`: `M <= 255`):
+///
+/// * Inside the guard band a vertex is at most `4·W·2^S` sub-pixels from the screen centre (`W`
+///   the width, at most `M`; likewise in y), and its rounded position stays there, so an edge in
+///   doubled units is at most `16·M·2^S` (+2 covers an odd size without sub-pixels): `|e| <= E`.
+/// * Inside the near and far planes `near <= w <= far`, so the exact depth `⌊near·2^30 / w⌋`
+///   lies in `[1, 2^30]` (`far` is within `2^14` units, `near` at least one bit): the
+///   differences `d` of the three depths are below 2^30. Every factor of the two cross
+///   products is below 2^30, so [`cross_diff_i64`] takes them, and `|num| <= 2·d·E <
+///   2^(51 − S)`.
+/// * The gradient numerators are `num · 2^(S + 1 + 10)`, below `2^62 − 2^(S+42)`, so twice one
+///   plus the area (below `2·E² < 2^41`) fits `i64`; the value's numerator `(num_x·t_x +
+///   num_y·t_y) · 2^10`, with the offsets `|t| <= 2^S` to the reference centre, is no larger;
+///   the start value `f0 · 2^10 < 2^41` plus a quotient below 2^62 fits too.
+///
+/// Every checked step of [`PlaneSolver::plane_i64`] therefore succeeds. Test
+/// `bounded_depth_planes_solve_in_64_bits`.
+pub(crate) const fn depth_planes_fit_i64(max_side: usize, sub_bits: u32) -> bool {
+    if sub_bits > crate::project::MAX_SUB_PIXEL_BITS || max_side > crate::project::MAX_SCREEN {
+        return false;
+    }
+    ((16 * max_side) << sub_bits) + 2 < 1 << (20 - sub_bits)
+}
+
 /// The depth plane: `q` in I24F40 (40 fractional bits, 10 more than [`Depth`]).
 #[derive(Clone, Copy, Debug)]
 pub struct DepthPlane {
@@ -595,6 +624,34 @@ impl DepthPlane {
             v.each_ref().map(|s| s.q.to_bits() as i64),
             DEPTH_PLANE_EXTRA_BITS,
         );
+        DepthPlane {
+            origin: solver.origin(),
+            q,
+        }
+    }
+
+    /// [`DepthPlane::new`] from the 64-bit solver alone ([`PlaneSolver::plane_i64`]), for a
+    /// triangle whose three vertices are inside every clip plane and were projected with the
+    /// exact division, on a screen for which [`depth_planes_fit_i64`] holds: there the 64-bit
+    /// solver never gives up (proof at [`depth_planes_fit_i64`]), so this is the same plane
+    /// and builds that only draw such triangles (`NoClip`, the exact projection, a small
+    /// screen) carry no 128-bit arithmetic. Test `bounded_depth_planes_solve_in_64_bits`.
+    #[inline]
+    pub(crate) fn new_i64<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> Self {
+        let f = v.each_ref().map(|s| s.q.to_bits() as i64);
+        let q = solver
+            .plane_i64(f[0], f[1] - f[0], f[2] - f[0], DEPTH_PLANE_EXTRA_BITS)
+            .unwrap_or_else(|| {
+                debug_assert!(
+                    false,
+                    "internal error: a bounded depth plane needs 128 bits"
+                );
+                Plane {
+                    value: 0,
+                    dx: 0,
+                    dy: 0,
+                }
+            });
         DepthPlane {
             origin: solver.origin(),
             q,
@@ -1021,6 +1078,93 @@ mod tests {
         }
         // Both paths were taken.
         assert!(fast > 1000 && fast < 39_000, "{fast}");
+    }
+
+    /// Depth planes of triangles inside the clip planes of a screen for which
+    /// `depth_planes_fit_i64` holds solve in 64 bits, and `DepthPlane::new_i64` gives
+    /// `DepthPlane::new`'s plane: vertices at the corners and edges of the guard band with the
+    /// nearest and farthest depths (every combination for three vertices, at several
+    /// sub-pixel offsets), and random eye points inside every plane, projected exactly.
+    #[test]
+    fn bounded_depth_planes_solve_in_64_bits() {
+        assert!(depth_planes_fit_i64(240, 4) && depth_planes_fit_i64(255, 4));
+        assert!(!depth_planes_fit_i64(256, 4) && !depth_planes_fit_i64(240, 5));
+        assert!(depth_planes_fit_i64(1023, 3) && !depth_planes_fit_i64(1024, 3));
+        assert!(!depth_planes_fit_i64(usize::MAX, 0) && !depth_planes_fit_i64(1, 9));
+        fn check<const S: u32>(v: &[ScreenVertex<S>; 3]) -> bool {
+            let Some(s) = PlaneSolver::new(v) else {
+                return false;
+            };
+            let f = v.each_ref().map(|s| s.q.to_bits() as i64);
+            let fast = s.plane_i64(f[0], f[1] - f[0], f[2] - f[0], DEPTH_PLANE_EXTRA_BITS);
+            assert_eq!(fast, Some(s.plane(f, DEPTH_PLANE_EXTRA_BITS)), "{v:?}");
+            let (a, b) = (DepthPlane::new_i64(&s, v), DepthPlane::new(&s, v));
+            assert_eq!((a.origin, a.q), (b.origin, b.q));
+            true
+        }
+        // The largest bounded screens: the guard band reaches 4 screens beyond each side.
+        fn corners<const S: u32>(side: i32) -> usize {
+            let (centre, guard) = ((side << S) / 2, (4 * side) << S);
+            let xs = [
+                centre - guard,
+                centre - guard + 5,
+                centre,
+                centre + guard - 3,
+                centre + guard,
+            ];
+            let qs = [1, 1 << 30, 1 << 10];
+            let points: std::vec::Vec<ScreenVertex<S>> = xs
+                .iter()
+                .flat_map(|&x| xs.iter().map(move |&y| (x, y)))
+                .flat_map(|(x, y)| {
+                    qs.iter().map(move |&q| ScreenVertex {
+                        x: crate::project::SubPx(x),
+                        y: crate::project::SubPx(y),
+                        q: Depth::from_bits(q),
+                        color: [I16F16::ZERO; 3],
+                    })
+                })
+                .collect();
+            let mut solved = 0;
+            for a in &points {
+                for b in &points {
+                    for c in points.iter().step_by(2) {
+                        solved += check(&[*a, *b, *c]) as usize;
+                    }
+                }
+            }
+            solved
+        }
+        assert!(corners::<4>(255) > 100_000);
+        assert!(corners::<3>(1023) > 100_000);
+        assert!(corners::<0>(255) > 100_000);
+        // Eye points inside every plane, projected exactly, on a 255-pixel screen.
+        let vp = crate::project::Viewport::<4>::new(255, 255, 1.0, 1.0 / 256.0, 16384.0).unwrap();
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut drawn = 0;
+        while drawn < 20_000 {
+            let v: [Option<ScreenVertex<4>>; 3] = core::array::from_fn(|_| {
+                let w = (next() % (1 << 30)) as i32 + 1;
+                // Up to 8·w either way: beyond the guard band's 4 screens (at this focal).
+                let off = |r: u64| ((((r % (1 << 35)) as i64 - (1 << 34)) >> 4) * w as i64) >> 27;
+                let p = crate::vertex::EyePoint {
+                    x: I16F16::from_bits(off(next()).clamp(i32::MIN as i64, i32::MAX as i64) as i32),
+                    y: I16F16::from_bits(off(next()).clamp(i32::MIN as i64, i32::MAX as i64) as i32),
+                    w: I16F16::from_bits(w),
+                };
+                let inside = vp.clip_distances(&p).iter().all(|&d| d >= 0);
+                inside.then(|| vp.project(&p, [I16F16::ZERO; 3])).flatten()
+            });
+            if let [Some(a), Some(b), Some(c)] = v {
+                drawn += check(&[a, b, c]) as usize;
+            }
+        }
     }
 
     /// The edge set-up (one 32-bit division, comparisons for the first row) places and steps

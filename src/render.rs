@@ -19,10 +19,11 @@ use crate::clip::{ClipVertex, Clipped, Clipping};
 use crate::depth::{DepthFormat, DepthRow};
 use crate::math::NormalPrecision;
 use crate::options::RenderOptions;
+use crate::project::ProjectionPrecision;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{
-    color_channels, first_row_xy, signed_area_xy, xy, DepthPlane, PlaneSolver, TriangleWalk,
-    WalkDepth,
+    color_channels, depth_planes_fit_i64, first_row_xy, signed_area_xy, xy, DepthPlane,
+    PlaneSolver, TriangleWalk, WalkDepth,
 };
 use crate::scene::{Instance, MeshColors, Scene, MAX_SCENE_TRIANGLES};
 use crate::shading::{Shading, SpanDepth};
@@ -690,6 +691,27 @@ impl TriangleOrder for IdOrder {
     }
 }
 
+/// The largest width and height a frame's target can have, known at compile time where the
+/// workspace's size is ([`Size`]), else unknown ([`Unbounded`]).
+pub(crate) trait ScreenBound {
+    /// The larger of the largest width and height.
+    const MAX_SIDE: usize;
+}
+
+/// No bound known.
+pub(crate) struct Unbounded;
+
+impl ScreenBound for Unbounded {
+    const MAX_SIDE: usize = usize::MAX;
+}
+
+/// Targets at most `W × H` pixels.
+pub(crate) struct Size<const W: usize, const H: usize>;
+
+impl<const W: usize, const H: usize> ScreenBound for Size<W, H> {
+    const MAX_SIDE: usize = if W > H { W } else { H };
+}
+
 /// Renders one frame: pass 1 files triangles in row buckets, pass 2 walks the rows band by band,
 /// handing spans to `resolve` and finished rows to `sink`.
 pub(crate) fn drive<
@@ -702,6 +724,7 @@ pub(crate) fn drive<
     const INSTANCES: usize,
     R: Resolve<P, S>,
     H: BucketHead,
+    D: ScreenBound,
 >(
     ws: Frame<'_, S::Payload<P>, R::Key, H>,
     resolve: &mut R,
@@ -812,7 +835,7 @@ pub(crate) fn drive<
         cache,
         vp,
         cull: options.cull_back_faces,
-        stages: core::marker::PhantomData::<(C, A)>,
+        stages: core::marker::PhantomData::<(C, A, D)>,
     };
     let mut rows = Buckets {
         heads: ws.heads,
@@ -820,7 +843,7 @@ pub(crate) fn drive<
         pieces: &pieces,
     };
     let height = ws.heads.len();
-    walk_rows::<P, S, SUB, K, R>(
+    walk_rows::<P, S, SUB, K, R, _>(
         height, ws.active, &mut rows, resolve, width, sink, &mut stats,
     )?;
     Ok(stats)
@@ -829,6 +852,8 @@ pub(crate) fn drive<
 /// What pass 2 activates on each row: the pieces that start there (in any order that is the
 /// same from frame to frame).
 pub(crate) trait RowPieces<const SUB: u32> {
+    /// Whether every piece's depth plane solves in 64 bits ([`DepthPlane::new_i64`]).
+    const DEPTH_PLANES_I64: bool = false;
     /// Calls `f(vertices, face colour, triangle id, sort key)` for each screen piece activated
     /// on `row` (rows come in order, each once per frame).
     fn each_row_piece<S: Shading>(
@@ -846,6 +871,7 @@ pub(crate) struct Buckets<'a, A, H = u16> {
 }
 
 impl<const SUB: u32, A: ActivePieces<SUB>, H: BucketHead> RowPieces<SUB> for Buckets<'_, A, H> {
+    const DEPTH_PLANES_I64: bool = A::DEPTH_PLANES_I64;
     #[inline(always)]
     fn each_row_piece<S: Shading>(
         &mut self,
@@ -864,6 +890,8 @@ impl<const SUB: u32, A: ActivePieces<SUB>, H: BucketHead> RowPieces<SUB> for Buc
 
 /// Where pass 2 gets the pieces of a bucket entry from.
 pub(crate) trait ActivePieces<const SUB: u32> {
+    /// Whether every piece's depth plane solves in 64 bits ([`DepthPlane::new_i64`]).
+    const DEPTH_PLANES_I64: bool = false;
     /// Calls `f(vertices, face colour, triangle id, sort key)` for each screen piece of bucket
     /// entry `entry` (a clipped triangle may have several).
     fn each_piece<S: Shading>(
@@ -874,19 +902,26 @@ pub(crate) trait ActivePieces<const SUB: u32> {
 }
 
 /// Pieces of mesh triangles, transformed, clipped and projected again on activation.
-struct MeshPieces<'a, 's, const SUB: u32, C, A: Arithmetic> {
+struct MeshPieces<'a, 's, const SUB: u32, C, A: Arithmetic, D> {
     setups: &'a [InstanceSetup<'s, A::Transform>],
     refs: &'a [u16],
     keys: &'a [u32],
     cache: &'a [CachedVertex],
     vp: &'a Viewport<SUB>,
     cull: bool,
-    stages: core::marker::PhantomData<(C, A)>,
+    stages: core::marker::PhantomData<(C, A, D)>,
 }
 
-impl<const SUB: u32, C: Clipping, A: Arithmetic> ActivePieces<SUB>
-    for MeshPieces<'_, '_, SUB, C, A>
+impl<const SUB: u32, C: Clipping, A: Arithmetic, D: ScreenBound> ActivePieces<SUB>
+    for MeshPieces<'_, '_, SUB, C, A, D>
 {
+    /// Without clipping every piece is a triangle inside every clip plane (others are
+    /// skipped); projected with the exact division on a bounded screen, its depth plane
+    /// solves in 64 bits ([`depth_planes_fit_i64`]).
+    const DEPTH_PLANES_I64: bool = !C::CLIPS
+        && !<A::Projection as ProjectionPrecision>::RECIPROCAL
+        && depth_planes_fit_i64(D::MAX_SIDE, SUB);
+
     #[inline(always)]
     fn each_piece<S: Shading>(
         &self,
@@ -941,10 +976,11 @@ pub(crate) fn walk_rows<
     const SUB: u32,
     K: RowSink<P>,
     R: Resolve<P, S>,
+    Q: RowPieces<SUB>,
 >(
     height: usize,
     active: &mut VecView<ActiveTri<S::Payload<P>, R::Key>>,
-    pieces: &mut impl RowPieces<SUB>,
+    pieces: &mut Q,
     resolve: &mut R,
     width: i32,
     sink: &mut K,
@@ -978,7 +1014,11 @@ pub(crate) fn walk_rows<
                         debug_assert!(false, "internal error: piece of {id} not walkable");
                         return;
                     };
-                    let depth = DepthPlane::new(&solver, s).walk_from(walk.row());
+                    let depth = match Q::DEPTH_PLANES_I64 {
+                        true => DepthPlane::new_i64(&solver, s),
+                        false => DepthPlane::new(&solver, s),
+                    };
+                    let depth = depth.walk_from(walk.row());
                     let mut tri_state = ActiveTri {
                         walk,
                         depth,

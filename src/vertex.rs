@@ -13,7 +13,9 @@
 //!
 //! [`MAX_MODEL_COORD`]: crate::scene::MAX_MODEL_COORD
 
-use crate::math::{fit_bits, mul_wide, NormalPrecision, NO_WIDE_MULTIPLY};
+use crate::math::{
+    fit_bits, fixed_from_f32, i16f16_from_f32, mul_wide, NormalPrecision, NO_WIDE_MULTIPLY,
+};
 use crate::scene::{Light, Transform, Vertex};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::{I16F16, I2F30};
@@ -148,16 +150,15 @@ impl ModelView {
         let mut m = [[I16F16::ZERO; 3]; 3];
         let mut t = [I16F16::ZERO; 3];
         for r in 0..3 {
-            let sign = if r == 2 { -1.0 } else { 1.0 };
+            // Negating a float flips its sign bit: exactly `-1.0 * entry`.
+            let signed = |entry: f32| if r == 2 { -entry } else { entry };
             let mut bound: i64 = 0;
             for (out, &entry) in m[r].iter_mut().zip(&mv.m[r][..3]) {
-                let v =
-                    I16F16::checked_from_num(sign * entry).ok_or(TransformError::OutOfEnvelope)?;
+                let v = i16f16_from_f32(signed(entry)).ok_or(TransformError::OutOfEnvelope)?;
                 *out = v;
                 bound += (v.to_bits() as i64).abs() * max_abs_bits as i64;
             }
-            let tv =
-                I16F16::checked_from_num(sign * mv.m[r][3]).ok_or(TransformError::OutOfEnvelope)?;
+            let tv = i16f16_from_f32(signed(mv.m[r][3])).ok_or(TransformError::OutOfEnvelope)?;
             t[r] = tv;
             bound += (tv.to_bits() as i64).abs() << 16;
             if bound > MAX_EYE_COORD_BITS << 16 {
@@ -293,13 +294,19 @@ pub struct Lighting {
 
 /// `v` in I2F30 bits, rounded to nearest (ties to even, as `fixed` rounds) and saturated; NaN
 /// gives 0. Written out because `fixed`'s saturating conversion panics on NaN, and the render
-/// path must not contain a panic (`examples/panic_never.rs` checks that at link time).
+/// path must not contain a panic (`examples/panic_never.rs` checks that at link time). The
+/// rounding is [`fixed_from_f32`]'s (integer operations on the float's bits, shared with the
+/// I16F16 conversions); out of range it saturates by the sign bit, as `as i32` would.
 fn q30(v: f32) -> i32 {
-    // Scaling by 2^30 is exact in f32 (it only changes the exponent), and `rintf` of an f32 is
-    // exact too: below 2^23 the rounded integer fits the 24-bit mantissa, above it the value is
-    // already an integer. So this equals rounding in f64, without pulling f64 soft-float code
-    // into builds for cores without an FPU. `as` saturates and maps NaN to 0.
-    libm::rintf(v * (1u32 << 30) as f32) as i32
+    let bits = v.to_bits();
+    match fixed_from_f32(v, 30) {
+        Some(q) => q,
+        // NaN (an all-ones exponent and a non-zero mantissa), tested on the bits: a float
+        // comparison would be a soft-float call.
+        None if bits & 0x7FFF_FFFF > 0x7F80_0000 => 0,
+        None if bits >> 31 != 0 => i32::MIN,
+        None => i32::MAX,
+    }
 }
 
 impl Lighting {
@@ -364,25 +371,34 @@ impl Lighting {
 
 /// The model-space normal of a face with vertices `v` (counter-clockwise = front), not
 /// normalized: the cross product of two edges.
+///
+/// Bit budget: a validated mesh's coordinates are within ±[`MAX_MODEL_COORD`] = 2^12 units,
+/// ±2^28 in I16F16 bits, so an edge component is within ±2^29 and fits `i32`; each product
+/// of two is at most 2^58 in magnitude (a 32 × 32 → 64-bit [`mul_wide`]) and each difference
+/// of two at most 2^59, in `i64`. That is the cross product the `i64` edges gave. (Vertices
+/// outside the envelope, which no validated mesh has, wrap in the edge subtraction instead of
+/// overflowing the `i64` products; neither is meaningful.) Test `face_normal_at_the_extremes`.
+///
+/// [`MAX_MODEL_COORD`]: crate::scene::MAX_MODEL_COORD
 #[inline]
 fn face_normal(v: [&Vertex; 3]) -> [i64; 3] {
-    let d = |a: &Vertex, b: &Vertex, k: usize| b[k].to_bits() as i64 - a[k].to_bits() as i64;
+    let d = |a: &Vertex, b: &Vertex, k: usize| b[k].to_bits().wrapping_sub(a[k].to_bits());
     let e1 = [0, 1, 2].map(|k| d(v[0], v[1], k));
     let e2 = [0, 1, 2].map(|k| d(v[0], v[2], k));
-    // Coordinates within ±2^28 bits: edge components < 2^29, products < 2^58, sums < 2^59.
+    let cross = |a: i32, b: i32, c: i32, d: i32| mul_wide(a, b) - mul_wide(c, d);
     [
-        cross_diff(e1[1], e2[2], e1[2], e2[1]),
-        cross_diff(e1[2], e2[0], e1[0], e2[2]),
-        cross_diff(e1[0], e2[1], e1[1], e2[0]),
+        cross(e1[1], e2[2], e1[2], e2[1]),
+        cross(e1[2], e2[0], e1[0], e2[2]),
+        cross(e1[0], e2[1], e1[1], e2[0]),
     ]
 }
 
 impl Lighting {
     /// `shade(base, self.face::<N>(v))`, mostly without the exact cosine: each channel is a
     /// non-decreasing function of the Lambert term, so where the colours at both ends of
-    /// [`NormalPrecision::lambert_bounds`] agree, every term between gives that colour, the
+    /// [`NormalPrecision::lambert`] agree, every term between gives that colour, the
     /// exact one included. Else (a colour step inside the bounds, a few faces in a hundred)
-    /// the exact cosine decides. Test `face_color_equals_the_shaded_face`.
+    /// the exact term decides ([`crate::math::Lambert::exact`], from the bounds' own values). Test `face_color_equals_the_shaded_face`.
     // Not inlined: in its caller it made the lean minimal build's render stack on thumbv6m
     // 1,264 B instead of 1,192 B, over the 4 KiB RAM budget with the workspace.
     #[inline(never)]
@@ -398,14 +414,14 @@ impl Lighting {
         let Some(w) = self.normal_to_world(n) else {
             return shade(base, self.ambient);
         };
-        let Some((lo, hi)) = N::lambert_bounds(w, self.direction) else {
+        let Some(lambert) = N::lambert(w, self.direction) else {
             return shade(base, self.intensity(0)); // (the exact cosine's zero vector)
         };
-        let low = shade(base, self.intensity(lo));
-        if lo == hi || shade(base, self.intensity(hi)) == low {
+        let low = shade(base, self.intensity(lambert.lo));
+        if lambert.lo == lambert.hi || shade(base, self.intensity(lambert.hi)) == low {
             return low;
         }
-        shade(base, self.intensity_of_world_normal::<N>(w))
+        shade(base, self.intensity(lambert.exact()))
     }
 
     /// Intensity of a surface whose model-space normal is the cross product `n` of two model
@@ -429,18 +445,6 @@ impl Lighting {
             None => self.ambient,
         }
     }
-}
-
-/// `a·b − c·d` as the `i64` expression gives it; on cores without a wide multiply in
-/// [`mul_wide`]s when every factor fits `i32` (a face of a validated mesh: edge components
-/// below 2^29).
-#[inline]
-fn cross_diff(a: i64, b: i64, c: i64, d: i64) -> i64 {
-    let fits = |v: i64| v as i32 as i64 == v;
-    if NO_WIDE_MULTIPLY && fits(a) && fits(b) && fits(c) && fits(d) {
-        return mul_wide(a as i32, b as i32) - mul_wide(c as i32, d as i32);
-    }
-    a * b - c * d
 }
 
 /// `base * intensity` per channel, rounded to nearest.
@@ -644,6 +648,57 @@ mod tests {
         assert_eq!(m.vertex::<W>(&v(0.0, 0.0, -3.0)), I2F30::from_bits(1 << 30));
     }
 
+    /// The face normal from `i32` edges equals the cross product in `i128` for vertices at
+    /// the ends of the model envelope (every corner of the ±2^28-bit cube, and edges of
+    /// ±2^29 on every axis), and for random ones inside it.
+    #[test]
+    fn face_normal_at_the_extremes() {
+        use crate::scene::MAX_MODEL_COORD;
+        let max = MAX_MODEL_COORD << 16;
+        let wide = |v: [&Vertex; 3]| -> [i64; 3] {
+            let d =
+                |a: &Vertex, b: &Vertex, k: usize| b[k].to_bits() as i128 - a[k].to_bits() as i128;
+            let e1 = [0, 1, 2].map(|k| d(v[0], v[1], k));
+            let e2 = [0, 1, 2].map(|k| d(v[0], v[2], k));
+            let n = [
+                e1[1] * e2[2] - e1[2] * e2[1],
+                e1[2] * e2[0] - e1[0] * e2[2],
+                e1[0] * e2[1] - e1[1] * e2[0],
+            ];
+            n.map(|c| i64::try_from(c).unwrap())
+        };
+        let corner =
+            |k: u32| [0, 1, 2].map(|a| Coord::from_bits(if k >> a & 1 == 0 { -max } else { max }));
+        let mut largest = 0;
+        for a in 0..8 {
+            for b in 0..8 {
+                for c in 0..8 {
+                    let v = [corner(a), corner(b), corner(c)];
+                    let n = face_normal([&v[0], &v[1], &v[2]]);
+                    assert_eq!(n, wide([&v[0], &v[1], &v[2]]), "{a} {b} {c}");
+                    largest = largest.max(n.iter().map(|c| c.unsigned_abs()).max().unwrap());
+                }
+            }
+        }
+        // Edges of ±2^29 on two axes: the products reach 2^58, and so do the components (a
+        // triangle in the cube is at most that large; 2^59 bounds the difference).
+        assert_eq!(largest, 1 << 58);
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..200_000 {
+            let v = [(); 3].map(|_| {
+                [(); 3].map(|_| {
+                    x ^= x << 13;
+                    x ^= x >> 7;
+                    x ^= x << 17;
+                    let c = (x as i32) >> (x >> 59);
+                    Coord::from_bits(c.clamp(-max, max))
+                })
+            });
+            let v = [&v[0], &v[1], &v[2]];
+            assert_eq!(face_normal(v), wide(v), "{v:?}");
+        }
+    }
+
     #[test]
     fn shade_in_words_equals_shade() {
         let wide = |c: u8, i: u32| (((c as i64 * i as i64) + (1 << 29)) >> 30).clamp(0, 255);
@@ -699,8 +754,8 @@ mod tests {
                     let narrow = shade(base, l.face::<NarrowNormals>([&a, &b, &c]));
                     assert_eq!(l.face_color::<NarrowNormals>(base, [&a, &b, &c]), narrow);
                     let w = l.normal_to_world(face_normal([&a, &b, &c]));
-                    let bounds = w.and_then(|w| WideNormals::lambert_bounds(w, l.direction));
-                    if let Some((lo, hi)) = bounds {
+                    let bounds = w.and_then(|w| WideNormals::lambert(w, l.direction));
+                    if let Some(crate::math::Lambert { lo, hi, .. }) = bounds {
                         exact_needed +=
                             (shade(base, l.intensity(lo)) != shade(base, l.intensity(hi))) as u32;
                     }

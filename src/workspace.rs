@@ -19,7 +19,10 @@ use crate::depth::Depth;
 use crate::depth::DepthFormat;
 use crate::options::{RenderOptions, MAX_INSTANCES};
 pub use crate::render::BucketHead;
-use crate::render::{drive, fill_span, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve};
+use crate::render::{
+    drive, fill_span, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve, ScreenBound, Size,
+    Unbounded,
+};
 use crate::scene::{Scene, MAX_SCENE_TRIANGLES};
 use crate::shading::Shading;
 use crate::sink::{RowPixel, RowSink};
@@ -315,8 +318,9 @@ impl<
         options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
+        // The workspace's size bounds the target's: planes may use it ([`Size`]).
         self.span_view()
-            .render_sized(width, height, scene, options, sink)
+            .render_bounded::<SUB_BITS, C, A, K, Size<W, H>>(width, height, scene, options, sink)
     }
 
     /// The workspace as slices, so code that renders through it is not generic over the sizes.
@@ -359,6 +363,24 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat, const INSTANCES: usize, B: BucketH
         options: &RenderOptions<SUB_BITS, C, A>,
         sink: &mut K,
     ) -> Result<FrameStats, RenderError<K::Error>> {
+        self.render_bounded::<SUB_BITS, C, A, K, Unbounded>(width, height, scene, options, sink)
+    }
+
+    /// [`SpanView::render_sized`] for a target at most `D::MAX_SIDE` pixels wide and high.
+    pub(crate) fn render_bounded<
+        const SUB_BITS: u32,
+        C: Clipping,
+        A: Arithmetic,
+        K: RowSink<P>,
+        D: ScreenBound,
+    >(
+        &mut self,
+        width: usize,
+        height: usize,
+        scene: &Scene<'_>,
+        options: &RenderOptions<SUB_BITS, C, A>,
+        sink: &mut K,
+    ) -> Result<FrameStats, RenderError<K::Error>> {
         let vp = viewport::<SUB_BITS, K::Error>(
             width,
             height,
@@ -382,7 +404,7 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat, const INSTANCES: usize, B: BucketH
             vertices: self.vertices,
         };
         let mut resolve = SpanZBuffer::new(depth, pixels, self.background);
-        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _, D>(
             frame,
             &mut resolve,
             &mut IdOrder,

@@ -259,7 +259,7 @@ impl<
         rows.file_patches()?;
         let mut resolve = SpanZBuffer::new(depth, pixels, self.background);
         let mut frame = FrameStats::default();
-        walk_rows::<P, S, SUB, K, _>(
+        walk_rows::<P, S, SUB, K, _, _>(
             height,
             self.active.as_mut_view(),
             &mut rows,

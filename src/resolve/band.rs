@@ -5,6 +5,7 @@ use crate::clip::Clipping;
 use crate::depth::Depth;
 use crate::depth::DepthFormat;
 use crate::options::{RenderOptions, MAX_INSTANCES};
+use crate::render::Unbounded;
 use crate::render::{
     drive, fill_span, internal, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve, NO_ENTRY,
 };
@@ -202,7 +203,7 @@ impl<
             width,
             y0: 0,
         };
-        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _, Unbounded>(
             frame,
             &mut band,
             &mut IdOrder,

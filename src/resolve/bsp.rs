@@ -16,6 +16,7 @@
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::options::RenderOptions;
+use crate::render::Unbounded;
 use crate::render::{
     drive, internal, viewport, ActiveTri, Frame, InstanceSetup, TriangleOrder, NO_ENTRY,
 };
@@ -511,7 +512,7 @@ impl<
             eye,
             stack: &mut self.stack,
         };
-        drive::<P, S, SUB_BITS, C, A, K, 1, _, _>(
+        drive::<P, S, SUB_BITS, C, A, K, 1, _, _, Unbounded>(
             frame,
             &mut resolve,
             &mut order,

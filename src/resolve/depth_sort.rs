@@ -4,6 +4,7 @@ use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::depth::DepthRow;
 use crate::options::{RenderOptions, MAX_INSTANCES};
+use crate::render::Unbounded;
 use crate::render::{drive, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve, NO_ENTRY};
 use crate::resolve::common::{check_sizes, render_whole_target};
 use crate::scene::Scene;
@@ -149,7 +150,7 @@ impl<
             background: self.background,
             spans: 0,
         };
-        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _, Unbounded>(
             frame,
             &mut resolve,
             &mut IdOrder,

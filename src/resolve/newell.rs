@@ -378,7 +378,7 @@ impl<
             next: &self.next,
             pieces: &pieces,
         };
-        walk_rows::<P, S, SUB_BITS, K, _>(
+        walk_rows::<P, S, SUB_BITS, K, _, _>(
             height,
             self.active.as_mut_view(),
             &mut rows,

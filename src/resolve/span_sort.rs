@@ -4,6 +4,7 @@ use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::depth::DepthRow;
 use crate::options::{RenderOptions, MAX_INSTANCES};
+use crate::render::Unbounded;
 use crate::render::{
     drive, internal, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve, NO_ENTRY,
 };
@@ -277,7 +278,7 @@ impl<
             background: self.background,
             spans: self.spans.as_mut_view(),
         };
-        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _>(
+        drive::<P, S, SUB_BITS, C, A, K, INSTANCES, _, _, Unbounded>(
             frame,
             &mut resolve,
             &mut IdOrder,
