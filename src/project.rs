@@ -515,11 +515,9 @@ pub(crate) mod tests {
                 ]);
             }
         }
-        let mut x = 0x1234_5678u32;
+        let mut rng = crate::test_rng::XorShift32::new(0x1234_5678u32);
         for _ in 0..1_000_000 {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
+            let x = rng.next_u32();
             values.push(f32::from_bits(x));
             values.push(f32::from_bits(x & 0x4FFF_FFFF));
         }
@@ -551,11 +549,9 @@ pub(crate) mod tests {
         assert_eq!((big.guard_x, big.guard_y), (1 << 21, 1 << 21));
         let small = Viewport::<4>::new(240, 160, 1.7, 0.1, 100.0).unwrap();
         let ends = [0, 1, -1, 1 << 30, -(1 << 30), i32::MAX, i32::MIN];
-        let mut x = 0x1234_5678u32;
+        let mut rng = crate::test_rng::XorShift32::new(0x1234_5678u32);
         let mut next = move || {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
+            let x = rng.next_u32();
             (x as i32) >> (x % 32)
         };
         for k in 0..200_000 {

@@ -1140,13 +1140,8 @@ mod tests {
         assert!(corners::<0>(255) > 100_000);
         // Eye points inside every plane, projected exactly, on a 255-pixel screen.
         let vp = crate::project::Viewport::<4>::new(255, 255, 1.0, 1.0 / 256.0, 16384.0).unwrap();
-        let mut x = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = crate::test_rng::XorShift64::new(0x9E37_79B9_7F4A_7C15u64);
+        let mut next = move || rng.next_u64();
         let mut drawn = 0;
         while drawn < 20_000 {
             let v: [Option<ScreenVertex<4>>; 3] = core::array::from_fn(|_| {

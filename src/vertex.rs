@@ -683,13 +683,11 @@ mod tests {
         // Edges of ±2^29 on two axes: the products reach 2^58, and so do the components (a
         // triangle in the cube is at most that large; 2^59 bounds the difference).
         assert_eq!(largest, 1 << 58);
-        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
         for _ in 0..200_000 {
             let v = [(); 3].map(|_| {
                 [(); 3].map(|_| {
-                    x ^= x << 13;
-                    x ^= x >> 7;
-                    x ^= x << 17;
+                    let x = rng.next_u64();
                     let c = (x as i32) >> (x >> 59);
                     Coord::from_bits(c.clamp(-max, max))
                 })
