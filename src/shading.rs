@@ -1,8 +1,9 @@
 //! Shading models and the span fill (the per-pixel loop of the span z-buffer).
 //!
 //! A shading model is a type, chosen at compile time: [`Flat`] (Lambert + ambient per face, one
-//! precomputed pixel per triangle) or [`Gouraud`] (lit per vertex, colour interpolated across
-//! the triangle). Depth is always perspective-correct: the span loop steps `q = near/w`, which
+//! precomputed pixel per triangle), [`Unlit`] (one colour per face, the mesh's own, for colours
+//! lit ahead of time by [`crate::scene::bake_face_colors`]) or [`Gouraud`] (lit per vertex,
+//! colour interpolated across the triangle). Depth is always perspective-correct: the span loop steps `q = near/w`, which
 //! is linear in screen space.
 //!
 //! How Gouraud colour is interpolated is its type parameter, an [`Interpolation`]:
@@ -37,12 +38,15 @@ pub struct SpanDepth {
     pub dq: i32,
 }
 
-/// How triangles are coloured. Implemented by [`Flat`] and [`Gouraud`] only.
+/// How triangles are coloured. Implemented by [`Flat`], [`Unlit`] and [`Gouraud`] only.
 pub trait Shading: sealed::Sealed + Copy + Default {
     /// What each active triangle carries for its span fills.
     type Payload<P: Copy>: Copy;
     /// Whether vertices need lit colours (Gouraud) or one colour per face is enough (flat).
     const PER_VERTEX: bool;
+    /// Whether the renderer lights the mesh's colours ([`Flat`], [`Gouraud`]) or takes them
+    /// as given ([`Unlit`]: a build with no lighting code at all).
+    const LIT: bool;
 
     /// The payload of a triangle whose lit face colour is `face` (flat) or whose vertices carry
     /// lit colours (Gouraud).
@@ -71,6 +75,37 @@ pub trait Shading: sealed::Sealed + Copy + Default {
 /// Flat shading: one Lambert + ambient colour per face.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Flat;
+
+/// Flat shading without lighting: one colour per face, the mesh's own colour as given (its
+/// per-face colour, its uniform colour, or the colour of the triangle's first vertex), with no
+/// Lambert or ambient term. The fill is [`Flat`]'s.
+///
+/// For static scenes: where an instance's transform and the light do not change, its flat
+/// colours are the same in every frame, so they can be lit once, on the host or at start-up,
+/// by [`crate::scene::bake_face_colors`]. A mesh with those colours per face, drawn `Unlit`,
+/// gives exactly the pixels of the original mesh drawn [`Flat`], and a build that uses only
+/// `Unlit` contains no lighting code (no normals, cosines or shading per triangle).
+///
+/// ```
+/// use embedded_graphics::pixelcolor::Rgb888;
+/// use fixed::types::I16F16;
+/// use scanline3d::arithmetic::Precise;
+/// use scanline3d::scene::{bake_face_colors, Light, Mesh, MeshColors, Transform, Vertex};
+///
+/// const Z: I16F16 = I16F16::ZERO;
+/// static VERTS: [Vertex; 3] = [[Z, Z, Z], [I16F16::ONE, Z, Z], [Z, I16F16::ONE, Z]];
+/// static TRIS: [[u16; 3]; 1] = [[0, 1, 2]];
+/// let mesh = Mesh::new(&VERTS, &TRIS, MeshColors::Uniform(Rgb888::new(200, 80, 40)), None)?;
+/// let light = Light::new([0.0, 0.0, 1.0], 0.25, 0.75)?;
+/// let mut baked = [Rgb888::new(0, 0, 0); 1];
+/// bake_face_colors::<Precise>(&mesh, &Transform::IDENTITY, &light, &mut baked)?;
+/// // Facing the light: ambient + diffuse = 1, the colour itself.
+/// assert_eq!(baked, [Rgb888::new(200, 80, 40)]);
+/// // Draw `Mesh::new(&VERTS, &TRIS, MeshColors::PerFace(&baked), None)` with `Unlit`.
+/// # Ok::<(), scanline3d::scene::SceneError>(())
+/// ```
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Unlit;
 
 /// Gouraud shading: Lambert + ambient per vertex, colour interpolated across the triangle as
 /// `I` says ([`Affine`] by default).
@@ -273,11 +308,13 @@ impl<const N: u32> Interpolation for PerSegment<N> {
 }
 
 impl sealed::Sealed for Flat {}
+impl sealed::Sealed for Unlit {}
 impl<I: Interpolation> sealed::Sealed for Gouraud<I> {}
 
 impl Shading for Flat {
     type Payload<P: Copy> = P;
     const PER_VERTEX: bool = false;
+    const LIT: bool = true;
 
     #[inline]
     fn payload<P: RowPixel, const S: u32>(
@@ -325,6 +362,39 @@ impl Shading for Flat {
     }
 }
 
+/// [`Flat`]'s payload, fill and paint: only the face colour differs (the renderer does not
+/// light it).
+impl Shading for Unlit {
+    type Payload<P: Copy> = P;
+    const PER_VERTEX: bool = false;
+    const LIT: bool = false;
+
+    #[inline]
+    fn payload<P: RowPixel, const S: u32>(
+        face: Rgb888,
+        id: u32,
+        solver: &PlaneSolver,
+        v: &[ScreenVertex<S>; 3],
+    ) -> P {
+        Flat::payload::<P, S>(face, id, solver, v)
+    }
+
+    #[inline]
+    fn fill<P: RowPixel, Z: DepthFormat>(
+        color: &P,
+        span: SpanDepth,
+        depth: &mut [Z],
+        pixels: &mut [P],
+    ) -> u32 {
+        Flat::fill(color, span, depth, pixels)
+    }
+
+    #[inline]
+    fn paint<P: RowPixel>(color: &P, x0: i32, y: i32, pixels: &mut [P]) {
+        Flat::paint(color, x0, y, pixels)
+    }
+}
+
 /// Per-triangle data for [`Gouraud`]: the colour planes and the pixel they are relative to
 /// (kept here, not with the depth, so flat triangles do not carry it).
 #[derive(Clone, Copy, Debug)]
@@ -337,6 +407,7 @@ pub struct GouraudPayload<T> {
 impl<I: Interpolation> Shading for Gouraud<I> {
     type Payload<P: Copy> = GouraudPayload<I::Planes>;
     const PER_VERTEX: bool = true;
+    const LIT: bool = true;
 
     fn payload<P: RowPixel, const S: u32>(
         _: Rgb888,
