@@ -23,6 +23,9 @@ fn main() {
     // `examples/firmware.rs` and `examples/tradeoff.rs` with `--cfg scanline3d_vertex_cache`
     // render with a vertex cache (`cargo xtask firmware` and `cargo xtask speed` measure both).
     println!("cargo::rustc-check-cfg=cfg(scanline3d_vertex_cache)");
+    // `examples/firmware.rs` with `--cfg scanline3d_baked` draws the demo's baked meshes with
+    // `Unlit` shading (face colours lit on the host; `cargo xtask firmware` measures it too).
+    println!("cargo::rustc-check-cfg=cfg(scanline3d_baked)");
     // `examples/metaball.rs` ray casts, or with `--cfg scanline3d_meta="poly16"` polygonizes
     // on that grid (`cargo xtask metaball-trade` measures each).
     println!(
