@@ -58,10 +58,10 @@ mod firmware {
     type Ws = demo::CachedPanelWorkspace<VERTS>;
     #[cfg(scanline3d_baked)]
     type Ws = demo::BakedPanelWorkspace<VERTS>;
-    #[cfg(not(scanline3d_baked))]
-    use demo::instances;
     #[cfg(scanline3d_baked)]
     use demo::baked_instances as instances;
+    #[cfg(not(scanline3d_baked))]
+    use demo::instances;
 
     /// One flat span fill, called the way the renderer calls it: through row slices.
     #[inline(never)]
