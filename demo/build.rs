@@ -6,7 +6,8 @@
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::I16F16;
 use scanline3d::arithmetic::Precise;
-use scanline3d::scene::{bake_face_colors, Light, Mesh, MeshColors, Transform, Vertex};
+use scanline3d::scene::{Light, Mesh, MeshColors, Transform, Vertex};
+use scanline3d::shading::bake_face_colors;
 use scanline3d_meshgen as meshgen;
 use std::fmt::Write;
 
@@ -14,15 +15,13 @@ use std::fmt::Write;
 #[path = "src/placement.rs"]
 mod placement;
 
+/// A mesh as the build script generates it: positions, triangles, per-face colours.
+type MeshParts<'a> = (&'a [[f64; 3]], &'a [[u16; 3]], &'a [[u8; 3]]);
+
 /// Writes `static {name}: [Rgb888; n]`: the colours `Flat` shading gives the faces of the mesh
 /// (`v`, `f`, per-face `colors`) placed by `transform` under the demo light, computed by the
-/// library itself (`scene::bake_face_colors`, the default arithmetic), for `Unlit` shading.
-fn write_baked(
-    out: &mut String,
-    name: &str,
-    (v, f, colors): (&[[f64; 3]], &[[u16; 3]], &[[u8; 3]]),
-    transform: &Transform,
-) {
+/// library itself (`shading::bake_face_colors`, the default arithmetic), for `Unlit` shading.
+fn write_baked(out: &mut String, name: &str, (v, f, colors): MeshParts<'_>, transform: &Transform) {
     let verts: Vec<Vertex> = v
         .iter()
         .map(|p| p.map(|c| I16F16::from_bits(meshgen::fixed_bits(c))))

@@ -103,7 +103,7 @@ pub fn instances() -> [Instance<'static>; PANEL_INSTANCES] {
 }
 
 /// The icosphere with its faces lit ahead of time: per-face colours baked by the build script
-/// ([`scanline3d::scene::bake_face_colors`], the default arithmetic) for [`LIGHT`] and the
+/// ([`scanline3d::shading::bake_face_colors`], the default arithmetic) for [`LIGHT`] and the
 /// sphere's place in [`instances`], to draw with [`Unlit`] shading. No normals: nothing lights
 /// it at run time.
 pub static SPHERE_BAKED: Mesh<'static> = valid(Mesh::new(

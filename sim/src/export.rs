@@ -30,12 +30,12 @@ pub struct Export<'a> {
     pub bsp: Option<&'a crate::bsp::Bsp>,
     /// Light the face colours ahead of time with this set-up arithmetic (`sim export
     /// --bake-light`): the colour table is what `Flat` shading gives each face under `light`
-    /// ([`scanline3d::scene::bake_face_colors`]), for drawing with `Unlit` shading.
+    /// ([`scanline3d::shading::bake_face_colors`]), for drawing with `Unlit` shading.
     pub bake_light: Option<crate::scene::SetupArith>,
 }
 
 /// The face colours `Flat` shading gives `mesh` (identity transform) under `light` with the
-/// set-up arithmetic `arith`: [`scanline3d::scene::bake_face_colors`].
+/// set-up arithmetic `arith`: [`scanline3d::shading::bake_face_colors`].
 pub fn baked_colors(
     mesh: &MeshData,
     light: &LightSpec,
@@ -43,7 +43,8 @@ pub fn baked_colors(
 ) -> Result<Vec<embedded_graphics::pixelcolor::Rgb888>, String> {
     use crate::scene::SetupArith as S;
     use scanline3d::arithmetic::{Frugal, Precise, Quick};
-    use scanline3d::scene::{bake_face_colors, Transform};
+    use scanline3d::scene::Transform;
+    use scanline3d::shading::bake_face_colors;
     let m = mesh.mesh()?;
     let light = light.fixed()?;
     let mut out = vec![embedded_graphics::pixelcolor::Rgb888::BLACK; mesh.triangles.len()];
@@ -234,7 +235,7 @@ impl Export<'_> {
         if let Some(arith) = self.bake_light {
             let _ = writeln!(
                 s,
-                "//!\n//! The face colours are lit ahead of time (`scanline3d::scene::bake_face_colors`, {} arithmetic)\n//! for `LIGHT` and the mesh where it is (identity transform): draw it with `scanline3d::Unlit`\n//! shading, which gives the pixels `Flat` gives the original colours, while the light and the\n//! mesh stay put (the camera may move).",
+                "//!\n//! The face colours are lit ahead of time (`scanline3d::shading::bake_face_colors`, {} arithmetic)\n//! for `LIGHT` and the mesh where it is (identity transform): draw it with `scanline3d::Unlit`\n//! shading, which gives the pixels `Flat` gives the original colours, while the light and the\n//! mesh stay put (the camera may move).",
                 arith.name()
             );
         }

@@ -1,4 +1,4 @@
-//! Face colours lit ahead of time (`scene::bake_face_colors`) and drawn `Unlit` give exactly
+//! Face colours lit ahead of time (`shading::bake_face_colors`) and drawn `Unlit` give exactly
 //! the frames `Flat` shading draws from the original colours: the demo orbit (its build-time
 //! tables and colours baked here for a narrow-normals preset) and corpus meshes.
 
@@ -6,7 +6,8 @@ use embedded_graphics::pixelcolor::Rgb888;
 use scanline3d::arithmetic::Arithmetic;
 use scanline3d::clip::Clipping;
 use scanline3d::preset::{self, Preset};
-use scanline3d::scene::{bake_face_colors, Instance, Mesh, MeshColors, Scene};
+use scanline3d::scene::{Instance, Mesh, MeshColors, Scene};
+use scanline3d::shading::bake_face_colors;
 use scanline3d::sink::HashSink;
 use scanline3d::{Flat, RenderOptions, Shading, Unlit, Workspace};
 use scanline3d_demo as demo;

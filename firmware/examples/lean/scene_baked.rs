@@ -3,7 +3,7 @@
 //! 42 vertices and 80 triangles as I16F16 `static` arrays, and the budget `sim analyze`
 //! measured over 8 view(s) at 240x240 with a 0 % margin.
 //!
-//! The face colours are lit ahead of time (`scanline3d::scene::bake_face_colors`, precise arithmetic)
+//! The face colours are lit ahead of time (`scanline3d::shading::bake_face_colors`, precise arithmetic)
 //! for `LIGHT` and the mesh where it is (identity transform): draw it with `scanline3d::Unlit`
 //! shading, which gives the pixels `Flat` gives the original colours, while the light and the
 //! mesh stay put (the camera may move).

@@ -178,7 +178,7 @@ fn baked_colours_follow_the_preset_s_normals() {
     assert_eq!(wide.len(), scene.mesh.triangles.len());
     assert_ne!(wide, narrow);
     let mut own = vec![Default::default(); wide.len()];
-    scanline3d::scene::bake_face_colors::<scanline3d::arithmetic::Frugal>(
+    scanline3d::shading::bake_face_colors::<scanline3d::arithmetic::Frugal>(
         &scene.mesh.mesh().unwrap(),
         &scanline3d::scene::Transform::IDENTITY,
         &light.fixed().unwrap(),
