@@ -15,7 +15,7 @@ fn main() {
     // only that variant, so each variant's flash can be measured alone; with
     // `--cfg scanline3d_corpus` it also renders the corpus file the xtask generates.
     println!(
-        "cargo::rustc-check-cfg=cfg(scanline3d_variant, values(\"fast\", \"balanced\", \"exact\", \"default\", \"bits0\", \"micromath\", \"narrowtransform\", \"reciprocal\", \"narrownormals\", \"depth16\", \"gouraudaffine\", \"gouraudsegments16\", \"gouraudsegments8\", \"gouraudperpixel\"))"
+        "cargo::rustc-check-cfg=cfg(scanline3d_variant, values(\"fast\", \"balanced\", \"exact\", \"default\", \"bits0\", \"micromath\", \"narrowtransform\", \"reciprocal\", \"narrownormals\", \"depth16\", \"gouraudaffine\", \"gouraudsegments16\", \"gouraudsegments8\", \"gouraudperpixel\", \"baked\"))"
     );
     println!("cargo::rustc-check-cfg=cfg(scanline3d_corpus)");
     // `--cfg scanline3d_corpus_only`: the corpus alone, without the demo orbit (`cargo xtask profile`).

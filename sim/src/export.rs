@@ -496,6 +496,18 @@ pub fn corpus_source(w: usize, h: usize, margin_percent: u32) -> Result<String, 
         let module = scene.name.replace('-', "_");
         let _ = writeln!(s, "#[allow(dead_code)]\npub mod {module} {{");
         s += &export.source()?;
+        // The same faces lit ahead of time, for `Unlit` shading (`cargo xtask profile baked`;
+        // only that build's `SCENES` refer to them, so no other build links them).
+        let baked = baked_colors(
+            &scene.mesh,
+            &LightSpec::default(),
+            crate::scene::SetupArith::Precise,
+        )?;
+        let _ = writeln!(s, "/// The face colours lit for `LIGHT` (default arithmetic), for `Unlit` shading.\npub static BAKED_COLORS: [Rgb888; {}] = [", baked.len());
+        for c in &baked {
+            let _ = writeln!(s, "    Rgb888::new({}, {}, {}),", c.r(), c.g(), c.b());
+        }
+        s += "];\n/// `MESH` with the baked colours.\npub static BAKED_MESH: Mesh<'static> = valid(Mesh::new(&VERTICES, &TRIANGLES, MeshColors::PerFace(&BAKED_COLORS), None));\n";
         // Views may differ in projection; `PROJECTION` above is the first view's.
         let _ = writeln!(
             s,
@@ -513,12 +525,12 @@ pub fn corpus_source(w: usize, h: usize, margin_percent: u32) -> Result<String, 
         entries.push((scene.name, module));
     }
     s += "/// One corpus scene as the firmware renders it.\n";
-    s += "pub struct CorpusScene {\n    pub name: &'static str,\n    pub mesh: &'static scanline3d::scene::Mesh<'static>,\n    pub cull_back_faces: bool,\n    pub projections: &'static [(f32, f32, f32)],\n    pub views: &'static [([f32; 3], [f32; 3], [f32; 3])],\n    pub light: ([f32; 3], f32, f32),\n}\n\n";
+    s += "pub struct CorpusScene {\n    pub name: &'static str,\n    pub mesh: &'static scanline3d::scene::Mesh<'static>,\n    #[cfg(scanline3d_variant = \"baked\")]\n    pub baked: &'static scanline3d::scene::Mesh<'static>,\n    pub cull_back_faces: bool,\n    pub projections: &'static [(f32, f32, f32)],\n    pub views: &'static [([f32; 3], [f32; 3], [f32; 3])],\n    pub light: ([f32; 3], f32, f32),\n}\n\n";
     let _ = writeln!(s, "pub static SCENES: [CorpusScene; {}] = [", entries.len());
     for (name, m) in &entries {
         let _ = writeln!(
             s,
-            "    CorpusScene {{ name: {name:?}, mesh: &{m}::MESH, cull_back_faces: {m}::CULL_BACK_FACES, projections: &{m}::PROJECTIONS, views: &{m}::VIEWS, light: {m}::LIGHT }},"
+            "    CorpusScene {{ name: {name:?}, mesh: &{m}::MESH, #[cfg(scanline3d_variant = \"baked\")] baked: &{m}::BAKED_MESH, cull_back_faces: {m}::CULL_BACK_FACES, projections: &{m}::PROJECTIONS, views: &{m}::VIEWS, light: {m}::LIGHT }},"
         );
     }
     s += "];\n\n";
