@@ -3,8 +3,52 @@
 //! the feature `hsr`, the hidden-surface test scenes (`OUT_DIR/hsr_scenes.rs`, about 1 MB of
 //! source, used only by the hidden-surface measurement firmware and its test).
 
+use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
+use fixed::types::I16F16;
+use scanline3d::arithmetic::Precise;
+use scanline3d::scene::{Light, Mesh, MeshColors, Transform, Vertex};
+use scanline3d::shading::bake_face_colors;
 use scanline3d_meshgen as meshgen;
 use std::fmt::Write;
+
+// The instances' transforms and the light, as the crate places them.
+#[path = "src/placement.rs"]
+mod placement;
+
+/// A mesh as the build script generates it: positions, triangles, per-face colours.
+type MeshParts<'a> = (&'a [[f64; 3]], &'a [[u16; 3]], &'a [[u8; 3]]);
+
+/// Writes `static {name}: [Rgb888; n]`: the colours `Flat` shading gives the faces of the mesh
+/// (`v`, `f`, per-face `colors`) placed by `transform` under the demo light, computed by the
+/// library itself (`shading::bake_face_colors`, the default arithmetic), for `Unlit` shading.
+fn write_baked(out: &mut String, name: &str, (v, f, colors): MeshParts<'_>, transform: &Transform) {
+    let verts: Vec<Vertex> = v
+        .iter()
+        .map(|p| p.map(|c| I16F16::from_bits(meshgen::fixed_bits(c))))
+        .collect();
+    let colors: Vec<Rgb888> = colors
+        .iter()
+        .map(|&[r, g, b]| Rgb888::new(r, g, b))
+        .collect();
+    let mesh = Mesh::new(&verts, f, MeshColors::PerFace(&colors), None).unwrap();
+    let (towards, ambient, diffuse) = placement::LIGHT;
+    let light = Light::new(towards, ambient, diffuse).unwrap();
+    let mut baked = vec![Rgb888::BLACK; f.len()];
+    bake_face_colors::<Precise>(&mesh, transform, &light, &mut baked).unwrap();
+    writeln!(out, "static {name}: [Rgb888; {}] = [", baked.len()).unwrap();
+    for c in baked {
+        writeln!(out, "    Rgb888::new({}, {}, {}),", c.r(), c.g(), c.b()).unwrap();
+    }
+    writeln!(out, "];").unwrap();
+}
+
+fn write_colors(out: &mut String, name: &str, colors: &[[u8; 3]]) {
+    writeln!(out, "static {name}: [Rgb888; {}] = [", colors.len()).unwrap();
+    for [r, g, b] in colors {
+        writeln!(out, "    Rgb888::new({r}, {g}, {b}),").unwrap();
+    }
+    writeln!(out, "];").unwrap();
+}
 
 fn normalize(p: [f64; 3]) -> [f64; 3] {
     let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
@@ -40,40 +84,37 @@ fn write_cube(out: &mut String) {
     write_vertices(out, "CUBE_VERTICES", &v);
     write_triangles(out, "CUBE_TRIANGLES", &f);
     let faces = [
-        "(230, 200, 60)",
-        "(60, 170, 220)",
-        "(220, 90, 120)",
-        "(120, 210, 110)",
-        "(240, 240, 235)",
-        "(90, 90, 110)",
+        [230, 200, 60],
+        [60, 170, 220],
+        [220, 90, 120],
+        [120, 210, 110],
+        [240, 240, 235],
+        [90, 90, 110],
     ];
-    writeln!(out, "static CUBE_COLORS: [Rgb888; 12] = [").unwrap();
-    for i in 0..12 {
-        writeln!(out, "    Rgb888::new{},", faces[i / 2]).unwrap();
-    }
-    writeln!(out, "];").unwrap();
+    let colors: Vec<[u8; 3]> = (0..12).map(|i| faces[i / 2]).collect();
+    write_colors(out, "CUBE_COLORS", &colors);
+    let transform = placement::cube_transform();
+    write_baked(out, "CUBE_BAKED_COLORS", (&v, &f, &colors), &transform);
 }
 
 /// An `n × n` checkerboard in the plane y = 0 spanning ±`half`, facing +y.
 fn write_ground(out: &mut String, n: usize, half: f64) {
     let (v, f) = meshgen::grid([n, n], [half, half], |_, _| 0.0);
-    let colors: Vec<&str> = (0..f.len())
+    let colors: Vec<[u8; 3]> = (0..f.len())
         .map(|t| {
             let (i, j) = ((t / 2) % n, (t / 2) / n);
             if (i + j) % 2 == 0 {
-                "(200, 200, 190)"
+                [200, 200, 190]
             } else {
-                "(70, 80, 90)"
+                [70, 80, 90]
             }
         })
         .collect();
     write_vertices(out, "GROUND_VERTICES", &v);
     write_triangles(out, "GROUND_TRIANGLES", &f);
-    writeln!(out, "static GROUND_COLORS: [Rgb888; {}] = [", colors.len()).unwrap();
-    for c in colors {
-        writeln!(out, "    Rgb888::new{c},").unwrap();
-    }
-    writeln!(out, "];").unwrap();
+    write_colors(out, "GROUND_COLORS", &colors);
+    let transform = placement::ground_transform();
+    write_baked(out, "GROUND_BAKED_COLORS", (&v, &f, &colors), &transform);
 }
 
 /// The hidden-surface test scenes of every level as one self-contained module body: static
@@ -117,6 +158,7 @@ fn write_hsr_scenes(out: &mut String) {
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed=src/placement.rs");
     let (v, f) = meshgen::icosphere(3);
     let mut out = String::new();
     writeln!(
@@ -141,21 +183,26 @@ fn main() {
     .unwrap();
     write_triangles(&mut out, "ICOSPHERE_TRIANGLES", &f);
     // Per-face colours: a warm-to-cool band by latitude with a faint stripe by longitude.
-    writeln!(out, "static ICOSPHERE_COLORS: [Rgb888; {}] = [", f.len()).unwrap();
-    for t in &f {
-        let c = normalize([0, 1, 2].map(|k| t.iter().map(|&i| v[i as usize][k]).sum::<f64>()));
-        let lat = (c[1] + 1.0) / 2.0;
-        let stripe = if (c[2].atan2(c[0]) * 6.0 / std::f64::consts::PI).floor() as i64 % 2 == 0 {
-            0.0
-        } else {
-            18.0
-        };
-        let r = (235.0 - 150.0 * lat + stripe).clamp(0.0, 255.0) as u8;
-        let g = (90.0 + 90.0 * lat).clamp(0.0, 255.0) as u8;
-        let b = (60.0 + 180.0 * lat - stripe).clamp(0.0, 255.0) as u8;
-        writeln!(out, "    Rgb888::new({r}, {g}, {b}),").unwrap();
-    }
-    writeln!(out, "];").unwrap();
+    let colors: Vec<[u8; 3]> = f
+        .iter()
+        .map(|t| {
+            let c = normalize([0, 1, 2].map(|k| t.iter().map(|&i| v[i as usize][k]).sum::<f64>()));
+            let lat = (c[1] + 1.0) / 2.0;
+            let stripe = if (c[2].atan2(c[0]) * 6.0 / std::f64::consts::PI).floor() as i64 % 2 == 0
+            {
+                0.0
+            } else {
+                18.0
+            };
+            let r = (235.0 - 150.0 * lat + stripe).clamp(0.0, 255.0) as u8;
+            let g = (90.0 + 90.0 * lat).clamp(0.0, 255.0) as u8;
+            let b = (60.0 + 180.0 * lat - stripe).clamp(0.0, 255.0) as u8;
+            [r, g, b]
+        })
+        .collect();
+    write_colors(&mut out, "ICOSPHERE_COLORS", &colors);
+    let transform = placement::sphere_transform();
+    write_baked(&mut out, "ICOSPHERE_BAKED", (&v, &f, &colors), &transform);
     write_cube(&mut out);
     write_ground(&mut out, 8, 4.0);
     let path = std::path::Path::new(&std::env::var("OUT_DIR").unwrap()).join("demo_meshes.rs");

@@ -15,7 +15,7 @@ fn main() {
     // only that variant, so each variant's flash can be measured alone; with
     // `--cfg scanline3d_corpus` it also renders the corpus file the xtask generates.
     println!(
-        "cargo::rustc-check-cfg=cfg(scanline3d_variant, values(\"fast\", \"balanced\", \"exact\", \"default\", \"bits0\", \"micromath\", \"narrowtransform\", \"reciprocal\", \"narrownormals\", \"depth16\", \"gouraudaffine\", \"gouraudsegments16\", \"gouraudsegments8\", \"gouraudperpixel\"))"
+        "cargo::rustc-check-cfg=cfg(scanline3d_variant, values(\"fast\", \"balanced\", \"exact\", \"default\", \"bits0\", \"micromath\", \"narrowtransform\", \"reciprocal\", \"narrownormals\", \"depth16\", \"gouraudaffine\", \"gouraudsegments16\", \"gouraudsegments8\", \"gouraudperpixel\", \"baked\"))"
     );
     println!("cargo::rustc-check-cfg=cfg(scanline3d_corpus)");
     // `--cfg scanline3d_corpus_only`: the corpus alone, without the demo orbit (`cargo xtask profile`).
@@ -23,6 +23,9 @@ fn main() {
     // `examples/firmware.rs` and `examples/tradeoff.rs` with `--cfg scanline3d_vertex_cache`
     // render with a vertex cache (`cargo xtask firmware` and `cargo xtask speed` measure both).
     println!("cargo::rustc-check-cfg=cfg(scanline3d_vertex_cache)");
+    // `examples/firmware.rs` with `--cfg scanline3d_baked` draws the demo's baked meshes with
+    // `Unlit` shading (face colours lit on the host; `cargo xtask firmware` measures it too).
+    println!("cargo::rustc-check-cfg=cfg(scanline3d_baked)");
     // `examples/metaball.rs` ray casts, or with `--cfg scanline3d_meta="poly16"` polygonizes
     // on that grid (`cargo xtask metaball-trade` measures each).
     println!(

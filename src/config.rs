@@ -41,7 +41,7 @@ use crate::math::MathBackend;
 use crate::method::Options;
 use crate::preset::{Preset, Reference};
 use crate::scene::{Camera, SceneError};
-use crate::shading::{Flat, Gouraud, Interpolation, Shading};
+use crate::shading::{Flat, Gouraud, Interpolation, Shading, Unlit};
 use crate::sink::RowPixel;
 use core::marker::PhantomData;
 
@@ -49,7 +49,7 @@ use core::marker::PhantomData;
 pub trait Config: 'static {
     /// Pixel format of the rows ([`RowPixel`]).
     type Pixel: RowPixel;
-    /// Shading model: [`Flat`] or [`Gouraud`] with its interpolation.
+    /// Shading model: [`Flat`], [`Unlit`] or [`Gouraud`] with its interpolation.
     type Shading: Shading;
     /// Depth format of the z-buffer row ([`crate::depth`]).
     type Depth: DepthFormat;
@@ -74,7 +74,7 @@ pub trait Config: 'static {
     }
 }
 
-/// A shading model whose Gouraud interpolation a preset chooses: [`Flat`], or [`Gouraud`]
+/// A shading model whose Gouraud interpolation a preset chooses: [`Flat`], [`Unlit`], or [`Gouraud`]
 /// (whatever interpolation it names is replaced by the preset's).
 pub trait ShadingKind: 'static {
     /// The shading model with interpolation `I`.
@@ -83,6 +83,10 @@ pub trait ShadingKind: 'static {
 
 impl ShadingKind for Flat {
     type With<I: Interpolation> = Flat;
+}
+
+impl ShadingKind for Unlit {
+    type With<I: Interpolation> = Unlit;
 }
 
 impl<J: Interpolation> ShadingKind for Gouraud<J> {

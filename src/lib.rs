@@ -153,6 +153,6 @@ struct ReadmeDoctests;
 pub use depth::Depth;
 pub use options::RenderOptions;
 pub use renderer::{Renderer, Storage, View};
-pub use shading::{Flat, Gouraud, Shading};
+pub use shading::{Flat, Gouraud, Shading, Unlit};
 pub use stats::{FrameStats, RenderError};
 pub use workspace::Workspace;

@@ -358,7 +358,11 @@ pub(crate) struct InstanceSetup<'a, T: TransformPrecision> {
     first_vertex: usize,
 }
 
-fn setup_instances<'a, T: TransformPrecision, E, const N: usize>(
+/// The instances' per-frame constants, lit for shading `S` unless it is [`Unlit`]
+/// (`S::LIT`): an unlit build computes no lighting.
+///
+/// [`Unlit`]: crate::shading::Unlit
+fn setup_instances<'a, S: Shading, T: TransformPrecision, E, const N: usize>(
     scene: &'a Scene<'a>,
 ) -> Result<Vec<InstanceSetup<'a, T>, N>, RenderError<E>> {
     // Triangle ids (and so the u16 ids in the row buckets) must stay below 65,535.
@@ -374,7 +378,11 @@ fn setup_instances<'a, T: TransformPrecision, E, const N: usize>(
         let mv = ModelView::new(&inst.transform, view, max_abs_bits)
             .map_err(|error| RenderError::Transform { instance: i, error })?;
         let mv = T::prepare(mv, max_abs_bits);
-        let lighting = Lighting::new(&scene.light, &inst.transform);
+        let lighting = if S::LIT {
+            Lighting::new(&scene.light, &inst.transform)
+        } else {
+            Lighting::NONE
+        };
         let setup = InstanceSetup {
             instance: inst,
             mv,
@@ -468,8 +476,15 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         idx.map(pick)
     }
 
-    /// The lit flat colour of triangle `tri`.
-    fn face_color<N: NormalPrecision>(&self, tri: usize, idx: [u16; 3]) -> Rgb888 {
+    /// The flat colour of triangle `tri`: lit, or for [`Unlit`] shading (`S::LIT` false) the
+    /// mesh's colour as given.
+    ///
+    /// [`Unlit`]: crate::shading::Unlit
+    #[inline]
+    fn face_color<S: Shading, N: NormalPrecision>(&self, tri: usize, idx: [u16; 3]) -> Rgb888 {
+        if !S::LIT {
+            return self.vertex_colors(tri, idx)[0];
+        }
         let verts = self.instance.mesh.vertices();
         let zero = [I16F16::ZERO; 3];
         let v = idx.map(|i| internal(verts.get(i as usize), &zero));
@@ -734,7 +749,7 @@ pub(crate) fn drive<
     vp: &Viewport<SUB>,
     sink: &mut K,
 ) -> Result<FrameStats, RenderError<K::Error>> {
-    let setups = setup_instances::<A::Transform, K::Error, INSTANCES>(scene)?;
+    let setups = setup_instances::<S, A::Transform, K::Error, INSTANCES>(scene)?;
     let mut stats = FrameStats::default();
     let width = vp.width as i32;
     let capacity = ws.refs.len().min(ws.next.len());
@@ -950,7 +965,7 @@ impl<const SUB: u32, C: Clipping, A: Arithmetic, D: ScreenBound> ActivePieces<SU
         let face = if S::PER_VERTEX {
             Rgb888::new(0, 0, 0)
         } else {
-            setup.face_color::<A::Normals>(tri, idx)
+            setup.face_color::<S, A::Normals>(tri, idx)
         };
         let (vp, cache) = (self.vp, self.cache);
         setup.screen_triangles::<SUB, C, A>(
@@ -1167,7 +1182,7 @@ pub(crate) fn for_each_screen_piece<
     vp: &Viewport<SUB>,
     mut f: impl FnMut([ScreenVertex<SUB>; 3], Rgb888, u32),
 ) -> Result<FrameStats, RenderError<E>> {
-    let setups = setup_instances::<A::Transform, E, INSTANCES>(scene)?;
+    let setups = setup_instances::<S, A::Transform, E, INSTANCES>(scene)?;
     let mut stats = FrameStats::default();
     for setup in &setups {
         let triangles = setup.instance.mesh.triangles();
@@ -1177,7 +1192,7 @@ pub(crate) fn for_each_screen_piece<
             let face = if S::PER_VERTEX {
                 Rgb888::new(0, 0, 0)
             } else {
-                setup.face_color::<A::Normals>(tri, idx)
+                setup.face_color::<S, A::Normals>(tri, idx)
             };
             let fate = setup.screen_triangles::<SUB, C, A>(
                 tri,

@@ -1,8 +1,9 @@
 //! Shading models and the span fill (the per-pixel loop of the span z-buffer).
 //!
 //! A shading model is a type, chosen at compile time: [`Flat`] (Lambert + ambient per face, one
-//! precomputed pixel per triangle) or [`Gouraud`] (lit per vertex, colour interpolated across
-//! the triangle). Depth is always perspective-correct: the span loop steps `q = near/w`, which
+//! precomputed pixel per triangle), [`Unlit`] (one colour per face, the mesh's own, for colours
+//! lit ahead of time by [`bake_face_colors`]) or [`Gouraud`] (lit per vertex,
+//! colour interpolated across the triangle). Depth is always perspective-correct: the span loop steps `q = near/w`, which
 //! is linear in screen space.
 //!
 //! How Gouraud colour is interpolated is its type parameter, an [`Interpolation`]:
@@ -16,9 +17,11 @@
 use crate::depth::DepthFormat;
 use crate::project::ScreenVertex;
 use crate::raster::{channel, ColorPlanes, PerspectivePlanes, PixelOrigin, PlaneSolver};
+use crate::scene::{Light, Mesh, MeshColors, SceneError, Transform};
 use crate::sink::RowPixel;
 use core::marker::PhantomData;
 use embedded_graphics::pixelcolor::Rgb888;
+use fixed::types::I16F16;
 
 mod sealed {
     pub trait Sealed {}
@@ -37,12 +40,15 @@ pub struct SpanDepth {
     pub dq: i32,
 }
 
-/// How triangles are coloured. Implemented by [`Flat`] and [`Gouraud`] only.
+/// How triangles are coloured. Implemented by [`Flat`], [`Unlit`] and [`Gouraud`] only.
 pub trait Shading: sealed::Sealed + Copy + Default {
     /// What each active triangle carries for its span fills.
     type Payload<P: Copy>: Copy;
     /// Whether vertices need lit colours (Gouraud) or one colour per face is enough (flat).
     const PER_VERTEX: bool;
+    /// Whether the renderer lights the mesh's colours ([`Flat`], [`Gouraud`]) or takes them
+    /// as given ([`Unlit`]: a build with no lighting code at all).
+    const LIT: bool;
 
     /// The payload of a triangle whose lit face colour is `face` (flat) or whose vertices carry
     /// lit colours (Gouraud).
@@ -71,6 +77,38 @@ pub trait Shading: sealed::Sealed + Copy + Default {
 /// Flat shading: one Lambert + ambient colour per face.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Flat;
+
+/// Flat shading without lighting: one colour per face, the mesh's own colour as given (its
+/// per-face colour, its uniform colour, or the colour of the triangle's first vertex), with no
+/// Lambert or ambient term. The fill is [`Flat`]'s.
+///
+/// For static scenes: where an instance's transform and the light do not change, its flat
+/// colours are the same in every frame, so they can be lit once, on the host or at start-up,
+/// by [`bake_face_colors`]. A mesh with those colours per face, drawn `Unlit`,
+/// gives exactly the pixels of the original mesh drawn [`Flat`], and a build that uses only
+/// `Unlit` contains no lighting code (no normals, cosines or shading per triangle).
+///
+/// ```
+/// use embedded_graphics::pixelcolor::Rgb888;
+/// use fixed::types::I16F16;
+/// use scanline3d::arithmetic::Precise;
+/// use scanline3d::scene::{Light, Mesh, MeshColors, Transform, Vertex};
+/// use scanline3d::shading::bake_face_colors;
+///
+/// const Z: I16F16 = I16F16::ZERO;
+/// static VERTS: [Vertex; 3] = [[Z, Z, Z], [I16F16::ONE, Z, Z], [Z, I16F16::ONE, Z]];
+/// static TRIS: [[u16; 3]; 1] = [[0, 1, 2]];
+/// let mesh = Mesh::new(&VERTS, &TRIS, MeshColors::Uniform(Rgb888::new(200, 80, 40)), None)?;
+/// let light = Light::new([0.0, 0.0, 1.0], 0.25, 0.75)?;
+/// let mut baked = [Rgb888::new(0, 0, 0); 1];
+/// bake_face_colors::<Precise>(&mesh, &Transform::IDENTITY, &light, &mut baked)?;
+/// // Facing the light: ambient + diffuse = 1, the colour itself.
+/// assert_eq!(baked, [Rgb888::new(200, 80, 40)]);
+/// // Draw `Mesh::new(&VERTS, &TRIS, MeshColors::PerFace(&baked), None)` with `Unlit`.
+/// # Ok::<(), scanline3d::scene::SceneError>(())
+/// ```
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Unlit;
 
 /// Gouraud shading: Lambert + ambient per vertex, colour interpolated across the triangle as
 /// `I` says ([`Affine`] by default).
@@ -273,11 +311,13 @@ impl<const N: u32> Interpolation for PerSegment<N> {
 }
 
 impl sealed::Sealed for Flat {}
+impl sealed::Sealed for Unlit {}
 impl<I: Interpolation> sealed::Sealed for Gouraud<I> {}
 
 impl Shading for Flat {
     type Payload<P: Copy> = P;
     const PER_VERTEX: bool = false;
+    const LIT: bool = true;
 
     #[inline]
     fn payload<P: RowPixel, const S: u32>(
@@ -325,6 +365,93 @@ impl Shading for Flat {
     }
 }
 
+/// Lights `mesh`'s faces ahead of time: writes to `out[t]` the colour [`Flat`] shading gives
+/// triangle `t` of `mesh` drawn with model transform `transform` under `light`, with the
+/// normals of arithmetic `A` (a preset's [`Arithmetic`], e.g. [`Precise`], the default, or
+/// `<preset::Balanced as Preset>::Arithmetic`). Exactly the renderer's colours: the same
+/// lighting code, so no rounding differs.
+///
+/// A mesh with these colours per face ([`MeshColors::PerFace`]) drawn with [`Unlit`] shading,
+/// the same transform, camera and arithmetic, gives exactly the pixels of `mesh` drawn [`Flat`].
+/// Only for instances whose transform and light stay as baked: the colours do not follow a
+/// moving light or a rotating object (a camera may move freely). No allocation; `out` is
+/// typically a `static` table on the host (`sim export --bake-light`) or a buffer filled at
+/// start-up.
+///
+/// Fails with [`SceneError::CountMismatch`] (`"baked face colours"`) if `out` does not hold
+/// exactly one colour per triangle, or [`SceneError::NonFinite`] if `transform` is not finite.
+///
+/// [`Arithmetic`]: crate::arithmetic::Arithmetic
+/// [`Precise`]: crate::arithmetic::Precise
+pub fn bake_face_colors<A: crate::arithmetic::Arithmetic>(
+    mesh: &Mesh<'_>,
+    transform: &Transform,
+    light: &Light,
+    out: &mut [Rgb888],
+) -> Result<(), SceneError> {
+    let triangles = mesh.triangles();
+    if out.len() != triangles.len() {
+        return Err(SceneError::CountMismatch {
+            what: "baked face colours",
+            expected: triangles.len(),
+            found: out.len(),
+        });
+    }
+    if transform.m.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(SceneError::NonFinite {
+            what: "model transform",
+        });
+    }
+    let lighting = crate::vertex::Lighting::new(light, transform);
+    let verts = mesh.vertices();
+    let zero = [I16F16::ZERO; 3];
+    let black = Rgb888::new(0, 0, 0);
+    for (t, (idx, slot)) in triangles.iter().zip(out.iter_mut()).enumerate() {
+        // Mesh::new checked every index and colour count.
+        let base = match mesh.colors() {
+            MeshColors::Uniform(c) => c,
+            MeshColors::PerFace(c) => c.get(t).copied().unwrap_or(black),
+            MeshColors::PerVertex(c) => c.get(idx[0] as usize).copied().unwrap_or(black),
+        };
+        let v = idx.map(|i| verts.get(i as usize).unwrap_or(&zero));
+        *slot = lighting.face_color::<A::Normals>(base, v);
+    }
+    Ok(())
+}
+
+/// [`Flat`]'s payload, fill and paint: only the face colour differs (the renderer does not
+/// light it).
+impl Shading for Unlit {
+    type Payload<P: Copy> = P;
+    const PER_VERTEX: bool = false;
+    const LIT: bool = false;
+
+    #[inline]
+    fn payload<P: RowPixel, const S: u32>(
+        face: Rgb888,
+        id: u32,
+        solver: &PlaneSolver,
+        v: &[ScreenVertex<S>; 3],
+    ) -> P {
+        Flat::payload::<P, S>(face, id, solver, v)
+    }
+
+    #[inline]
+    fn fill<P: RowPixel, Z: DepthFormat>(
+        color: &P,
+        span: SpanDepth,
+        depth: &mut [Z],
+        pixels: &mut [P],
+    ) -> u32 {
+        Flat::fill(color, span, depth, pixels)
+    }
+
+    #[inline]
+    fn paint<P: RowPixel>(color: &P, x0: i32, y: i32, pixels: &mut [P]) {
+        Flat::paint(color, x0, y, pixels)
+    }
+}
+
 /// Per-triangle data for [`Gouraud`]: the colour planes and the pixel they are relative to
 /// (kept here, not with the depth, so flat triangles do not carry it).
 #[derive(Clone, Copy, Debug)]
@@ -337,6 +464,7 @@ pub struct GouraudPayload<T> {
 impl<I: Interpolation> Shading for Gouraud<I> {
     type Payload<P: Copy> = GouraudPayload<I::Planes>;
     const PER_VERTEX: bool = true;
+    const LIT: bool = true;
 
     fn payload<P: RowPixel, const S: u32>(
         _: Rgb888,
@@ -492,5 +620,124 @@ mod tests {
                 assert_eq!(seg[16], one[16], "segment boundary exact, length {len}");
             }
         }
+    }
+
+    /// A random closed-ish mesh: `n` triangles over 24 vertices scattered in ±1.5 (either
+    /// winding, so some faces are back faces, some lit from behind).
+    fn random_mesh_data(
+        seed: u64,
+    ) -> (std::vec::Vec<crate::scene::Vertex>, std::vec::Vec<[u16; 3]>) {
+        let mut rng = crate::test_rng::XorShift64::new(seed);
+        let mut coord = || I16F16::from_bits((rng.next_u64() % (3 << 16)) as i32 - (3 << 15));
+        let verts: std::vec::Vec<crate::scene::Vertex> =
+            (0..24).map(|_| [coord(), coord(), coord()]).collect();
+        let mut rng = crate::test_rng::XorShift64::new(seed ^ 0x5555);
+        let tris = (0..60)
+            .map(|_| [(); 3].map(|_| (rng.next_u64() % 24) as u16))
+            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+            .collect();
+        (verts, tris)
+    }
+
+    /// The hash of `mesh` drawn with shading `S`, arithmetic `A` and transform `transform`
+    /// from a few cameras.
+    fn hashes<S: crate::Shading, A: crate::arithmetic::Arithmetic>(
+        mesh: &Mesh<'_>,
+        transform: Transform,
+        light: Light,
+    ) -> std::vec::Vec<u32> {
+        use crate::sink::HashSink;
+        let instances = [crate::scene::Instance { mesh, transform }];
+        let mut ws: std::boxed::Box<crate::Workspace<Rgb888, S, 64, 48, 64, 64, 1>> =
+            std::boxed::Box::new(crate::Workspace::new(Rgb888::new(1, 2, 3)));
+        let options = crate::RenderOptions::default().with_arithmetic(A::default());
+        [[0.0, 0.5, 4.0], [3.0, -1.0, 2.0], [-2.0, 2.5, -3.0]]
+            .iter()
+            .map(|&eye| {
+                let camera = crate::scene::Camera::look_at(eye, [0.0; 3], [0.0, 1.0, 0.0])
+                    .unwrap()
+                    .perspective(60.0, 0.5, 20.0)
+                    .unwrap();
+                let scene = crate::scene::Scene::new(&instances, camera, light).unwrap();
+                let mut sink = HashSink::new();
+                ws.render(&scene, &options, &mut sink).unwrap();
+                sink.hash()
+            })
+            .collect()
+    }
+
+    /// Baked colours drawn `Unlit` give `Flat`'s frames, for each colour source and two
+    /// normal precisions.
+    fn baked_equals_flat<A: crate::arithmetic::Arithmetic>() {
+        let light = Light::new([-0.45, 0.8, 0.55], 0.25, 0.75).unwrap();
+        let transform = Transform::translation([0.2, -0.1, 0.3])
+            .then_after(&Transform::rotation_y(0.7))
+            .then_after(&Transform::scale([1.2, 0.8, -1.0]));
+        for seed in 1..=4u64 {
+            let (verts, tris) = random_mesh_data(seed);
+            let face: std::vec::Vec<Rgb888> = (0..tris.len())
+                .map(|t| Rgb888::new((t as u8).wrapping_mul(7), (t as u8).wrapping_mul(3), 90))
+                .collect();
+            let vertex: std::vec::Vec<Rgb888> = (0..verts.len())
+                .map(|v| Rgb888::new(200, (v as u8).wrapping_mul(10), 255 - v as u8))
+                .collect();
+            for colors in [
+                MeshColors::Uniform(Rgb888::new(180, 140, 60)),
+                MeshColors::PerFace(&face),
+                MeshColors::PerVertex(&vertex),
+            ] {
+                let mesh = Mesh::new(&verts, &tris, colors, None).unwrap();
+                let mut baked = std::vec![Rgb888::new(0, 0, 0); tris.len()];
+                bake_face_colors::<A>(&mesh, &transform, &light, &mut baked).unwrap();
+                let unlit = Mesh::new(&verts, &tris, MeshColors::PerFace(&baked), None).unwrap();
+                let want = hashes::<crate::Flat, A>(&mesh, transform, light);
+                let got = hashes::<crate::Unlit, A>(&unlit, transform, light);
+                assert_eq!(got, want, "seed {seed}, {colors:?}");
+                // The light mattered: unbaked colours drawn unlit give other frames.
+                assert_ne!(hashes::<crate::Unlit, A>(&mesh, transform, light), want);
+            }
+        }
+    }
+
+    #[test]
+    fn baked_colours_drawn_unlit_equal_flat_shading() {
+        baked_equals_flat::<crate::arithmetic::Precise>();
+        baked_equals_flat::<crate::arithmetic::Quick>();
+    }
+
+    #[test]
+    fn baking_needs_one_colour_per_triangle() {
+        let (verts, tris) = random_mesh_data(9);
+        let mesh = Mesh::new(
+            &verts,
+            &tris,
+            MeshColors::Uniform(Rgb888::new(9, 9, 9)),
+            None,
+        )
+        .unwrap();
+        let light = Light::new([0.0, 0.0, 1.0], 0.2, 0.8).unwrap();
+        for len in [0, tris.len() - 1, tris.len() + 1] {
+            let mut out = std::vec![Rgb888::new(0, 0, 0); len];
+            assert_eq!(
+                bake_face_colors::<crate::arithmetic::Precise>(
+                    &mesh,
+                    &Transform::IDENTITY,
+                    &light,
+                    &mut out
+                ),
+                Err(SceneError::CountMismatch {
+                    what: "baked face colours",
+                    expected: tris.len(),
+                    found: len,
+                })
+            );
+        }
+        let mut nan = Transform::IDENTITY;
+        nan.m[1][2] = f32::NAN;
+        let mut out = std::vec![Rgb888::new(0, 0, 0); tris.len()];
+        assert!(matches!(
+            bake_face_colors::<crate::arithmetic::Precise>(&mesh, &nan, &light, &mut out),
+            Err(SceneError::NonFinite { .. })
+        ));
     }
 }

@@ -310,6 +310,17 @@ fn q30(v: f32) -> i32 {
 }
 
 impl Lighting {
+    /// No lighting: what a render with [`Unlit`](crate::shading::Unlit) shading keeps per
+    /// instance instead of [`Lighting::new`] (never used to light; every intensity from it is
+    /// 0), so that build computes no lighting set-up either.
+    pub const NONE: Lighting = Lighting {
+        normal_matrix: [[0; 3]; 3],
+        flip: false,
+        direction: [0; 3],
+        ambient: I2F30::ZERO,
+        diffuse: I2F30::ZERO,
+    };
+
     /// Lighting for one instance with the given model transform (finite, checked by the caller).
     pub fn new(light: &Light, model: &Transform) -> Lighting {
         let a = &model.m;

@@ -21,11 +21,9 @@
 use core::convert::Infallible;
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888};
 use fixed::types::I16F16;
-use scanline3d::scene::{
-    Camera, Instance, Light, Mesh, MeshColors, Scene, SceneError, Transform, Vertex,
-};
+use scanline3d::scene::{Camera, Instance, Light, Mesh, MeshColors, Scene, SceneError, Vertex};
 use scanline3d::sink::HashSink;
-use scanline3d::{Flat, FrameStats, RenderError, RenderOptions, Workspace};
+use scanline3d::{Flat, FrameStats, RenderError, RenderOptions, Shading, Unlit, Workspace};
 
 const fn c(bits: i32) -> I16F16 {
     I16F16::from_bits(bits)
@@ -36,6 +34,9 @@ include!(concat!(env!("OUT_DIR"), "/demo_meshes.rs"));
 pub mod byte_hash;
 pub mod metaballs;
 pub mod patches;
+mod placement;
+
+pub use placement::LIGHT;
 
 /// The hidden-surface test scenes of `sim hsr` as static meshes (`HSR_MESHES[level]`, the
 /// objects of one scene in instance order), generated from `scanline3d_meshgen::hsr_scene`.
@@ -88,17 +89,62 @@ pub fn instances() -> [Instance<'static>; PANEL_INSTANCES] {
     [
         Instance {
             mesh: &SPHERE,
-            transform: Transform::IDENTITY,
+            transform: placement::sphere_transform(),
         },
         Instance {
             mesh: &CUBE,
-            transform: Transform::translation([1.35, -0.55, 1.15])
-                .then_after(&Transform::rotation_y(0.6))
-                .then_after(&Transform::scale([0.45; 3])),
+            transform: placement::cube_transform(),
         },
         Instance {
             mesh: &GROUND,
-            transform: Transform::translation([0.0, -1.0, 0.0]),
+            transform: placement::ground_transform(),
+        },
+    ]
+}
+
+/// The icosphere with its faces lit ahead of time: per-face colours baked by the build script
+/// ([`scanline3d::shading::bake_face_colors`], the default arithmetic) for [`LIGHT`] and the
+/// sphere's place in [`instances`], to draw with [`Unlit`] shading. No normals: nothing lights
+/// it at run time.
+pub static SPHERE_BAKED: Mesh<'static> = valid(Mesh::new(
+    &ICOSPHERE_VERTICES,
+    &ICOSPHERE_TRIANGLES,
+    MeshColors::PerFace(&ICOSPHERE_BAKED),
+    None,
+));
+
+/// The cube with its faces lit ahead of time (as [`SPHERE_BAKED`]).
+pub static CUBE_BAKED: Mesh<'static> = valid(Mesh::new(
+    &CUBE_VERTICES,
+    &CUBE_TRIANGLES,
+    MeshColors::PerFace(&CUBE_BAKED_COLORS),
+    None,
+));
+
+/// The ground with its faces lit ahead of time (as [`SPHERE_BAKED`]).
+pub static GROUND_BAKED: Mesh<'static> = valid(Mesh::new(
+    &GROUND_VERTICES,
+    &GROUND_TRIANGLES,
+    MeshColors::PerFace(&GROUND_BAKED_COLORS),
+    None,
+));
+
+/// [`instances`] with the baked meshes, to draw with [`Unlit`] shading
+/// ([`BakedPanelWorkspace`]): the same frames as [`instances`] drawn [`Flat`], as long as the
+/// light stays [`LIGHT`] and the objects stay where they are (the camera may move).
+pub fn baked_instances() -> [Instance<'static>; PANEL_INSTANCES] {
+    [
+        Instance {
+            mesh: &SPHERE_BAKED,
+            transform: placement::sphere_transform(),
+        },
+        Instance {
+            mesh: &CUBE_BAKED,
+            transform: placement::cube_transform(),
+        },
+        Instance {
+            mesh: &GROUND_BAKED,
+            transform: placement::ground_transform(),
         },
     ]
 }
@@ -125,9 +171,6 @@ pub fn camera(frame: u32, frames: u32) -> Result<Camera, SceneError> {
     let (eye, target, up, fovy, near, far) = camera_parameters(frame, frames);
     Camera::look_at(eye, target, up)?.perspective(fovy, near, far)
 }
-
-/// The demo light's parameters: towards the light, ambient, diffuse.
-pub const LIGHT: ([f32; 3], f32, f32) = ([-0.45, 0.8, 0.55], 0.25, 0.75);
 
 /// The demo light: from the upper left front, 25 % ambient.
 pub fn light() -> Result<Light, SceneError> {
@@ -168,9 +211,16 @@ pub type PanelWorkspace = CachedPanelWorkspace<0>;
 
 /// [`PanelWorkspace`] with a vertex cache of `VERTS` entries ([`scanline3d::cache`]);
 /// [`PANEL_VERTICES`] holds the whole demo.
-pub type CachedPanelWorkspace<const VERTS: usize> = Workspace<
+pub type CachedPanelWorkspace<const VERTS: usize> = PanelWorkspaceOf<Flat, VERTS>;
+
+/// The demo's workspace for the baked meshes ([`baked_instances`]): [`Unlit`] shading, a vertex
+/// cache of `VERTS` entries, the same capacities.
+pub type BakedPanelWorkspace<const VERTS: usize> = PanelWorkspaceOf<Unlit, VERTS>;
+
+/// The demo's workspace with shading `S` and a vertex cache of `VERTS` entries.
+pub type PanelWorkspaceOf<S, const VERTS: usize> = Workspace<
     Rgb565,
-    Flat,
+    S,
     WIDTH,
     HEIGHT,
     PANEL_TRIANGLES,
@@ -192,9 +242,10 @@ pub struct PanelFrame {
 /// Renders `scene` (normally [`scene`] at some frame) into `ws`, hashing the rows as a
 /// frame-buffer-less panel would receive them. Firmware and host call this same function, so
 /// equal hashes mean bit-identical output across machines. With or without a vertex cache the
-/// frames are the same.
-pub fn render_panel_frame<const VERTS: usize>(
-    ws: &mut CachedPanelWorkspace<VERTS>,
+/// frames are the same, and so are [`baked_instances`] drawn [`Unlit`] and [`instances`] drawn
+/// [`Flat`].
+pub fn render_panel_frame<S: Shading, const VERTS: usize>(
+    ws: &mut PanelWorkspaceOf<S, VERTS>,
     scene: &Scene<'_>,
 ) -> Result<PanelFrame, RenderError<Infallible>> {
     let mut sink = HashSink::new();

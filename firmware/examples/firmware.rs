@@ -16,7 +16,9 @@
 //! frame (hash, instructions, pixels), the inner span loop's cost and a summary with the stack
 //! high-water mark, then exits with status 0, or 1 on any error or panic. Built with
 //! `--cfg scanline3d_vertex_cache` (through `cargo rustc`) it renders the same frames with a
-//! vertex cache holding every demo vertex.
+//! vertex cache holding every demo vertex. Built with `--cfg scanline3d_baked` it draws the
+//! demo's meshes with face colours lit ahead of time on the host (`demo::baked_instances`) with
+//! `Unlit` shading: the same frames, for a static light and static objects only.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
@@ -47,9 +49,19 @@ mod firmware {
     /// The demo's workspace; built with `--cfg scanline3d_vertex_cache` (`cargo xtask firmware`
     /// does that too), with a vertex cache holding every demo vertex.
     #[cfg(not(scanline3d_vertex_cache))]
-    type Ws = demo::PanelWorkspace;
+    const VERTS: usize = 0;
     #[cfg(scanline3d_vertex_cache)]
-    type Ws = demo::CachedPanelWorkspace<{ demo::PANEL_VERTICES }>;
+    const VERTS: usize = demo::PANEL_VERTICES;
+    /// Lit every frame ([`Flat`]), or with `--cfg scanline3d_baked` unlit ([`scanline3d::Unlit`])
+    /// with face colours baked on the host.
+    #[cfg(not(scanline3d_baked))]
+    type Ws = demo::CachedPanelWorkspace<VERTS>;
+    #[cfg(scanline3d_baked)]
+    type Ws = demo::BakedPanelWorkspace<VERTS>;
+    #[cfg(scanline3d_baked)]
+    use demo::baked_instances as instances;
+    #[cfg(not(scanline3d_baked))]
+    use demo::instances;
 
     /// One flat span fill, called the way the renderer calls it: through row slices.
     #[inline(never)]
@@ -117,7 +129,7 @@ mod firmware {
         let mut lines: [Option<FrameLine>; demo::ORBIT_FRAMES as usize] = Default::default();
         {
             let mut ws = Ws::new(demo::BACKGROUND.into());
-            let instances = demo::instances();
+            let instances = instances();
             for (frame, line) in lines.iter_mut().enumerate() {
                 let frame = frame as u32;
                 let scene =

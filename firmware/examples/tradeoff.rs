@@ -27,7 +27,7 @@ use scanline3d::preset::{self, Preset};
 use scanline3d::scene::{Camera, Scene, SceneError};
 use scanline3d::shading::{Affine, Gouraud, Interpolation, PerPixel, PerSegment};
 use scanline3d::sink::HashSink;
-use scanline3d::{Depth, Flat, RenderOptions, Shading, Workspace};
+use scanline3d::{Depth, Flat, RenderOptions, Shading, Unlit, Workspace};
 use scanline3d_demo as demo;
 #[cfg(not(target_os = "none"))]
 use scanline3d_demo::byte_hash::{ByteHashSink, Tee};
@@ -146,7 +146,12 @@ impl<C: Fn() -> Counter, R: FnMut(&str, u32, Frame)> Renders for Orbit<'_, C, R>
         options: RenderOptions<S, FrustumClip, A>,
     ) -> Result<(), &'static str> {
         let mut ws = fresh(|| Ws::<Sh, Z>::new(Rgb565::new(0, 0, 0)));
-        let instances = demo::instances();
+        // Unlit shading draws the demo's baked meshes.
+        let instances = if Sh::LIT {
+            demo::instances()
+        } else {
+            demo::baked_instances()
+        };
         for f in 0..demo::ORBIT_FRAMES {
             let (eye, target, up, fovy, near, far) = demo::camera_parameters(f, demo::ORBIT_FRAMES);
             let scene = Scene {
@@ -190,6 +195,8 @@ const BUILD_VARIANT: &str = if cfg!(scanline3d_variant = "fast") {
     "gouraud-segments8"
 } else if cfg!(scanline3d_variant = "gouraudperpixel") {
     "gouraud-per-pixel"
+} else if cfg!(scanline3d_variant = "baked") {
+    "baked"
 } else {
     "balanced"
 };
@@ -261,6 +268,12 @@ fn variants(r: &mut impl Renders) -> Result<(), &'static str> {
     if renders("depth16") {
         r.variant::<Flat, 4, _, Libm, Depth16>("depth16", default)?;
     }
+    // The default drawing face colours lit ahead of time (`Unlit`: the demo's baked meshes,
+    // the corpus scenes' `BAKED_MESH`), the same frames for static scenes. Built only when
+    // asked for (`cargo xtask profile baked ...`), not on the host.
+    if cfg!(scanline3d_variant = "baked") {
+        r.variant::<Unlit, 4, _, Libm, Depth>("baked", default)?;
+    }
     gouraud::<Affine>(r, "gouraud-affine")?;
     gouraud::<PerSegment<16>>(r, "gouraud-segments16")?;
     gouraud::<PerSegment<8>>(r, "gouraud-segments8")?;
@@ -313,6 +326,16 @@ mod corpus_views {
     #[cfg(scanline3d_vertex_cache)]
     const CORPUS_CACHE: usize = corpus::MAX_VERTICES;
 
+    /// The mesh scene `s` draws with shading `Sh`: for `Unlit` (the `baked` variant), the
+    /// face colours baked for the scene's light.
+    fn mesh_for<Sh: Shading>(s: &corpus::CorpusScene) -> &'static scanline3d::scene::Mesh<'static> {
+        #[cfg(scanline3d_variant = "baked")]
+        if !Sh::LIT {
+            return s.baked;
+        }
+        s.mesh
+    }
+
     pub struct Views<'a, C, R> {
         pub count: &'a C,
         pub report: R,
@@ -327,7 +350,7 @@ mod corpus_views {
             let mut ws = fresh(|| CorpusWs::<Sh, Z>::new(Rgb565::new(0, 0, 0)));
             for s in &corpus::SCENES {
                 let instances = [Instance {
-                    mesh: s.mesh,
+                    mesh: mesh_for::<Sh>(s),
                     transform: Transform::IDENTITY,
                 }];
                 let (towards, ambient, diffuse) = s.light;

@@ -28,6 +28,36 @@ pub struct Export<'a> {
     /// A BSP tree built for `mesh` (then `mesh` is the tree's split mesh): exported as
     /// `static` nodes validated at compile time, with the traversal stack it needs.
     pub bsp: Option<&'a crate::bsp::Bsp>,
+    /// Light the face colours ahead of time with this set-up arithmetic (`sim export
+    /// --bake-light`): the colour table is what `Flat` shading gives each face under `light`
+    /// ([`scanline3d::shading::bake_face_colors`]), for drawing with `Unlit` shading.
+    pub bake_light: Option<crate::scene::SetupArith>,
+}
+
+/// The face colours `Flat` shading gives `mesh` (identity transform) under `light` with the
+/// set-up arithmetic `arith`: [`scanline3d::shading::bake_face_colors`].
+pub fn baked_colors(
+    mesh: &MeshData,
+    light: &LightSpec,
+    arith: crate::scene::SetupArith,
+) -> Result<Vec<embedded_graphics::pixelcolor::Rgb888>, String> {
+    use crate::scene::SetupArith as S;
+    use scanline3d::arithmetic::{Frugal, Precise, Quick};
+    use scanline3d::scene::Transform;
+    use scanline3d::shading::bake_face_colors;
+    let m = mesh.mesh()?;
+    let light = light.fixed()?;
+    let mut out = vec![embedded_graphics::pixelcolor::Rgb888::BLACK; mesh.triangles.len()];
+    let t = Transform::IDENTITY;
+    match arith {
+        S::Precise | S::NarrowTransform | S::Reciprocal => {
+            bake_face_colors::<Precise>(&m, &t, &light, &mut out)
+        }
+        S::Quick => bake_face_colors::<Quick>(&m, &t, &light, &mut out),
+        S::Frugal | S::NarrowNormals => bake_face_colors::<Frugal>(&m, &t, &light, &mut out),
+    }
+    .map_err(|e| e.to_string())?;
+    Ok(out)
 }
 
 /// The mesh's own vertex normals (from the OBJ file) in I16F16 bits when it has them, else
@@ -163,8 +193,21 @@ fn bsp_source(b: &crate::bsp::Bsp) -> String {
 
 impl Export<'_> {
     /// The generated source, laid out close to rustfmt's style (pass it through [`rustfmt`]).
-    pub fn source(&self) -> String {
-        let m = self.mesh;
+    pub fn source(&self) -> Result<String, String> {
+        let baked;
+        let m = match self.bake_light {
+            Some(arith) => {
+                if self.normals {
+                    return Err("--bake-light exports colours for Unlit shading: no normals (Gouraud would light them again)".into());
+                }
+                baked = MeshData {
+                    colors: baked_colors(self.mesh, &self.light, arith)?,
+                    ..self.mesh.clone()
+                };
+                &baked
+            }
+            None => self.mesh,
+        };
         let a = self.analysis;
         let (nv, nt) = (m.vertices.len(), m.triangles.len());
         let tris = a.triangle_capacity(self.margin_percent);
@@ -187,6 +230,13 @@ impl Export<'_> {
                 s,
                 "//! The mesh is the split mesh of a BSP tree built for the OBJ's {} triangles (`BSP_TREE`).",
                 b.origin.iter().max().map_or(0, |&o| o as usize + 1)
+            );
+        }
+        if let Some(arith) = self.bake_light {
+            let _ = writeln!(
+                s,
+                "//!\n//! The face colours are lit ahead of time (`scanline3d::shading::bake_face_colors`, {} arithmetic)\n//! for `LIGHT` and the mesh where it is (identity transform): draw it with `scanline3d::Unlit`\n//! shading, which gives the pixels `Flat` gives the original colours, while the light and the\n//! mesh stay put (the camera may move).",
+                arith.name()
             );
         }
         let _ = writeln!(
@@ -243,7 +293,15 @@ impl Export<'_> {
                 c.b()
             )
         } else {
-            let _ = writeln!(s, "/// One colour per triangle.");
+            let _ = writeln!(
+                s,
+                "{}",
+                if self.bake_light.is_some() {
+                    "/// One colour per triangle, lit for `LIGHT` (draw with `Unlit` shading)."
+                } else {
+                    "/// One colour per triangle."
+                }
+            );
             let _ = writeln!(s, "pub static FACE_COLORS: [Rgb888; {nt}] = [");
             for c in &m.colors {
                 let _ = writeln!(s, "    Rgb888::new({}, {}, {}),", c.r(), c.g(), c.b());
@@ -374,7 +432,15 @@ impl Export<'_> {
         }
         s += "];\n\n";
         let l = self.light;
-        let _ = writeln!(s, "/// The light: towards the light, ambient, diffuse.");
+        let _ = writeln!(
+            s,
+            "{}",
+            if self.bake_light.is_some() {
+                "/// The light: towards the light, ambient, diffuse (the face colours are lit for it)."
+            } else {
+                "/// The light: towards the light, ambient, diffuse."
+            }
+        );
         let _ = writeln!(
             s,
             "pub const LIGHT: ([f32; 3], f32, f32) = {};",
@@ -387,7 +453,7 @@ impl Export<'_> {
                 0
             )
         );
-        s
+        Ok(s)
     }
 }
 
@@ -425,10 +491,23 @@ pub fn corpus_source(w: usize, h: usize, margin_percent: u32) -> Result<String, 
             normals: false,
             command: format!("scanline3d_sim::export::corpus_source({w}, {h}, {margin_percent})"),
             bsp: None,
+            bake_light: None,
         };
         let module = scene.name.replace('-', "_");
         let _ = writeln!(s, "#[allow(dead_code)]\npub mod {module} {{");
-        s += &export.source();
+        s += &export.source()?;
+        // The same faces lit ahead of time, for `Unlit` shading (`cargo xtask profile baked`;
+        // only that build's `SCENES` refer to them, so no other build links them).
+        let baked = baked_colors(
+            &scene.mesh,
+            &LightSpec::default(),
+            crate::scene::SetupArith::Precise,
+        )?;
+        let _ = writeln!(s, "/// The face colours lit for `LIGHT` (default arithmetic), for `Unlit` shading.\npub static BAKED_COLORS: [Rgb888; {}] = [", baked.len());
+        for c in &baked {
+            let _ = writeln!(s, "    Rgb888::new({}, {}, {}),", c.r(), c.g(), c.b());
+        }
+        s += "];\n/// `MESH` with the baked colours.\npub static BAKED_MESH: Mesh<'static> = valid(Mesh::new(&VERTICES, &TRIANGLES, MeshColors::PerFace(&BAKED_COLORS), None));\n";
         // Views may differ in projection; `PROJECTION` above is the first view's.
         let _ = writeln!(
             s,
@@ -446,12 +525,12 @@ pub fn corpus_source(w: usize, h: usize, margin_percent: u32) -> Result<String, 
         entries.push((scene.name, module));
     }
     s += "/// One corpus scene as the firmware renders it.\n";
-    s += "pub struct CorpusScene {\n    pub name: &'static str,\n    pub mesh: &'static scanline3d::scene::Mesh<'static>,\n    pub cull_back_faces: bool,\n    pub projections: &'static [(f32, f32, f32)],\n    pub views: &'static [([f32; 3], [f32; 3], [f32; 3])],\n    pub light: ([f32; 3], f32, f32),\n}\n\n";
+    s += "pub struct CorpusScene {\n    pub name: &'static str,\n    pub mesh: &'static scanline3d::scene::Mesh<'static>,\n    #[cfg(scanline3d_variant = \"baked\")]\n    pub baked: &'static scanline3d::scene::Mesh<'static>,\n    pub cull_back_faces: bool,\n    pub projections: &'static [(f32, f32, f32)],\n    pub views: &'static [([f32; 3], [f32; 3], [f32; 3])],\n    pub light: ([f32; 3], f32, f32),\n}\n\n";
     let _ = writeln!(s, "pub static SCENES: [CorpusScene; {}] = [", entries.len());
     for (name, m) in &entries {
         let _ = writeln!(
             s,
-            "    CorpusScene {{ name: {name:?}, mesh: &{m}::MESH, cull_back_faces: {m}::CULL_BACK_FACES, projections: &{m}::PROJECTIONS, views: &{m}::VIEWS, light: {m}::LIGHT }},"
+            "    CorpusScene {{ name: {name:?}, mesh: &{m}::MESH, #[cfg(scanline3d_variant = \"baked\")] baked: &{m}::BAKED_MESH, cull_back_faces: {m}::CULL_BACK_FACES, projections: &{m}::PROJECTIONS, views: &{m}::VIEWS, light: {m}::LIGHT }},"
         );
     }
     s += "];\n\n";

@@ -546,6 +546,15 @@ struct ExportArgs {
     /// the tree's split mesh, and the budget is measured for it.
     #[arg(long)]
     bsp: bool,
+    /// Light the face colours ahead of time for the scene's light and export them as the
+    /// mesh's colour table, for `Unlit` shading (static light and mesh): the same pixels as
+    /// `Flat` with the original colours, with no lighting on the target.
+    #[arg(long)]
+    bake_light: bool,
+    /// The preset whose set-up arithmetic (its normals) --bake-light lights with: the firmware's
+    /// (default: the default `RenderOptions`, `Precise`).
+    #[arg(long, requires = "bake_light")]
+    bake_preset: Option<scanline3d_sim::scene::PresetChoice>,
 }
 
 fn analyze_command(a: AnalyzeArgs) -> Result<(), String> {
@@ -718,8 +727,12 @@ fn export_command(a: ExportArgs) -> Result<(), String> {
         normals: a.normals,
         command,
         bsp: bsp.as_ref(),
+        bake_light: a.bake_light.then(|| {
+            a.bake_preset
+                .map_or(scanline3d_sim::scene::SetupArith::Precise, |p| p.arith())
+        }),
     };
-    let source = export.source();
+    let source = export.source()?;
     let source = scanline3d_sim::export::rustfmt(&source).unwrap_or_else(|| {
         let _ = writeln!(
             std::io::stderr(),

@@ -240,7 +240,8 @@ impl CameraSpec {
 }
 
 impl LightSpec {
-    fn fixed(&self) -> Result<Light, String> {
+    /// The library's light (f32).
+    pub fn fixed(&self) -> Result<Light, String> {
         Light::new(
             f32s(self.direction),
             self.ambient as f32,

@@ -472,10 +472,18 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
     }
 
     /// The flat colours of `patch` with its normal at `(u, v)` (black for Gouraud, which
-    /// colours vertices instead).
+    /// colours vertices instead; the patch's colour on both sides, unlit, for
+    /// [`Unlit`](crate::shading::Unlit)).
     fn face<S: Shading>(&self, patch: u16, net: &Net, [u, v]: Uv) -> Sides<Rgb888> {
         if S::PER_VERTEX {
             return BLACK_SIDES;
+        }
+        if !S::LIT {
+            let base = self.model.color(patch as usize);
+            return Sides {
+                front: base,
+                back: base,
+            };
         }
         self.lit(patch, net.normal(u, v))
     }

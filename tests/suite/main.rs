@@ -1,6 +1,7 @@
 //! Integration tests of the library, one binary: each module was once its own test target.
 //! Linking one binary instead of one per file keeps `cargo xtask test` inside its budget.
 
+mod bake;
 mod bsp_export;
 mod common;
 mod cover;

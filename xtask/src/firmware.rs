@@ -1,5 +1,5 @@
-//! `cargo xtask firmware`: the demo orbit on QEMU for every target, twice, with hashes, sizes and
-//! the vertex-cache variant.
+//! `cargo xtask firmware`: the demo orbit on QEMU for every target, twice, with hashes, sizes,
+//! the vertex-cache variant and the baked variants (face colours lit on the host, `Unlit`).
 
 use crate::*;
 
@@ -79,8 +79,70 @@ pub(crate) fn firmware() -> Result<(), String> {
         }
         println!("frame hashes equal the host's: {expected:08x?}");
         sizes(target, &first)?;
-        vertex_cache_on_target(target, &first, &expected)?;
+        let cached = vertex_cache_on_target(target, &first, &expected)?;
+        baked_on_target(target, &[], &first, &expected)?;
+        baked_on_target(target, &["scanline3d_vertex_cache"], &cached, &expected)?;
     }
+    Ok(())
+}
+
+/// The demo firmware built with `--cfg` each of `cfgs`: returns its output (every frame's hash
+/// checked against `expected`).
+fn firmware_variant(target: &str, cfgs: &[&str], expected: &[u32]) -> Result<String, String> {
+    let mut cmd = cargo();
+    cmd.args([
+        "rustc",
+        "--package",
+        FIRMWARE_PACKAGE,
+        "--profile",
+        "firmware",
+    ])
+    .args(["--example", "firmware"])
+    .args(["--target", target, "--"]);
+    for cfg in cfgs {
+        cmd.args(["--cfg", cfg]);
+    }
+    run(cmd.env("CARGO_TARGET_DIR", firmware_target_dir(target)))?;
+    let elf = firmware_elf(target, "firmware", "firmware");
+    let out = tradeoff::run_on_qemu_with(target, &elf, &[])?;
+    let hashes = frame_hashes(&out);
+    if hashes != expected {
+        return Err(format!(
+            "{target} with {cfgs:?}: frame hashes {hashes:08x?} differ from the host's {expected:08x?}"
+        ));
+    }
+    Ok(out)
+}
+
+/// The demo firmware with its face colours lit on the host (`--cfg scanline3d_baked`, `Unlit`
+/// shading) and `cfgs`: the frames must hash as the lit ones; prints its cost against the lit
+/// run `lit` (firmware output, the same `cfgs`). Valid for a static light and static objects.
+pub(crate) fn baked_on_target(
+    target: &str,
+    cfgs: &[&str],
+    lit: &str,
+    expected: &[u32],
+) -> Result<(), String> {
+    let label = if cfgs.is_empty() {
+        "baked face colours"
+    } else {
+        "baked face colours with a vertex cache"
+    };
+    step(&format!("firmware with {label}, {target}"));
+    let mut all = vec!["scanline3d_baked"];
+    all.extend_from_slice(cfgs);
+    let out = firmware_variant(target, &all, expected)?;
+    print!("{out}");
+    let (lit_mean, baked) = (mean_frame_instructions(lit), mean_frame_instructions(&out));
+    println!(
+        "{label}: the same hashes; {:.2} M instructions per frame against {:.2} M lit ({:.2}x fewer); peak stack {} B against {} B",
+        baked / 1e6,
+        lit_mean / 1e6,
+        lit_mean / baked.max(1.0),
+        summary_field(&out, "peak_stack"),
+        summary_field(lit, "peak_stack")
+    );
+    sizes(target, &out)?;
     Ok(())
 }
 
@@ -106,32 +168,14 @@ pub(crate) fn mean_frame_instructions(output: &str) -> f64 {
 
 /// The demo firmware again with a vertex cache holding every demo vertex (`--cfg
 /// scanline3d_vertex_cache`): the frames must hash the same; prints its cost against the
-/// uncached run `uncached` (firmware output) and its renderer RAM.
+/// uncached run `uncached` (firmware output) and its renderer RAM, and returns its output.
 pub(crate) fn vertex_cache_on_target(
     target: &str,
     uncached: &str,
     expected: &[u32],
-) -> Result<(), String> {
+) -> Result<String, String> {
     step(&format!("firmware with a vertex cache, {target}"));
-    run(cargo()
-        .args([
-            "rustc",
-            "--package",
-            FIRMWARE_PACKAGE,
-            "--profile",
-            "firmware",
-        ])
-        .args(["--example", "firmware"])
-        .args(["--target", target, "--", "--cfg", "scanline3d_vertex_cache"])
-        .env("CARGO_TARGET_DIR", firmware_target_dir(target)))?;
-    let elf = firmware_elf(target, "firmware", "firmware");
-    let out = tradeoff::run_on_qemu_with(target, &elf, &[])?;
-    let hashes = frame_hashes(&out);
-    if hashes != expected {
-        return Err(format!(
-            "{target} with a vertex cache: frame hashes {hashes:08x?} differ from the host's {expected:08x?}"
-        ));
-    }
+    let out = firmware_variant(target, &["scanline3d_vertex_cache"], expected)?;
     let (plain, cached) = (
         mean_frame_instructions(uncached),
         mean_frame_instructions(&out),
@@ -144,7 +188,7 @@ pub(crate) fn vertex_cache_on_target(
         summary_field(&out, "renderer_ram"),
         summary_field(uncached, "renderer_ram")
     );
-    Ok(())
+    Ok(out)
 }
 
 /// An ELF symbol: name, size, type, section index.

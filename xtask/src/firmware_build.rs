@@ -25,8 +25,13 @@ pub(crate) fn firmware_target_dir(target: &str) -> std::path::PathBuf {
 }
 
 /// The lean firmware examples, as `cargo build --example` names them.
-pub(crate) const LEAN_EXAMPLES: [&str; 4] =
-    ["lean_bsp", "lean_minimal", "lean_full", "lean_baseline"];
+pub(crate) const LEAN_EXAMPLES: [&str; 5] = [
+    "lean_bsp",
+    "lean_minimal",
+    "lean_minimal_baked",
+    "lean_full",
+    "lean_baseline",
+];
 
 /// Builds firmware examples with `profile` for every target, the targets in parallel: each
 /// build ends in a single-threaded link-time optimisation, so one cargo per target keeps both

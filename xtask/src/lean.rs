@@ -4,7 +4,9 @@ use crate::*;
 
 /// The lean firmware variants (`firmware/examples/lean_*.rs`), built with the size-optimised `lean`
 /// profile.
-pub(crate) const LEAN_VARIANTS: [&str; 3] = ["minimal", "full", "baseline"];
+/// `minimal_baked` is `minimal` drawing the scene exported with `--bake-light` (face colours
+/// lit on the host) with `Unlit` shading: the same hashes.
+pub(crate) const LEAN_VARIANTS: [&str; 4] = ["minimal", "minimal_baked", "full", "baseline"];
 
 /// The scene the lean firmware was exported from, and how many views it was analysed from.
 pub(crate) const LEAN_OBJ: &str = "firmware/examples/lean/icosphere80.obj";
@@ -126,7 +128,7 @@ pub(crate) fn lean_runs(profile: &str, with_table: bool) -> Result<(), String> {
         }
         let (base_flash, base_out) = &flash["baseline"];
         let base_stack = summary_field(base_out, "peak_stack");
-        for variant in ["minimal", "full"] {
+        for variant in ["minimal", "minimal_baked", "full"] {
             let (f, out) = &flash[variant];
             let workspace = summary_field(out, "workspace");
             let stack = summary_field(out, "peak_stack");

@@ -17,6 +17,17 @@ const LEAN_RS: &str = "firmware/examples/lean/scene.rs";
 /// The export command for it (run from the repository root).
 /// Margin 0: the lean builds measure the smallest workspace that renders these views.
 const LEAN_EXPORT: &[&str] = &["export", LEAN_OBJ, "--views", "8", "--margin", "0"];
+/// The lean baked firmware's scene: the same, its face colours lit ahead of time (`Unlit`).
+const BAKED_RS: &str = "firmware/examples/lean/scene_baked.rs";
+const BAKED_EXPORT: &[&str] = &[
+    "export",
+    LEAN_OBJ,
+    "--views",
+    "8",
+    "--margin",
+    "0",
+    "--bake-light",
+];
 /// The lean BSP firmware's scene: the cyclic-overlap corpus scene with its BSP tree.
 const BSP_RS: &str = "firmware/examples/lean/cyclic_bsp.rs";
 const BSP_EXPORT: &[&str] = &[
@@ -62,9 +73,13 @@ fn lean_obj_is_the_generated_icosphere() {
 
 #[test]
 fn export_regenerates_the_committed_lean_scenes_and_they_are_rustfmt_clean() {
-    for (i, (args, committed)) in [(LEAN_EXPORT, LEAN_RS), (BSP_EXPORT, BSP_RS)]
-        .into_iter()
-        .enumerate()
+    for (i, (args, committed)) in [
+        (LEAN_EXPORT, LEAN_RS),
+        (BAKED_EXPORT, BAKED_RS),
+        (BSP_EXPORT, BSP_RS),
+    ]
+    .into_iter()
+    .enumerate()
     {
         let dir =
             std::env::temp_dir().join(format!("scanline3d-export-{}-{i}", std::process::id()));
@@ -128,4 +143,47 @@ fn bad_export_input_is_one_clear_error() {
     let (code, err) = run(&["analyze", LEAN_OBJ, "--views", "0"]);
     assert_eq!(code, Some(2));
     assert!(err.contains("--views"), "{err}");
+    // Baked colours are for Unlit shading: normals would let Gouraud light them again.
+    let (code, err) = run(&[
+        "export",
+        LEAN_OBJ,
+        "--views",
+        "2",
+        "--bake-light",
+        "--normals",
+        "--out",
+        "x.rs",
+    ]);
+    assert_eq!(code, Some(2));
+    assert!(
+        err.contains("--bake-light") && err.lines().count() == 1,
+        "{err}"
+    );
+}
+
+/// `--bake-light` with a narrow-normals preset writes the colours `Flat` gives with that
+/// preset's arithmetic (`export::baked_colors`), which differ from the default's somewhere on
+/// the heightfield, and each equals the library's own bake.
+#[test]
+fn baked_colours_follow_the_preset_s_normals() {
+    use scanline3d_sim::export::baked_colors;
+    use scanline3d_sim::scene::{LightSpec, SetupArith};
+    let scene = scanline3d_sim::corpus::all()
+        .into_iter()
+        .find(|s| s.name == "heightfield")
+        .unwrap();
+    let light = LightSpec::default();
+    let wide = baked_colors(&scene.mesh, &light, SetupArith::Precise).unwrap();
+    let narrow = baked_colors(&scene.mesh, &light, SetupArith::Frugal).unwrap();
+    assert_eq!(wide.len(), scene.mesh.triangles.len());
+    assert_ne!(wide, narrow);
+    let mut own = vec![Default::default(); wide.len()];
+    scanline3d::shading::bake_face_colors::<scanline3d::arithmetic::Frugal>(
+        &scene.mesh.mesh().unwrap(),
+        &scanline3d::scene::Transform::IDENTITY,
+        &light.fixed().unwrap(),
+        &mut own,
+    )
+    .unwrap();
+    assert_eq!(own, narrow);
 }
