@@ -179,6 +179,55 @@ pub fn narrow(v: I32F32) -> Option<I16F16> {
     (high >> 15 == high >> 31).then_some(I16F16::from_bits((bits >> 16) as i32))
 }
 
+/// Whether the tracer's square roots and reciprocals start from single-precision floating
+/// point: on Arm cores with a hardware FPU (the `eabihf` targets, Cortex-M4F and the like), where
+/// a conversion, multiply or divide of `f32` is one instruction. The integer corrections after the
+/// estimate make the results exactly those of the integer forms on every target.
+pub const FLOAT_ESTIMATES: bool = cfg!(all(target_arch = "arm", target_abi = "eabihf"));
+
+/// ⌊√v⌋ for a 32-bit integer, the tracer's: [`isqrt32_float`] where the core has an FPU
+/// ([`FLOAT_ESTIMATES`]), else [`isqrt32`]. The same bits either way.
+#[inline]
+pub const fn root32(v: u32) -> u32 {
+    if FLOAT_ESTIMATES {
+        isqrt32_float(v)
+    } else {
+        isqrt32(v)
+    }
+}
+
+/// ⌊√v⌋ for a 32-bit integer from a single-precision estimate: `1/√v` from the exponent-halving
+/// bit seed and two Newton steps `y ← y·(c − v/2·y²)` (the second with `c` a little below 3/2,
+/// so the estimate `v·y` stays under √v), truncated, then checked by its square: `r` is ⌊√v⌋
+/// when `r² ≤ v < (r + 1)²`, else `r + 1` is tried. The estimate is a fraction of a unit below
+/// √v (two Newton steps leave about 5·10^-6 relative, 0.3 at the largest root), so one of the
+/// two is the root; should neither be, [`isqrt32_newton`] gives it, so the result is ⌊√v⌋
+/// whatever the floating point does (tested against every 32-bit input,
+/// `float_root_is_exact_everywhere`). About 25 instructions with a hardware FPU (Cortex-M4F),
+/// no division.
+#[inline]
+pub const fn isqrt32_float(v: u32) -> u32 {
+    let f = v as f32;
+    let h = 0.5 * f;
+    let y = f32::from_bits(0x5f37_5a86_u32.wrapping_sub(f.to_bits() >> 1));
+    let y = y * (1.5 - h * y * y);
+    let y = y * (1.499_998_5 - h * y * y);
+    // ⌊√v⌋ ≤ 65535 for any 32-bit v.
+    let mut r = (f * y) as u32;
+    if r > 65_535 {
+        r = 65_535;
+    }
+    // r² ≤ v < (r + 1)² ⇔ v − r² ≤ 2r, the difference wrapping to a huge value when r² > v.
+    if v.wrapping_sub(r * r) <= 2 * r {
+        return r;
+    }
+    r += 1;
+    if r <= 65_535 && v.wrapping_sub(r * r) <= 2 * r {
+        return r;
+    }
+    isqrt32_newton(v)
+}
+
 /// √v for a non-negative I32F32, as an I16F16 (negative input gives 0).
 ///
 /// The raw I16F16 result is ⌊√bits⌋ of the I32F32's raw bits, computed with a 32-bit square root
@@ -194,13 +243,13 @@ pub const fn sqrt(v: I32F32) -> I16F16 {
     let high = (bits >> 32) as u32;
     if high == 0 {
         // Below 2^32: the exact root, below 2^16.
-        return I16F16::from_bits(isqrt32(bits as u32) as i32);
+        return I16F16::from_bits(root32(bits as u32) as i32);
     }
     // The smallest even shift that brings the radicand below 2^32 (2 to 32), from the high
     // word alone: its 32 − lz bits rounded up to even.
     let shift = (33 - high.leading_zeros()) & !1;
     // root < 2^16 and shift / 2 ≤ 16: the product stays below 2^32.
-    let root = isqrt32(((bits as u64) >> shift) as u32) << (shift / 2);
+    let root = root32(((bits as u64) >> shift) as u32) << (shift / 2);
     if root > i32::MAX as u32 {
         I16F16::MAX
     } else {
@@ -243,6 +292,11 @@ fn normalize_by(v: [i32; 3], len: i32) -> Option<[i32; 3]> {
 #[inline]
 pub fn reciprocal46(len: u32) -> i64 {
     if len > 1 << 14 {
+        if FLOAT_ESTIMATES {
+            if let Some(q) = reciprocal46_float(len) {
+                return q;
+            }
+        }
         // 2^46 = 2^14 · 2^32 with 2^14 < len: the quotient fits 32 bits.
         return i64::from(div_rem_below(1 << 14, 0, len).0);
     }
@@ -254,6 +308,24 @@ pub fn reciprocal46(len: u32) -> i64 {
     } else {
         r << (k - 17)
     }
+}
+
+/// ⌊2^46 / `len`⌋ for `len` above 2^14 from a single-precision estimate, or `None` where the
+/// estimate's remainder does not fit 32 bits (`len` near 2^30 and above, beyond the lengths the
+/// envelope gives). The quotient `2^46 / len` in `f32` is within 2^-23 of the exact one; taken
+/// down by more than its error (`q0 − q0/2^22 − 2`, below ⌊2^46 / len⌋), its remainder
+/// `2^46 − q0·len` is non-negative and at most about 3·2^23 + 4·len, and
+/// `q0 + ⌊remainder / len⌋` is the exact quotient: one 32-bit division instead of
+/// `math::div_rem_below`'s two digits. Exact whatever the estimate, since the remainder is checked.
+#[inline]
+pub fn reciprocal46_float(len: u32) -> Option<i64> {
+    const TWO_TO_46: f32 = (1u64 << 46) as f32;
+    let q = TWO_TO_46 / len as f32;
+    let q0 = q as u32;
+    let q0 = q0.wrapping_sub(q0 >> 22).wrapping_sub(2);
+    let rem = (1u64 << 46).wrapping_sub(u64::from(q0) * u64::from(len));
+    let rem = u32::try_from(rem).ok()?;
+    Some(i64::from(q0) + i64::from(rem.checked_div(len)?))
 }
 
 /// ⌊2^62 / `l`⌋ for `l` in [2^30, 2^31) (so at most 2^32), exact, without a 64-bit division:
@@ -315,6 +387,101 @@ pub fn ratio16(n: u64, d: u64) -> u64 {
 mod tests {
     use super::*;
     use std::vec::Vec;
+
+    /// Inputs for the square roots: random values of every length, 0, 1, every perfect square
+    /// and its neighbours at each power of 2 and near the top, and the maximum.
+    fn root_inputs() -> Vec<u32> {
+        let mut rng = crate::test_rng::XorShift64::new(0x3c6e_f372_fe94_f82bu64);
+        let mut next = || rng.next_u64();
+        let mut v: Vec<u32> = (0..300_000)
+            .map(|_| (next() >> 32) as u32 >> (next() % 32))
+            .collect();
+        let squares = (0..=65_535u32)
+            .step_by(97)
+            .chain(0..300)
+            .chain(65_000..=65_535)
+            .chain((0..16).map(|b| 1 << b));
+        for r in squares {
+            let s = r * r;
+            let above = s.wrapping_add(2 * r);
+            v.extend([
+                s,
+                s.wrapping_sub(1),
+                s.wrapping_add(1),
+                above,
+                above.wrapping_add(1),
+            ]);
+        }
+        v.extend([0, 1, 2, 3, u32::MAX, u32::MAX - 1, 1 << 31, (1 << 31) - 1]);
+        v
+    }
+
+    #[test]
+    fn float_root_is_the_integer_root() {
+        for v in root_inputs() {
+            assert_eq!(isqrt32_float(v), isqrt32_newton(v), "{v}");
+            assert_eq!(root32(v), isqrt32_newton(v), "{v}");
+        }
+    }
+
+    /// Every 32-bit input (about a minute in a release build:
+    /// `cargo test -p scanline3d --release --lib float_root_is_exact_everywhere -- --ignored`).
+    #[test]
+    #[ignore]
+    fn float_root_is_exact_everywhere() {
+        let mut r = 0u32;
+        for v in 0..=u32::MAX {
+            // ⌊√v⌋ steps up by one at each square.
+            if u64::from(r + 1) * u64::from(r + 1) == u64::from(v) {
+                r += 1;
+            }
+            assert_eq!(isqrt32_float(v), r, "{v}");
+        }
+    }
+
+    /// Every length from 2^14 + 1 to the envelope's largest (2^13·√3 units, below 2^30 raw)
+    /// takes the single-precision path, and its quotient is exact (about ten seconds in a
+    /// release build: `cargo test -p scanline3d --release --lib float_reciprocal_is_exact_everywhere
+    /// -- --ignored`).
+    #[test]
+    #[ignore]
+    fn float_reciprocal_is_exact_everywhere() {
+        for len in (1u32 << 14) + 1..(1 << 30) - (1 << 23) {
+            let exact = (1u64 << 46) / u64::from(len);
+            assert_eq!(reciprocal46_float(len), Some(exact as i64), "{len}");
+        }
+    }
+
+    #[test]
+    fn float_reciprocal_is_the_exact_quotient() {
+        let mut rng = crate::test_rng::XorShift64::new(0xbb67_ae85_84ca_a73bu64);
+        let mut next = || rng.next_u64();
+        let lens = (0..300_000)
+            .map(|_| ((next() >> 33) as u32 >> (next() % 17)).max((1 << 14) + 1))
+            .chain((1u32 << 14) + 1..1 << 17)
+            .chain((14..31).flat_map(|b| [(1u32 << b) - 1, 1 << b, (1 << b) + 1]))
+            .chain([
+                (1 << 31) - 1,
+                (1 << 31) - 2,
+                (1 << 30) - (1 << 23),
+                46_341,
+                65_535,
+            ]);
+        let mut fell_back = 0;
+        for len in lens.filter(|l| *l > 1 << 14) {
+            let exact = (1i64 << 46) / i64::from(len);
+            match reciprocal46_float(len) {
+                Some(q) => assert_eq!(q, exact, "{len}"),
+                None => {
+                    // Only lengths beyond the envelope's (2^13·√3 units < 2^30 raw).
+                    assert!(len > (1 << 30) - (1 << 23), "{len}");
+                    fell_back += 1;
+                }
+            }
+            assert_eq!(reciprocal46(len), exact, "{len}");
+        }
+        assert!(fell_back > 0);
+    }
 
     #[test]
     fn reciprocal46_is_within_its_bound() {
