@@ -213,7 +213,7 @@ const ROOT_SEEDS: [u16; 192] = {
 };
 
 /// ⌊√v⌋ for a 32-bit integer without a division: for `v ≥ 2^30` (every radicand `sqrt` shifts
-/// down to 32 bits) the root of `v`'s top byte from a table of 192 entries ([`ROOT_SEEDS`]), at
+/// down to 32 bits) the root of `v`'s top byte from a table of 192 entries (`ROOT_SEEDS`), at
 /// most 511 below ⌊√v⌋, then the nine low bits of the difference one at a time, keeping
 /// `rem = v − r²` (adding `d` is allowed when `(2r + d)·d ≤ rem`): nine steps instead of
 /// [`isqrt32_bitwise`]'s sixteen, which smaller `v` keep. Exact (tested against
