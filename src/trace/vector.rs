@@ -101,9 +101,9 @@ impl Vec3 {
     #[inline]
     pub const fn dot_bits(self, o: Vec3) -> i64 {
         let (a, b) = (self.bits(), o.bits());
-        (a[0] as i64 * b[0] as i64)
-            .wrapping_add(a[1] as i64 * b[1] as i64)
-            .wrapping_add(a[2] as i64 * b[2] as i64)
+        wide(a[0], b[0])
+            .wrapping_add(wide(a[1], b[1]))
+            .wrapping_add(wide(a[2], b[2]))
     }
 
     /// `self · s` for a scalar `s`, each product narrowed to I16F16 (saturating: only reached
@@ -111,11 +111,11 @@ impl Vec3 {
     #[inline]
     pub fn scale(self, s: I16F16) -> Vec3 {
         let a = self.bits();
-        let s = s.to_bits() as i64;
+        let s = s.to_bits();
         Vec3::from_bits(
-            narrow_bits(a[0] as i64 * s),
-            narrow_bits(a[1] as i64 * s),
-            narrow_bits(a[2] as i64 * s),
+            narrow_bits(wide(a[0], s)),
+            narrow_bits(wide(a[1], s)),
+            narrow_bits(wide(a[2], s)),
         )
     }
 
@@ -168,7 +168,32 @@ pub const fn narrow_bits(v: i64) -> i32 {
 /// `a · b` for two I16F16 values, truncated, saturating outside the I16F16 range.
 #[inline]
 pub fn mul(a: I16F16, b: I16F16) -> I16F16 {
-    I16F16::from_bits(narrow_bits(a.wide_mul(b).to_bits()))
+    I16F16::from_bits(narrow_bits(wide(a.to_bits(), b.to_bits())))
+}
+
+/// `a · b` as `i64`: on ARMv6-M, which has no 32 × 32 → 64-bit multiply (an `i64` product is a
+/// call to `__aeabi_lmul` there), from four 32-bit multiplies of 16-bit halves, as
+/// `math::mul_wide` does for the rasterizer (here `const`, for [`Vec3::dot_bits`]); elsewhere
+/// the `i64` multiply. The same value either way (test `wide_is_the_i64_product`).
+#[inline]
+pub const fn wide(a: i32, b: i32) -> i64 {
+    if crate::math::NO_WIDE_MULTIPLY {
+        wide_in_halves(a, b)
+    } else {
+        a as i64 * b as i64
+    }
+}
+
+/// [`wide`] from 32-bit multiplies, on every target: with `a = ah·2^16 + al` (`ah` signed, `al`
+/// in `[0, 2^16)`) and `b` alike, `a·b = ah·bh·2^32 + (ah·bl + al·bh)·2^16 + al·bl`, each of the
+/// four products fitting 32 bits.
+#[inline]
+const fn wide_in_halves(a: i32, b: i32) -> i64 {
+    let (ah, al) = (a >> 16, a & 0xFFFF);
+    let (bh, bl) = (b >> 16, b & 0xFFFF);
+    let cross = (ah * bl) as i64 + (al * bh) as i64;
+    let low = (al as u32 * bl as u32) as i64;
+    (((ah * bh) as i64) << 32) + (cross << 16) + low
 }
 
 /// An I32F32 narrowed to I16F16, or `None` outside the I16F16 range.
@@ -460,6 +485,39 @@ mod tests {
         }
         v.extend([0, 1, 2, 3, u32::MAX, u32::MAX - 1, 1 << 31, (1 << 31) - 1]);
         v
+    }
+
+    #[test]
+    fn wide_is_the_i64_product() {
+        let mut rng = crate::test_rng::XorShift64::new(0xa54f_f53a_5f1d_36f1u64);
+        let mut next = || rng.next_u64();
+        let edges = [
+            0,
+            1,
+            -1,
+            0xFFFF,
+            0x1_0000,
+            -0x1_0000,
+            i32::MAX,
+            i32::MIN,
+            i32::MIN + 1,
+        ];
+        let pairs = (0..200_000)
+            .map(|_| {
+                (
+                    (next() as i32) >> (next() % 32),
+                    (next() as i32) >> (next() % 32),
+                )
+            })
+            .chain(
+                edges
+                    .iter()
+                    .flat_map(|a| edges.iter().map(move |b| (*a, *b))),
+            );
+        for (a, b) in pairs {
+            assert_eq!(wide_in_halves(a, b), a as i64 * b as i64, "{a} {b}");
+            assert_eq!(wide(a, b), a as i64 * b as i64, "{a} {b}");
+        }
     }
 
     #[test]
