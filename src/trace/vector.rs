@@ -184,6 +184,17 @@ pub const fn wide(a: i32, b: i32) -> i64 {
     }
 }
 
+/// `a · b` for a signed and an unsigned 32-bit factor, exactly `a as i64 * b as i64`, from four
+/// 32-bit multiplies of 16-bit halves (`a`'s high half signed; `al·bh` and `al·bl` unsigned):
+/// for ARMv6-M, where the `i64` multiply is a call (test `wide_is_the_i64_product`).
+#[inline]
+pub const fn wide_by_unsigned(a: i32, b: u32) -> i64 {
+    let (ah, al) = (a >> 16, (a & 0xFFFF) as u32);
+    let (bh, bl) = (b >> 16, b & 0xFFFF);
+    let cross = (ah * bl as i32) as i64 + (al * bh) as i64;
+    (((ah * bh as i32) as i64) << 32) + (cross << 16) + (al * bl) as i64
+}
+
 /// [`wide`] from 32-bit multiplies, on every target: with `a = ah·2^16 + al` (`ah` signed, `al`
 /// in `[0, 2^16)`) and `b` alike, `a·b = ah·bh·2^32 + (ah·bl + al·bh)·2^16 + al·bl`, each of the
 /// four products fitting 32 bits.
@@ -349,6 +360,13 @@ fn normalize_by(v: [i32; 3], len: i32) -> Option<[i32; 3]> {
         return None;
     }
     let inv = reciprocal46(len as u32);
+    if crate::math::NO_WIDE_MULTIPLY {
+        // ARMv6-M: a reciprocal below 2^32 (every length over 1/4) in 32-bit multiplies.
+        if let Ok(inv) = u32::try_from(inv) {
+            let c = |x: i32| (wide_by_unsigned(x, inv) >> 30) as i32;
+            return Some([c(v[0]), c(v[1]), c(v[2])]);
+        }
+    }
     let c = |x: i32| ((x as i64 * inv) >> 30) as i32;
     Some([c(v[0]), c(v[1]), c(v[2])])
 }
@@ -517,6 +535,8 @@ mod tests {
         for (a, b) in pairs {
             assert_eq!(wide_in_halves(a, b), a as i64 * b as i64, "{a} {b}");
             assert_eq!(wide(a, b), a as i64 * b as i64, "{a} {b}");
+            let u = b as u32;
+            assert_eq!(wide_by_unsigned(a, u), a as i64 * u as i64, "{a} {u}");
         }
     }
 
