@@ -250,7 +250,7 @@ const ROOT_SEEDS: [u16; 192] = {
 
 /// ⌊√v⌋ for a 32-bit integer without a division: for `v ≥ 2^30` (every radicand `sqrt` shifts
 /// down to 32 bits) the root of `v`'s top byte from a table of 192 entries (`ROOT_SEEDS`), at
-/// most 511 below ⌊√v⌋, then the nine low bits of the difference one at a time, keeping
+/// most 257 below ⌊√v⌋, then the nine low bits (up to 511) of the difference one at a time, keeping
 /// `rem = v − r²` (adding `d` is allowed when `(2r + d)·d ≤ rem`): nine steps instead of
 /// [`isqrt32_bitwise`]'s sixteen, which smaller `v` keep. Exact (tested against
 /// [`isqrt32_newton`], every 32-bit input once).
