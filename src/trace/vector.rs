@@ -560,7 +560,7 @@ mod tests {
         }
     }
 
-    /// Every 32-bit input, both roots (about a minute in a release build:
+    /// Every 32-bit input, both roots (about two minutes in a release build:
     /// `cargo test -p scanline3d --release --lib float_root_is_exact_everywhere -- --ignored`).
     #[test]
     #[ignore]
