@@ -9,7 +9,7 @@
 //! other primitives' quotients are 64-bit integer divisions of raw bits.
 
 use crate::trace::shape::{AaBox, Ellipsoid, Facet, Frustum, Plane, Shape, Sphere};
-use crate::trace::vector::{mul, narrow, narrow_bits, ratio16, sqrt, Vec3};
+use crate::trace::vector::{mul, narrow, narrow_bits, ratio16, sqrt, wide, Vec3};
 use fixed::types::{I16F16, I32F32};
 
 /// A ray: origin and unit direction.
@@ -51,7 +51,7 @@ fn sphere(s: &Sphere, ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16>
     // r · 2^-15). Each form is used where its error is the smaller, so rays leaving the
     // surface (|b| ≤ r) do not meet it again beyond EPSILON.
     let disc = if b.unsigned_abs() <= s.radius.unsigned_abs() {
-        b.wide_mul(b) - (oc.dot(oc) - s.radius2)
+        I32F32::from_bits(wide(b.to_bits(), b.to_bits())) - (oc.dot(oc) - s.radius2)
     } else {
         let q = oc.sub(ray.dir.scale(b));
         s.radius2 - q.dot(q)

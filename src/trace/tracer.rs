@@ -30,7 +30,7 @@ use crate::sink::{Row, RowPixel, RowSink};
 use crate::trace::intersect::{reflect, Ray};
 use crate::trace::row_shadow::{any_blocks, RowShadows, ShadowCandidate};
 use crate::trace::scene::{Colour, LightKind, Scene, TraceCamera, MAX_LIGHTS};
-use crate::trace::vector::{mul, narrow_bits, sqrt, Vec3};
+use crate::trace::vector::{mul, narrow_bits, sqrt, wide, Vec3};
 use embedded_graphics::pixelcolor::Rgb888;
 use fixed::types::{I16F16, I32F32};
 
@@ -394,7 +394,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         };
         let window = (
             mul(self.camera.near, len),
-            I16F16::from_bits(narrow_bits(self.camera.far.wide_mul(len).to_bits())),
+            I16F16::from_bits(narrow_bits(wide(self.camera.far.to_bits(), len.to_bits()))),
         );
         let mut sum = Colour::BLACK;
         let mut stack: heapless::Vec<Pending, STACK> = heapless::Vec::new();
@@ -686,8 +686,8 @@ pub fn refract(d: Vec3, n: Vec3, n1: I16F16, n2: I16F16) -> Option<Vec3> {
     let eta = ior_ratio(n1, n2)?;
     let cos_i = I16F16::from_bits(narrow_bits(-d.dot_bits(n)));
     // k = 1 − η²(1 − cos²θi): the squared cosine of the refracted angle.
-    let sin2_i = I32F32::ONE - cos_i.wide_mul(cos_i);
-    let eta2 = eta.wide_mul(eta);
+    let sin2_i = I32F32::ONE - I32F32::from_bits(wide(cos_i.to_bits(), cos_i.to_bits()));
+    let eta2 = I32F32::from_bits(wide(eta.to_bits(), eta.to_bits()));
     let k = I32F32::ONE
         - I32F32::from_bits(((eta2.to_bits() as i128 * sin2_i.to_bits() as i128) >> 32) as i64);
     if k < I32F32::ZERO {

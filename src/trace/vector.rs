@@ -101,9 +101,9 @@ impl Vec3 {
     #[inline]
     pub const fn dot_bits(self, o: Vec3) -> i64 {
         let (a, b) = (self.bits(), o.bits());
-        (a[0] as i64 * b[0] as i64)
-            .wrapping_add(a[1] as i64 * b[1] as i64)
-            .wrapping_add(a[2] as i64 * b[2] as i64)
+        wide(a[0], b[0])
+            .wrapping_add(wide(a[1], b[1]))
+            .wrapping_add(wide(a[2], b[2]))
     }
 
     /// `self · s` for a scalar `s`, each product narrowed to I16F16 (saturating: only reached
@@ -111,11 +111,11 @@ impl Vec3 {
     #[inline]
     pub fn scale(self, s: I16F16) -> Vec3 {
         let a = self.bits();
-        let s = s.to_bits() as i64;
+        let s = s.to_bits();
         Vec3::from_bits(
-            narrow_bits(a[0] as i64 * s),
-            narrow_bits(a[1] as i64 * s),
-            narrow_bits(a[2] as i64 * s),
+            narrow_bits(wide(a[0], s)),
+            narrow_bits(wide(a[1], s)),
+            narrow_bits(wide(a[2], s)),
         )
     }
 
@@ -168,7 +168,43 @@ pub const fn narrow_bits(v: i64) -> i32 {
 /// `a · b` for two I16F16 values, truncated, saturating outside the I16F16 range.
 #[inline]
 pub fn mul(a: I16F16, b: I16F16) -> I16F16 {
-    I16F16::from_bits(narrow_bits(a.wide_mul(b).to_bits()))
+    I16F16::from_bits(narrow_bits(wide(a.to_bits(), b.to_bits())))
+}
+
+/// `a · b` as `i64`: on ARMv6-M, which has no 32 × 32 → 64-bit multiply (an `i64` product is a
+/// call to `__aeabi_lmul` there), from four 32-bit multiplies of 16-bit halves, as
+/// `math::mul_wide` does for the rasterizer (here `const`, for [`Vec3::dot_bits`]); elsewhere
+/// the `i64` multiply. The same value either way (test `wide_is_the_i64_product`).
+#[inline]
+pub const fn wide(a: i32, b: i32) -> i64 {
+    if crate::math::NO_WIDE_MULTIPLY {
+        wide_in_halves(a, b)
+    } else {
+        a as i64 * b as i64
+    }
+}
+
+/// `a · b` for a signed and an unsigned 32-bit factor, exactly `a as i64 * b as i64`, from four
+/// 32-bit multiplies of 16-bit halves (`a`'s high half signed; `al·bh` and `al·bl` unsigned):
+/// for ARMv6-M, where the `i64` multiply is a call (test `wide_is_the_i64_product`).
+#[inline]
+pub const fn wide_by_unsigned(a: i32, b: u32) -> i64 {
+    let (ah, al) = (a >> 16, (a & 0xFFFF) as u32);
+    let (bh, bl) = (b >> 16, b & 0xFFFF);
+    let cross = (ah * bl as i32) as i64 + (al * bh) as i64;
+    (((ah * bh as i32) as i64) << 32) + (cross << 16) + (al * bl) as i64
+}
+
+/// [`wide`] from 32-bit multiplies, on every target: with `a = ah·2^16 + al` (`ah` signed, `al`
+/// in `[0, 2^16)`) and `b` alike, `a·b = ah·bh·2^32 + (ah·bl + al·bh)·2^16 + al·bl`, each of the
+/// four products fitting 32 bits.
+#[inline]
+const fn wide_in_halves(a: i32, b: i32) -> i64 {
+    let (ah, al) = (a >> 16, a & 0xFFFF);
+    let (bh, bl) = (b >> 16, b & 0xFFFF);
+    let cross = (ah * bl) as i64 + (al * bh) as i64;
+    let low = (al as u32 * bl as u32) as i64;
+    (((ah * bh) as i64) << 32) + (cross << 16) + low
 }
 
 /// An I32F32 narrowed to I16F16, or `None` outside the I16F16 range.
@@ -177,6 +213,101 @@ pub fn narrow(v: I32F32) -> Option<I16F16> {
     // In range exactly when bits 47 to 63 are all equal (see `narrow_bits`).
     let (bits, high) = (v.to_bits(), (v.to_bits() >> 32) as i32);
     (high >> 15 == high >> 31).then_some(I16F16::from_bits((bits >> 16) as i32))
+}
+
+/// Whether the tracer's square roots and reciprocals start from single-precision floating
+/// point: on Arm cores with a hardware FPU (the `eabihf` targets, Cortex-M4F and the like), where
+/// a conversion, multiply or divide of `f32` is one instruction. The integer corrections after the
+/// estimate make the results exactly those of the integer forms on every target.
+pub const FLOAT_ESTIMATES: bool = cfg!(all(target_arch = "arm", target_abi = "eabihf"));
+
+/// ⌊√v⌋ for a 32-bit integer, the tracer's: [`isqrt32_float`] where the core has an FPU
+/// ([`FLOAT_ESTIMATES`]), [`isqrt32_table`] on ARMv6-M (no divider), else [`isqrt32`]. The
+/// same bits every way.
+#[inline]
+pub const fn root32(v: u32) -> u32 {
+    if FLOAT_ESTIMATES {
+        isqrt32_float(v)
+    } else if cfg!(all(target_arch = "arm", not(target_has_atomic = "32"))) {
+        // ARMv6-M is the Arm profile without 32-bit atomics (and without a divider).
+        isqrt32_table(v)
+    } else {
+        isqrt32(v)
+    }
+}
+
+/// `⌊4096·√i⌋` for `i` in 64..256: the root of `i · 2^24`, a lower bound of the root of any
+/// `v` whose top byte is `i`, at most 257 below it (`4096·(√(i+1) − √i) + 1`, largest at 64).
+const ROOT_SEEDS: [u16; 192] = {
+    let mut t = [0u16; 192];
+    let mut j = 0;
+    while j < 192 {
+        t[j] = isqrt32_bitwise(((j as u32) + 64) << 24) as u16;
+        j += 1;
+    }
+    t
+};
+
+/// ⌊√v⌋ for a 32-bit integer without a division: for `v ≥ 2^30` (every radicand `sqrt` shifts
+/// down to 32 bits) the root of `v`'s top byte from a table of 192 entries (`ROOT_SEEDS`), at
+/// most 257 below ⌊√v⌋, then the nine low bits (up to 511) of the difference one at a time, keeping
+/// `rem = v − r²` (adding `d` is allowed when `(2r + d)·d ≤ rem`): nine steps instead of
+/// [`isqrt32_bitwise`]'s sixteen, which smaller `v` keep. Exact (tested against
+/// [`isqrt32_newton`], every 32-bit input once).
+#[inline]
+pub const fn isqrt32_table(v: u32) -> u32 {
+    if v < 1 << 30 {
+        return isqrt32_bitwise(v);
+    }
+    // v >> 24 is in 64..256.
+    let index = (v >> 24) as usize - 64;
+    if index >= ROOT_SEEDS.len() {
+        return isqrt32_bitwise(v);
+    }
+    let mut r = ROOT_SEEDS[index] as u32;
+    let mut rem = v - r * r;
+    let mut d = 256;
+    while d != 0 {
+        let step = (2 * r + d) * d;
+        if step <= rem {
+            rem -= step;
+            r += d;
+        }
+        d >>= 1;
+    }
+    r
+}
+
+/// ⌊√v⌋ for a 32-bit integer from a single-precision estimate: `1/√v` from the exponent-halving
+/// bit seed and two Newton steps `y ← y·(c − v/2·y²)` (the second with `c` a little below 3/2,
+/// so the estimate `v·y` stays under √v), truncated, then checked by its square: `r` is ⌊√v⌋
+/// when `r² ≤ v < (r + 1)²`, else `r + 1` is tried. The estimate is a fraction of a unit below
+/// √v (two Newton steps leave about 5·10^-6 relative, 0.3 at the largest root), so one of the
+/// two is the root; should neither be, [`isqrt32_newton`] gives it, so the result is ⌊√v⌋
+/// whatever the floating point does (tested against every 32-bit input,
+/// `float_root_is_exact_everywhere`). About 25 instructions with a hardware FPU (Cortex-M4F),
+/// no division.
+#[inline]
+pub const fn isqrt32_float(v: u32) -> u32 {
+    let f = v as f32;
+    let h = 0.5 * f;
+    let y = f32::from_bits(0x5f37_5a86_u32.wrapping_sub(f.to_bits() >> 1));
+    let y = y * (1.5 - h * y * y);
+    let y = y * (1.499_998_5 - h * y * y);
+    // ⌊√v⌋ ≤ 65535 for any 32-bit v.
+    let mut r = (f * y) as u32;
+    if r > 65_535 {
+        r = 65_535;
+    }
+    // r² ≤ v < (r + 1)² ⇔ v − r² ≤ 2r, the difference wrapping to a huge value when r² > v.
+    if v.wrapping_sub(r * r) <= 2 * r {
+        return r;
+    }
+    r += 1;
+    if r <= 65_535 && v.wrapping_sub(r * r) <= 2 * r {
+        return r;
+    }
+    isqrt32_newton(v)
 }
 
 /// √v for a non-negative I32F32, as an I16F16 (negative input gives 0).
@@ -194,13 +325,13 @@ pub const fn sqrt(v: I32F32) -> I16F16 {
     let high = (bits >> 32) as u32;
     if high == 0 {
         // Below 2^32: the exact root, below 2^16.
-        return I16F16::from_bits(isqrt32(bits as u32) as i32);
+        return I16F16::from_bits(root32(bits as u32) as i32);
     }
     // The smallest even shift that brings the radicand below 2^32 (2 to 32), from the high
     // word alone: its 32 − lz bits rounded up to even.
     let shift = (33 - high.leading_zeros()) & !1;
     // root < 2^16 and shift / 2 ≤ 16: the product stays below 2^32.
-    let root = isqrt32(((bits as u64) >> shift) as u32) << (shift / 2);
+    let root = root32(((bits as u64) >> shift) as u32) << (shift / 2);
     if root > i32::MAX as u32 {
         I16F16::MAX
     } else {
@@ -229,6 +360,13 @@ fn normalize_by(v: [i32; 3], len: i32) -> Option<[i32; 3]> {
         return None;
     }
     let inv = reciprocal46(len as u32);
+    if crate::math::NO_WIDE_MULTIPLY {
+        // ARMv6-M: a reciprocal below 2^32 (every length over 1/4) in 32-bit multiplies.
+        if let Ok(inv) = u32::try_from(inv) {
+            let c = |x: i32| (wide_by_unsigned(x, inv) >> 30) as i32;
+            return Some([c(v[0]), c(v[1]), c(v[2])]);
+        }
+    }
     let c = |x: i32| ((x as i64 * inv) >> 30) as i32;
     Some([c(v[0]), c(v[1]), c(v[2])])
 }
@@ -243,6 +381,11 @@ fn normalize_by(v: [i32; 3], len: i32) -> Option<[i32; 3]> {
 #[inline]
 pub fn reciprocal46(len: u32) -> i64 {
     if len > 1 << 14 {
+        if FLOAT_ESTIMATES {
+            if let Some(q) = reciprocal46_float(len) {
+                return q;
+            }
+        }
         // 2^46 = 2^14 · 2^32 with 2^14 < len: the quotient fits 32 bits.
         return i64::from(div_rem_below(1 << 14, 0, len).0);
     }
@@ -254,6 +397,24 @@ pub fn reciprocal46(len: u32) -> i64 {
     } else {
         r << (k - 17)
     }
+}
+
+/// ⌊2^46 / `len`⌋ for `len` above 2^14 from a single-precision estimate, or `None` where the
+/// estimate's remainder does not fit 32 bits (`len` near 2^30 and above, beyond the lengths the
+/// envelope gives). The quotient `2^46 / len` in `f32` is within 2^-23 of the exact one; taken
+/// down by more than its error (`q0 − q0/2^22 − 2`, below ⌊2^46 / len⌋), its remainder
+/// `2^46 − q0·len` is non-negative and at most about 3·2^23 + 4·len, and
+/// `q0 + ⌊remainder / len⌋` is the exact quotient: one 32-bit division instead of
+/// `math::div_rem_below`'s two digits. Exact whatever the estimate, since the remainder is checked.
+#[inline]
+pub fn reciprocal46_float(len: u32) -> Option<i64> {
+    const TWO_TO_46: f32 = (1u64 << 46) as f32;
+    let q = TWO_TO_46 / len as f32;
+    let q0 = q as u32;
+    let q0 = q0.wrapping_sub(q0 >> 22).wrapping_sub(2);
+    let rem = (1u64 << 46).wrapping_sub(u64::from(q0) * u64::from(len));
+    let rem = u32::try_from(rem).ok()?;
+    Some(i64::from(q0) + i64::from(rem.checked_div(len)?))
 }
 
 /// ⌊2^62 / `l`⌋ for `l` in [2^30, 2^31) (so at most 2^32), exact, without a 64-bit division:
@@ -315,6 +476,149 @@ pub fn ratio16(n: u64, d: u64) -> u64 {
 mod tests {
     use super::*;
     use std::vec::Vec;
+
+    /// Inputs for the square roots: random values of every length, 0, 1, every perfect square
+    /// and its neighbours at each power of 2 and near the top, and the maximum.
+    fn root_inputs() -> Vec<u32> {
+        let mut rng = crate::test_rng::XorShift64::new(0x3c6e_f372_fe94_f82bu64);
+        let mut next = || rng.next_u64();
+        let mut v: Vec<u32> = (0..300_000)
+            .map(|_| (next() >> 32) as u32 >> (next() % 32))
+            .collect();
+        let squares = (0..=65_535u32)
+            .step_by(97)
+            .chain(0..300)
+            .chain(65_000..=65_535)
+            .chain((0..16).map(|b| 1 << b));
+        for r in squares {
+            let s = r * r;
+            let above = s.wrapping_add(2 * r);
+            v.extend([
+                s,
+                s.wrapping_sub(1),
+                s.wrapping_add(1),
+                above,
+                above.wrapping_add(1),
+            ]);
+        }
+        v.extend([0, 1, 2, 3, u32::MAX, u32::MAX - 1, 1 << 31, (1 << 31) - 1]);
+        v
+    }
+
+    #[test]
+    fn wide_is_the_i64_product() {
+        let mut rng = crate::test_rng::XorShift64::new(0xa54f_f53a_5f1d_36f1u64);
+        let mut next = || rng.next_u64();
+        let edges = [
+            0,
+            1,
+            -1,
+            0xFFFF,
+            0x1_0000,
+            -0x1_0000,
+            i32::MAX,
+            i32::MIN,
+            i32::MIN + 1,
+        ];
+        let pairs = (0..200_000)
+            .map(|_| {
+                (
+                    (next() as i32) >> (next() % 32),
+                    (next() as i32) >> (next() % 32),
+                )
+            })
+            .chain(
+                edges
+                    .iter()
+                    .flat_map(|a| edges.iter().map(move |b| (*a, *b))),
+            );
+        for (a, b) in pairs {
+            assert_eq!(wide_in_halves(a, b), a as i64 * b as i64, "{a} {b}");
+            assert_eq!(wide(a, b), a as i64 * b as i64, "{a} {b}");
+            let u = b as u32;
+            assert_eq!(wide_by_unsigned(a, u), a as i64 * u as i64, "{a} {u}");
+        }
+    }
+
+    #[test]
+    fn table_root_is_the_integer_root() {
+        for v in root_inputs() {
+            assert_eq!(isqrt32_table(v), isqrt32_newton(v), "{v}");
+        }
+        // Each seed is the root of its byte's least value.
+        for (j, seed) in ROOT_SEEDS.iter().enumerate() {
+            let v = (j as u32 + 64) << 24;
+            assert_eq!(u32::from(*seed), isqrt32_newton(v), "{v}");
+        }
+    }
+
+    #[test]
+    fn float_root_is_the_integer_root() {
+        for v in root_inputs() {
+            assert_eq!(isqrt32_float(v), isqrt32_newton(v), "{v}");
+            assert_eq!(root32(v), isqrt32_newton(v), "{v}");
+        }
+    }
+
+    /// Every 32-bit input, both roots (about two minutes in a release build:
+    /// `cargo test -p scanline3d --release --lib float_root_is_exact_everywhere -- --ignored`).
+    #[test]
+    #[ignore]
+    fn float_root_is_exact_everywhere() {
+        let mut r = 0u32;
+        for v in 0..=u32::MAX {
+            // ⌊√v⌋ steps up by one at each square.
+            if u64::from(r + 1) * u64::from(r + 1) == u64::from(v) {
+                r += 1;
+            }
+            assert_eq!(isqrt32_float(v), r, "{v}");
+            assert_eq!(isqrt32_table(v), r, "{v}");
+        }
+    }
+
+    /// Every length from 2^14 + 1 to the envelope's largest (2^13·√3 units, below 2^30 raw)
+    /// takes the single-precision path, and its quotient is exact (about ten seconds in a
+    /// release build: `cargo test -p scanline3d --release --lib float_reciprocal_is_exact_everywhere
+    /// -- --ignored`).
+    #[test]
+    #[ignore]
+    fn float_reciprocal_is_exact_everywhere() {
+        for len in (1u32 << 14) + 1..(1 << 30) - (1 << 23) {
+            let exact = (1u64 << 46) / u64::from(len);
+            assert_eq!(reciprocal46_float(len), Some(exact as i64), "{len}");
+        }
+    }
+
+    #[test]
+    fn float_reciprocal_is_the_exact_quotient() {
+        let mut rng = crate::test_rng::XorShift64::new(0xbb67_ae85_84ca_a73bu64);
+        let mut next = || rng.next_u64();
+        let lens = (0..300_000)
+            .map(|_| ((next() >> 33) as u32 >> (next() % 17)).max((1 << 14) + 1))
+            .chain((1u32 << 14) + 1..1 << 17)
+            .chain((14..31).flat_map(|b| [(1u32 << b) - 1, 1 << b, (1 << b) + 1]))
+            .chain([
+                (1 << 31) - 1,
+                (1 << 31) - 2,
+                (1 << 30) - (1 << 23),
+                46_341,
+                65_535,
+            ]);
+        let mut fell_back = 0;
+        for len in lens.filter(|l| *l > 1 << 14) {
+            let exact = (1i64 << 46) / i64::from(len);
+            match reciprocal46_float(len) {
+                Some(q) => assert_eq!(q, exact, "{len}"),
+                None => {
+                    // Only lengths beyond the envelope's (2^13·√3 units < 2^30 raw).
+                    assert!(len > (1 << 30) - (1 << 23), "{len}");
+                    fell_back += 1;
+                }
+            }
+            assert_eq!(reciprocal46(len), exact, "{len}");
+        }
+        assert!(fell_back > 0);
+    }
 
     #[test]
     fn reciprocal46_is_within_its_bound() {
