@@ -407,6 +407,8 @@ pub struct PlaneSolver {
     area: i64,
     flip: bool,
     sub_bits: u32,
+    /// Every edge component below `2^(20 − S)` doubled units ([`PlaneSolver::plane_bounded`]).
+    short_edges: bool,
 }
 
 impl PlaneSolver {
@@ -423,6 +425,12 @@ impl PlaneSolver {
         let c = v[0].x.0 >> S;
         let r = v[0].y.0 >> S;
         let centre = |i: i32| ((2 * i as i64) + 1) << S;
+        let short_edges = S <= SHORT_EDGE_BITS
+            && (e1.0.unsigned_abs()
+                | e1.1.unsigned_abs()
+                | e2.0.unsigned_abs()
+                | e2.1.unsigned_abs())
+                < 1 << (SHORT_EDGE_BITS - S.min(SHORT_EDGE_BITS));
         Some(PlaneSolver {
             origin: PixelOrigin { c, r },
             to_ref: (centre(c) - p0.0, centre(r) - p0.1),
@@ -431,6 +439,7 @@ impl PlaneSolver {
             area: area.abs(),
             flip: area < 0,
             sub_bits: S,
+            short_edges,
         })
     }
 
@@ -478,6 +487,15 @@ impl PlaneSolver {
     /// numerators stay below 2^63.
     #[inline]
     fn plane_i64(&self, f0: i64, d1: i64, d2: i64, extra: u32) -> Option<Plane> {
+        if let Some(p) = self.plane_bounded(f0, d1, d2, extra) {
+            return Some(p);
+        }
+        self.plane_checked(f0, d1, d2, extra)
+    }
+
+    /// [`PlaneSolver::plane_i64`]'s checked steps, one by one.
+    #[inline]
+    fn plane_checked(&self, f0: i64, d1: i64, d2: i64, extra: u32) -> Option<Plane> {
         let mut num_x = cross_diff_i64(d1, self.e2.1, d2, self.e1.1)?;
         let mut num_y = cross_diff_i64(d2, self.e1.0, d1, self.e2.0)?;
         if self.flip {
@@ -497,6 +515,59 @@ impl PlaneSolver {
             value,
             dx: div.round_div(num_x.checked_mul(px)?)?,
             dy: div.round_div(num_y.checked_mul(px)?)?,
+        })
+    }
+
+    /// [`PlaneSolver::plane_checked`] without a check per step, for the triangle whose every
+    /// step is known to fit (`None` for any other): edges below `2^(20 − S)` doubled units
+    /// (`short_edges`: on a 240-pixel screen with 4 sub-pixel bits, every triangle that
+    /// reaches no further than about 2,000 pixels), value differences `|d1|, |d2| < 2^30`
+    /// (any two depths in `[0, 2^30]`), `|f0| < 2^32` and `extra <= 10`. The same operations
+    /// on the same values, wrapping instead of checked; none wraps, so the plane is the same
+    /// to the bit. Why, with `E = 2^(20 − S)`:
+    ///
+    /// * every factor of the cross products fits 31 bits, so `mul_wide` is exact and
+    ///   `|num| <= 2·(2^30 − 1)·(E − 1) < 2^(51 − S) − 2^31`;
+    /// * `num · 2^(S + 1 + extra) < 2^62 − 2^(S + 42)` (`extra <= 10`), so twice it plus the
+    ///   area (below `2·E² <= 2^41`) fits `i64`;
+    /// * the offsets to the reference centre are at most `2^S` (`|t| <= 2^S`), so the value's
+    ///   numerator `(num_x·t_x + num_y·t_y) · 2^extra` is no larger than the gradients';
+    /// * `f0 · 2^extra < 2^42`, plus a quotient below `2^62`, fits.
+    ///
+    /// This is [`depth_planes_fit_i64`]'s argument, tested per triangle instead of bounded
+    /// for a build. Test `bounded_plane_equals_checked_plane`.
+    #[inline]
+    fn plane_bounded(&self, f0: i64, d1: i64, d2: i64, extra: u32) -> Option<Plane> {
+        const D: u64 = 1 << 30;
+        if !(self.short_edges
+            && extra <= DEPTH_PLANE_EXTRA_BITS
+            && d1.unsigned_abs() < D
+            && d2.unsigned_abs() < D
+            && f0.unsigned_abs() < 1 << 32)
+        {
+            return None;
+        }
+        // Factors below 2^30 (the values) and 2^20 (the edges): exact 32 x 32 -> 64 products.
+        let cross = |a: i64, b: i64, c: i64, d: i64| {
+            mul_wide(a as i32, b as i32).wrapping_sub(mul_wide(c as i32, d as i32))
+        };
+        let mut num_x = cross(d1, self.e2.1, d2, self.e1.1);
+        let mut num_y = cross(d2, self.e1.0, d1, self.e2.0);
+        if self.flip {
+            num_x = num_x.wrapping_neg();
+            num_y = num_y.wrapping_neg();
+        }
+        let div = RoundDivisor::new(self.area);
+        let px = self.sub_bits + 1 + extra;
+        // |to_ref| <= 2^S: products by an i32.
+        let to_ref = mul_i64_i32(num_x, self.to_ref.0 as i32)
+            .wrapping_add(mul_i64_i32(num_y, self.to_ref.1 as i32));
+        Some(Plane {
+            value: f0
+                .wrapping_shl(extra)
+                .wrapping_add(div.round_div_bounded(to_ref.wrapping_shl(extra))),
+            dx: div.round_div_bounded(num_x.wrapping_shl(px)),
+            dy: div.round_div_bounded(num_y.wrapping_shl(px)),
         })
     }
 }
@@ -530,6 +601,17 @@ impl RoundDivisor {
         match self.by {
             Some(by) => Some(by.floor_div(n.checked_mul(2)?.checked_add(self.d)?)),
             None => round_div_i64(n, self.d),
+        }
+    }
+
+    /// [`RoundDivisor::round_div`] for `|2·n| + d < 2^63` (then nothing is checked: nothing
+    /// overflows, and the quotient is the same).
+    #[inline(always)]
+    fn round_div_bounded(&self, n: i64) -> i64 {
+        let num = n.wrapping_mul(2).wrapping_add(self.d);
+        match self.by {
+            Some(by) => by.floor_div(num),
+            None => floor_div_i64(num, self.d.wrapping_mul(2)),
         }
     }
 }
@@ -616,6 +698,9 @@ pub struct DepthPlane {
 
 /// Extra fractional bits of the depth plane over [`Depth`].
 const DEPTH_PLANE_EXTRA_BITS: u32 = 10;
+
+/// `S +` the bits of an edge (doubled units) that [`PlaneSolver::plane_bounded`] takes.
+const SHORT_EDGE_BITS: u32 = 20;
 
 impl DepthPlane {
     /// Depth plane of triangle `v`; `None` for zero area.
@@ -1078,6 +1163,77 @@ mod tests {
         }
         // Both paths were taken.
         assert!(fast > 1000 && fast < 39_000, "{fast}");
+    }
+
+    /// `plane_bounded` takes every triangle and value it may, and gives `plane_checked`'s
+    /// plane for each: edges up to its limit (and just past it), values up to `2^32` apart
+    /// from `f0` and differences up to `2^30` (and just past both), both signs of the area.
+    #[test]
+    fn bounded_plane_equals_checked_plane() {
+        fn run<const S: u32>(cases: u32, seed: u64) -> (u32, u32) {
+            let mut rng = crate::test_rng::XorShift64::new(seed);
+            let mut next = move || rng.next_u64();
+            let (mut bounded, mut refused) = (0, 0);
+            // Half an edge limit, in sub-pixels (doubled units are twice them).
+            let half = 1i64 << (SHORT_EDGE_BITS - S - 1);
+            for i in 0..cases {
+                // Edges from a pixel to just past the limit.
+                let reach = match i % 4 {
+                    0 => half + 2,
+                    1 => half,
+                    _ => {
+                        1i64 << (S
+                            + (next() % u64::from(SHORT_EDGE_BITS - 2 * S.min(8)).max(1)) as u32)
+                    }
+                };
+                let base = (next() % (1 << 20)) as i64 - (1 << 19);
+                let mut coord = || base + (next() % (reach as u64 + 1)) as i64 - reach / 2;
+                let v: [ScreenVertex<S>; 3] = core::array::from_fn(|_| ScreenVertex {
+                    x: crate::project::SubPx(coord() as i32),
+                    y: crate::project::SubPx(coord() as i32),
+                    q: Depth::ZERO,
+                    color: [I16F16::ZERO; 3],
+                });
+                let Some(s) = PlaneSolver::new(&v) else {
+                    continue;
+                };
+                let value = |r: u64, bits: u32| (r >> (64 - bits)) as i64 - (1i64 << (bits - 1));
+                let f0 = match i % 3 {
+                    0 => value(next(), 33),
+                    1 => (1 << 32) - 1 - (next() % 2) as i64,
+                    _ => value(next(), 31),
+                };
+                let mut diff = || match next() % 4 {
+                    0 => (1 << 30) - 1 + (next() % 2) as i64,
+                    1 => -(1 << 30) + (next() % 2) as i64,
+                    _ => value(next(), 31),
+                };
+                let (d1, d2) = (diff(), diff());
+                for extra in [0, 5, DEPTH_PLANE_EXTRA_BITS, DEPTH_PLANE_EXTRA_BITS + 1] {
+                    match s.plane_bounded(f0, d1, d2, extra) {
+                        Some(p) => {
+                            bounded += 1;
+                            assert!(s.short_edges && extra <= DEPTH_PLANE_EXTRA_BITS);
+                            assert!(d1.abs() < 1 << 30 && d2.abs() < 1 << 30 && f0.abs() < 1 << 32);
+                            assert_eq!(
+                                Some(p),
+                                s.plane_checked(f0, d1, d2, extra),
+                                "{v:?} {f0} {d1} {d2} {extra}"
+                            );
+                        }
+                        None => refused += 1,
+                    }
+                }
+            }
+            (bounded, refused)
+        }
+        for (bounded, refused) in [
+            run::<0>(30_000, 0x9E37_79B9_7F4A_7C15),
+            run::<4>(60_000, 0xD1B5_4A32_D192_ED03),
+            run::<8>(30_000, 0x8CB9_2BA7_2F3D_8DD7),
+        ] {
+            assert!(bounded > 10_000 && refused > 10_000, "{bounded} {refused}");
+        }
     }
 
     /// Depth planes of triangles inside the clip planes of a screen for which
