@@ -743,7 +743,7 @@ impl DepthPlane {
         }
     }
 
-    /// [`DepthPlane::new`] from the 64-bit solver alone ([`PlaneSolver::plane_i64`]), for a
+    /// [`DepthPlane::new`] from the 64-bit solver alone ([`PlaneSolver::plane_bounded`]), for a
     /// triangle whose three vertices are inside every clip plane and were projected with the
     /// exact division, on a screen for which [`depth_planes_fit_i64`] holds: there the 64-bit
     /// solver never gives up (proof at [`depth_planes_fit_i64`]), so this is the same plane
@@ -752,8 +752,10 @@ impl DepthPlane {
     #[inline]
     pub(crate) fn new_i64<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> Self {
         let f = v.each_ref().map(|s| s.q.to_bits() as i64);
+        // Edges below `16·max(W, H)·2^S + 2 < 2^(20−S)` and depths in `[1, 2^30]`: the
+        // bounded solver's premise, so its checked steps stay out of the build.
         let q = solver
-            .plane_i64(f[0], f[1] - f[0], f[2] - f[0], DEPTH_PLANE_EXTRA_BITS)
+            .plane_bounded(f[0], f[1] - f[0], f[2] - f[0], DEPTH_PLANE_EXTRA_BITS)
             .unwrap_or_else(|| {
                 debug_assert!(
                     false,
@@ -1331,6 +1333,9 @@ mod tests {
             let f = v.each_ref().map(|s| s.q.to_bits() as i64);
             let fast = s.plane_i64(f[0], f[1] - f[0], f[2] - f[0], DEPTH_PLANE_EXTRA_BITS);
             assert_eq!(fast, Some(s.plane(f, DEPTH_PLANE_EXTRA_BITS)), "{v:?}");
+            // `new_i64` takes the bounded solver: its premise holds here.
+            let bounded = s.plane_bounded(f[0], f[1] - f[0], f[2] - f[0], DEPTH_PLANE_EXTRA_BITS);
+            assert_eq!(bounded, fast, "{v:?}");
             let (a, b) = (DepthPlane::new_i64(&s, v), DepthPlane::new(&s, v));
             assert_eq!((a.origin, a.q), (b.origin, b.q));
             true
