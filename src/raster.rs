@@ -32,7 +32,6 @@ use crate::math::{
     NO_WIDE_MULTIPLY,
 };
 use crate::project::ScreenVertex;
-use core::cmp::Ordering;
 use fixed::types::I16F16;
 
 /// First row (or column) whose centre lies at or after position `p` (doubled units, S bits):
@@ -231,25 +230,47 @@ impl TriangleWalk {
     /// first row at or below `min_row`, stopping before `max_row`. `None` if it covers no row
     /// there or has zero area.
     pub fn new<const S: u32>(v: [(i32, i32); 3], min_row: i32, max_row: i32) -> Option<Self> {
+        let cross = (v[1].0 as i64 - v[0].0 as i64) * (v[2].1 as i64 - v[0].1 as i64)
+            - (v[2].0 as i64 - v[0].0 as i64) * (v[1].1 as i64 - v[0].1 as i64);
+        if cross == 0 {
+            return None;
+        }
+        Self::oriented::<S>(v, cross < 0, min_row, max_row)
+    }
+
+    /// [`TriangleWalk::new`] for a triangle of non-zero area whose signed area
+    /// `(v1 − v0) × (v2 − v0)` (x right, y down) is known to be negative (`negative`) or
+    /// positive, as [`PlaneSolver`] finds it: the walk takes its orientation from that sign and
+    /// the order its sort puts the vertices in, instead of a cross product of its own. The same
+    /// walk (test `oriented_walk_equals_new`).
+    #[inline]
+    pub fn oriented<const S: u32>(
+        v: [(i32, i32); 3],
+        negative: bool,
+        min_row: i32,
+        max_row: i32,
+    ) -> Option<Self> {
         let mut o = v;
-        // Sort by y (stable three-element network).
+        // Sort by y (stable three-element network), counting the swaps: an odd permutation
+        // flips the sign of the area.
+        let mut odd = false;
         if o[1].1 < o[0].1 {
             o.swap(0, 1);
+            odd = !odd;
         }
         if o[2].1 < o[1].1 {
             o.swap(1, 2);
+            odd = !odd;
         }
         if o[1].1 < o[0].1 {
             o.swap(0, 1);
+            odd = !odd;
         }
         let [top, mid, bottom] = o;
-        let cross = (bottom.0 as i64 - top.0 as i64) * (mid.1 as i64 - top.1 as i64)
-            - (bottom.1 as i64 - top.1 as i64) * (mid.0 as i64 - top.0 as i64);
-        let long_is_left = match cross.cmp(&0) {
-            Ordering::Less => true,
-            Ordering::Greater => false,
-            Ordering::Equal => return None,
-        };
+        // The long edge (top to bottom) is on the left when `(bottom − top) × (mid − top)`, which
+        // is `−(mid − top) × (bottom − top)`, is negative: when the sorted order's area is
+        // positive, the original's with the permutation's sign.
+        let long_is_left = negative == odd;
         let row_of = |y: i32| first_centre_at_or_after::<S>(2 * y as i64);
         let r0 = row_of(top.1).max(min_row as i64);
         let r1 = row_of(mid.1);
@@ -407,6 +428,8 @@ pub struct PlaneSolver {
     area: i64,
     flip: bool,
     sub_bits: u32,
+    /// Every edge component below `2^(20 − S)` doubled units ([`PlaneSolver::plane_bounded`]).
+    short_edges: bool,
 }
 
 impl PlaneSolver {
@@ -423,6 +446,12 @@ impl PlaneSolver {
         let c = v[0].x.0 >> S;
         let r = v[0].y.0 >> S;
         let centre = |i: i32| ((2 * i as i64) + 1) << S;
+        let short_edges = S <= SHORT_EDGE_BITS
+            && (e1.0.unsigned_abs()
+                | e1.1.unsigned_abs()
+                | e2.0.unsigned_abs()
+                | e2.1.unsigned_abs())
+                < 1 << (SHORT_EDGE_BITS - S.min(SHORT_EDGE_BITS));
         Some(PlaneSolver {
             origin: PixelOrigin { c, r },
             to_ref: (centre(c) - p0.0, centre(r) - p0.1),
@@ -431,12 +460,20 @@ impl PlaneSolver {
             area: area.abs(),
             flip: area < 0,
             sub_bits: S,
+            short_edges,
         })
     }
 
     /// The reference pixel of the planes this solver produces.
     pub fn origin(&self) -> PixelOrigin {
         self.origin
+    }
+
+    /// Whether the triangle's signed area `(v1 − v0) × (v2 − v0)` (x right, y down) is
+    /// negative (a front face), for [`TriangleWalk::oriented`].
+    #[inline]
+    pub fn negative(&self) -> bool {
+        self.flip
     }
 
     /// Solves the plane through values `f` at the three vertices (raw bits of any format below
@@ -478,6 +515,15 @@ impl PlaneSolver {
     /// numerators stay below 2^63.
     #[inline]
     fn plane_i64(&self, f0: i64, d1: i64, d2: i64, extra: u32) -> Option<Plane> {
+        if let Some(p) = self.plane_bounded(f0, d1, d2, extra) {
+            return Some(p);
+        }
+        self.plane_checked(f0, d1, d2, extra)
+    }
+
+    /// [`PlaneSolver::plane_i64`]'s checked steps, one by one.
+    #[inline]
+    fn plane_checked(&self, f0: i64, d1: i64, d2: i64, extra: u32) -> Option<Plane> {
         let mut num_x = cross_diff_i64(d1, self.e2.1, d2, self.e1.1)?;
         let mut num_y = cross_diff_i64(d2, self.e1.0, d1, self.e2.0)?;
         if self.flip {
@@ -497,6 +543,59 @@ impl PlaneSolver {
             value,
             dx: div.round_div(num_x.checked_mul(px)?)?,
             dy: div.round_div(num_y.checked_mul(px)?)?,
+        })
+    }
+
+    /// [`PlaneSolver::plane_checked`] without a check per step, for the triangle whose every
+    /// step is known to fit (`None` for any other): edges below `2^(20 − S)` doubled units
+    /// (`short_edges`: on a 240-pixel screen with 4 sub-pixel bits, every triangle that
+    /// reaches no further than about 2,000 pixels), value differences `|d1|, |d2| < 2^30`
+    /// (any two depths in `[0, 2^30]`), `|f0| < 2^32` and `extra <= 10`. The same operations
+    /// on the same values, wrapping instead of checked; none wraps, so the plane is the same
+    /// to the bit. Why, with `E = 2^(20 − S)`:
+    ///
+    /// * every factor of the cross products fits 31 bits, so `mul_wide` is exact and
+    ///   `|num| <= 2·(2^30 − 1)·(E − 1) < 2^(51 − S) − 2^31`;
+    /// * `num · 2^(S + 1 + extra) < 2^62 − 2^(S + 42)` (`extra <= 10`), so twice it plus the
+    ///   area (below `2·E² <= 2^41`) fits `i64`;
+    /// * the offsets to the reference centre are at most `2^S` (`|t| <= 2^S`), so the value's
+    ///   numerator `(num_x·t_x + num_y·t_y) · 2^extra` is no larger than the gradients';
+    /// * `f0 · 2^extra < 2^42`, plus a quotient below `2^62`, fits.
+    ///
+    /// This is [`depth_planes_fit_i64`]'s argument, tested per triangle instead of bounded
+    /// for a build. Test `bounded_plane_equals_checked_plane`.
+    #[inline]
+    fn plane_bounded(&self, f0: i64, d1: i64, d2: i64, extra: u32) -> Option<Plane> {
+        const D: u64 = 1 << 30;
+        if !(self.short_edges
+            && extra <= DEPTH_PLANE_EXTRA_BITS
+            && d1.unsigned_abs() < D
+            && d2.unsigned_abs() < D
+            && f0.unsigned_abs() < 1 << 32)
+        {
+            return None;
+        }
+        // Factors below 2^30 (the values) and 2^20 (the edges): exact 32 x 32 -> 64 products.
+        let cross = |a: i64, b: i64, c: i64, d: i64| {
+            mul_wide(a as i32, b as i32).wrapping_sub(mul_wide(c as i32, d as i32))
+        };
+        let mut num_x = cross(d1, self.e2.1, d2, self.e1.1);
+        let mut num_y = cross(d2, self.e1.0, d1, self.e2.0);
+        if self.flip {
+            num_x = num_x.wrapping_neg();
+            num_y = num_y.wrapping_neg();
+        }
+        let div = RoundDivisor::new(self.area);
+        let px = self.sub_bits + 1 + extra;
+        // |to_ref| <= 2^S: products by an i32.
+        let to_ref = mul_i64_i32(num_x, self.to_ref.0 as i32)
+            .wrapping_add(mul_i64_i32(num_y, self.to_ref.1 as i32));
+        Some(Plane {
+            value: f0
+                .wrapping_shl(extra)
+                .wrapping_add(div.round_div_bounded(to_ref.wrapping_shl(extra))),
+            dx: div.round_div_bounded(num_x.wrapping_shl(px)),
+            dy: div.round_div_bounded(num_y.wrapping_shl(px)),
         })
     }
 }
@@ -530,6 +629,17 @@ impl RoundDivisor {
         match self.by {
             Some(by) => Some(by.floor_div(n.checked_mul(2)?.checked_add(self.d)?)),
             None => round_div_i64(n, self.d),
+        }
+    }
+
+    /// [`RoundDivisor::round_div`] for `|2·n| + d < 2^63` (then nothing is checked: nothing
+    /// overflows, and the quotient is the same).
+    #[inline(always)]
+    fn round_div_bounded(&self, n: i64) -> i64 {
+        let num = n.wrapping_mul(2).wrapping_add(self.d);
+        match self.by {
+            Some(by) => by.floor_div(num),
+            None => floor_div_i64(num, self.d.wrapping_mul(2)),
         }
     }
 }
@@ -617,6 +727,9 @@ pub struct DepthPlane {
 /// Extra fractional bits of the depth plane over [`Depth`].
 const DEPTH_PLANE_EXTRA_BITS: u32 = 10;
 
+/// `S +` the bits of an edge (doubled units) that [`PlaneSolver::plane_bounded`] takes.
+const SHORT_EDGE_BITS: u32 = 20;
+
 impl DepthPlane {
     /// Depth plane of triangle `v`; `None` for zero area.
     pub fn new<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> Self {
@@ -630,7 +743,7 @@ impl DepthPlane {
         }
     }
 
-    /// [`DepthPlane::new`] from the 64-bit solver alone ([`PlaneSolver::plane_i64`]), for a
+    /// [`DepthPlane::new`] from the 64-bit solver alone ([`PlaneSolver::plane_bounded`]), for a
     /// triangle whose three vertices are inside every clip plane and were projected with the
     /// exact division, on a screen for which [`depth_planes_fit_i64`] holds: there the 64-bit
     /// solver never gives up (proof at [`depth_planes_fit_i64`]), so this is the same plane
@@ -639,8 +752,10 @@ impl DepthPlane {
     #[inline]
     pub(crate) fn new_i64<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> Self {
         let f = v.each_ref().map(|s| s.q.to_bits() as i64);
+        // Edges below `16·max(W, H)·2^S + 2 < 2^(20−S)` and depths in `[1, 2^30]`: the
+        // bounded solver's premise, so its checked steps stay out of the build.
         let q = solver
-            .plane_i64(f[0], f[1] - f[0], f[2] - f[0], DEPTH_PLANE_EXTRA_BITS)
+            .plane_bounded(f[0], f[1] - f[0], f[2] - f[0], DEPTH_PLANE_EXTRA_BITS)
             .unwrap_or_else(|| {
                 debug_assert!(
                     false,
@@ -1080,6 +1195,126 @@ mod tests {
         assert!(fast > 1000 && fast < 39_000, "{fast}");
     }
 
+    /// The walk oriented by the solver's sign is `TriangleWalk::new`'s: random triangles from a
+    /// pixel to the guard band, every vertex order (both windings, ties in y), walked to the
+    /// end and compared row by row.
+    #[test]
+    fn oriented_walk_equals_new() {
+        let mut rng = crate::test_rng::XorShift64::new(0x3C6E_F372_FE94_F82B);
+        let mut next = move || rng.next_u64();
+        let mut walked = 0;
+        for i in 0..40_000 {
+            let span = 1i64 << (3 + next() % 12);
+            let mut coord = || ((next() % (2 * span as u64)) as i64 - span / 2) as i32;
+            let mut v = [(coord(), coord()), (coord(), coord()), (coord(), coord())];
+            if i % 4 == 0 {
+                v[1].1 = v[0].1; // a horizontal edge
+            }
+            let sv: [ScreenVertex<4>; 3] = v.map(|(x, y)| ScreenVertex {
+                x: crate::project::SubPx(x),
+                y: crate::project::SubPx(y),
+                q: Depth::ZERO,
+                color: [I16F16::ZERO; 3],
+            });
+            let solver = PlaneSolver::new(&sv);
+            let min_row = (next() % 8) as i32;
+            let a = TriangleWalk::new::<4>(v, min_row, 300);
+            let b = solver.and_then(|s| TriangleWalk::oriented::<4>(v, s.negative(), min_row, 300));
+            assert_eq!(a.is_some(), b.is_some(), "{v:?}");
+            let (Some(mut a), Some(mut b)) = (a, b) else {
+                continue;
+            };
+            // The orientation as the walk found it before: the cross product of its sorted
+            // vertices.
+            let mut o = v;
+            o.sort_by_key(|p| p.1);
+            let [t, m, b_] = o.map(|(x, y)| (x as i64, y as i64));
+            let cross = (b_.0 - t.0) * (m.1 - t.1) - (b_.1 - t.1) * (m.0 - t.0);
+            assert_eq!(b.long_is_left, cross < 0, "{v:?}");
+            walked += 1;
+            loop {
+                assert_eq!((a.row(), a.span()), (b.row(), b.span()), "{v:?}");
+                let (more_a, more_b) = (a.advance::<4>(), b.advance::<4>());
+                assert_eq!(more_a, more_b, "{v:?}");
+                if !more_a {
+                    break;
+                }
+            }
+        }
+        assert!(walked > 10_000, "{walked}");
+    }
+
+    /// `plane_bounded` takes every triangle and value it may, and gives `plane_checked`'s
+    /// plane for each: edges up to its limit (and just past it), values up to `2^32` apart
+    /// from `f0` and differences up to `2^30` (and just past both), both signs of the area.
+    #[test]
+    fn bounded_plane_equals_checked_plane() {
+        fn run<const S: u32>(cases: u32, seed: u64) -> (u32, u32) {
+            let mut rng = crate::test_rng::XorShift64::new(seed);
+            let mut next = move || rng.next_u64();
+            let (mut bounded, mut refused) = (0, 0);
+            // Half an edge limit, in sub-pixels (doubled units are twice them).
+            let half = 1i64 << (SHORT_EDGE_BITS - S - 1);
+            for i in 0..cases {
+                // Edges from a pixel to just past the limit.
+                let reach = match i % 4 {
+                    0 => half + 2,
+                    1 => half,
+                    _ => {
+                        1i64 << (S
+                            + (next() % u64::from(SHORT_EDGE_BITS - 2 * S.min(8)).max(1)) as u32)
+                    }
+                };
+                let base = (next() % (1 << 20)) as i64 - (1 << 19);
+                let mut coord = || base + (next() % (reach as u64 + 1)) as i64 - reach / 2;
+                let v: [ScreenVertex<S>; 3] = core::array::from_fn(|_| ScreenVertex {
+                    x: crate::project::SubPx(coord() as i32),
+                    y: crate::project::SubPx(coord() as i32),
+                    q: Depth::ZERO,
+                    color: [I16F16::ZERO; 3],
+                });
+                let Some(s) = PlaneSolver::new(&v) else {
+                    continue;
+                };
+                let value = |r: u64, bits: u32| (r >> (64 - bits)) as i64 - (1i64 << (bits - 1));
+                let f0 = match i % 3 {
+                    0 => value(next(), 33),
+                    1 => (1 << 32) - 1 - (next() % 2) as i64,
+                    _ => value(next(), 31),
+                };
+                let mut diff = || match next() % 4 {
+                    0 => (1 << 30) - 1 + (next() % 2) as i64,
+                    1 => -(1 << 30) + (next() % 2) as i64,
+                    _ => value(next(), 31),
+                };
+                let (d1, d2) = (diff(), diff());
+                for extra in [0, 5, DEPTH_PLANE_EXTRA_BITS, DEPTH_PLANE_EXTRA_BITS + 1] {
+                    match s.plane_bounded(f0, d1, d2, extra) {
+                        Some(p) => {
+                            bounded += 1;
+                            assert!(s.short_edges && extra <= DEPTH_PLANE_EXTRA_BITS);
+                            assert!(d1.abs() < 1 << 30 && d2.abs() < 1 << 30 && f0.abs() < 1 << 32);
+                            assert_eq!(
+                                Some(p),
+                                s.plane_checked(f0, d1, d2, extra),
+                                "{v:?} {f0} {d1} {d2} {extra}"
+                            );
+                        }
+                        None => refused += 1,
+                    }
+                }
+            }
+            (bounded, refused)
+        }
+        for (bounded, refused) in [
+            run::<0>(30_000, 0x9E37_79B9_7F4A_7C15),
+            run::<4>(60_000, 0xD1B5_4A32_D192_ED03),
+            run::<8>(30_000, 0x8CB9_2BA7_2F3D_8DD7),
+        ] {
+            assert!(bounded > 10_000 && refused > 10_000, "{bounded} {refused}");
+        }
+    }
+
     /// Depth planes of triangles inside the clip planes of a screen for which
     /// `depth_planes_fit_i64` holds solve in 64 bits, and `DepthPlane::new_i64` gives
     /// `DepthPlane::new`'s plane: vertices at the corners and edges of the guard band with the
@@ -1098,6 +1333,9 @@ mod tests {
             let f = v.each_ref().map(|s| s.q.to_bits() as i64);
             let fast = s.plane_i64(f[0], f[1] - f[0], f[2] - f[0], DEPTH_PLANE_EXTRA_BITS);
             assert_eq!(fast, Some(s.plane(f, DEPTH_PLANE_EXTRA_BITS)), "{v:?}");
+            // `new_i64` takes the bounded solver: its premise holds here.
+            let bounded = s.plane_bounded(f[0], f[1] - f[0], f[2] - f[0], DEPTH_PLANE_EXTRA_BITS);
+            assert_eq!(bounded, fast, "{v:?}");
             let (a, b) = (DepthPlane::new_i64(&s, v), DepthPlane::new(&s, v));
             assert_eq!((a.origin, a.q), (b.origin, b.q));
             true

@@ -1020,10 +1020,12 @@ pub(crate) fn walk_rows<
             // Activate this row's pieces.
             {
                 pieces.each_row_piece::<S>(row, |s, face, id, key| {
-                    let (Some(walk), Some(solver)) = (
-                        TriangleWalk::new::<SUB>(s.each_ref().map(xy), y, height as i32),
-                        PlaneSolver::new(s),
-                    ) else {
+                    let solver = PlaneSolver::new(s);
+                    let walk = solver.and_then(|solver| {
+                        let v = s.each_ref().map(xy);
+                        TriangleWalk::oriented::<SUB>(v, solver.negative(), y, height as i32)
+                    });
+                    let (Some(walk), Some(solver)) = (walk, solver) else {
                         // Pieces have screen area and rows from this one on (their bucket is
                         // their first row, or the first of their triangle's pieces).
                         debug_assert!(false, "internal error: piece of {id} not walkable");
