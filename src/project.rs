@@ -159,7 +159,7 @@ impl<const S: u32> Viewport<S> {
     /// `>= 0` inside. Near/far are in I16F16 bits; the guard planes in sub-pixels × w bits.
     ///
     /// The guard half-widths (below 2^21) and `w` fit `i32`, so `guard · w` is a 32 × 32 →
-    /// 64-bit [`mul_wide`]: on cores without a wide multiply (thumbv6m) four 32-bit
+    /// 64-bit `mul_wide`: on cores without a wide multiply (thumbv6m) four 32-bit
     /// multiplies instead of a call of the 64-bit one, elsewhere the same `i64` product. Test
     /// `clip_distances_equal_the_64_bit_products`.
     #[inline]
