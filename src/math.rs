@@ -125,6 +125,54 @@ pub(crate) fn mul_i64_i32(a: i64, b: i32) -> i64 {
     }
 }
 
+/// The low word of `v >> s` (arithmetic, `s < 64`), as `(v >> s) as i32`: on cores without a
+/// wide multiply ([`NO_WIDE_MULTIPLY`], whose 64-bit shifts by a variable amount are calls)
+/// from the two 32-bit words of `v`, elsewhere the 64-bit shift. The same bits either way (test
+/// `shifts_in_words_are_exact`).
+#[inline]
+pub(crate) fn shr_low_word(v: i64, s: u32) -> i32 {
+    if NO_WIDE_MULTIPLY {
+        shr_low_word_in_words(v, s)
+    } else {
+        (v >> (s & 63)) as i32
+    }
+}
+
+/// [`shr_low_word`] in 32-bit shifts, on every target (tested on the host too).
+#[inline]
+fn shr_low_word_in_words(v: i64, s: u32) -> i32 {
+    let (hi, lo) = ((v >> 32) as i32, v as u32);
+    let s = s & 63;
+    if s >= 32 {
+        hi >> (s - 32)
+    } else if s == 0 {
+        lo as i32
+    } else {
+        (lo >> s | (hi as u32) << (32 - s)) as i32
+    }
+}
+
+/// `v >> s` (arithmetic, `s < 64`): on cores without a wide multiply ([`NO_WIDE_MULTIPLY`])
+/// from the two 32-bit words of `v`, elsewhere the 64-bit shift. The same value either way
+/// (test `shifts_in_words_are_exact`).
+#[inline]
+pub(crate) fn shr_i64(v: i64, s: u32) -> i64 {
+    if NO_WIDE_MULTIPLY {
+        shr_i64_in_words(v, s)
+    } else {
+        v >> (s & 63)
+    }
+}
+
+/// [`shr_i64`] in 32-bit shifts, on every target (tested on the host too).
+#[inline]
+fn shr_i64_in_words(v: i64, s: u32) -> i64 {
+    let s = s & 63;
+    let hi = (v >> 32) as i32;
+    let hi = if s >= 32 { hi >> 31 } else { hi >> s };
+    ((hi as i64) << 32) | shr_low_word_in_words(v, s) as u32 as i64
+}
+
 /// `(a · b) mod 2^64` for `0 <= b < 2^16`, as `a.wrapping_mul(b as i64)`: on cores without a
 /// wide multiply ([`NO_WIDE_MULTIPLY`]) from three 32-bit multiplies (`a`'s low word in two
 /// 16-bit halves and its high word, each times `b`, whose products fit 32 bits), elsewhere
@@ -609,7 +657,7 @@ pub(crate) fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i32; 3]> {
     Some(if len > bits {
         // |c >> s| <= 2^bits.
         let s = len - bits;
-        v.map(|c| (c >> s) as i32)
+        v.map(|c| shr_low_word(c, s))
     } else {
         // |c| < 2^len <= 2^bits, and so is the result.
         let s = bits - len;
@@ -802,6 +850,35 @@ mod tests {
                 let want = a.wrapping_mul(b as i64);
                 assert_eq!(mul_i64_u16_in_words(a, b), want, "{a} * {b}");
                 assert_eq!(mul_i64_u16(a, b), want, "{a} * {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn shifts_in_words_are_exact() {
+        let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
+        let edges = [
+            0i64,
+            1,
+            -1,
+            i64::MAX,
+            i64::MIN,
+            u32::MAX as i64,
+            -(1 << 32),
+            1 << 31,
+        ];
+        for k in 0..100_000u64 {
+            let x = rng.next_u64();
+            let v = match k % 3 {
+                0 => x as i64,
+                1 => (x as i64) >> (x % 64),
+                _ => edges[(k / 3 % 8) as usize].wrapping_add((x >> 60) as i64 - 8),
+            };
+            for s in 0..64 {
+                assert_eq!(shr_low_word_in_words(v, s), (v >> s) as i32, "{v} >> {s}");
+                assert_eq!(shr_low_word(v, s), (v >> s) as i32, "{v} >> {s}");
+                assert_eq!(shr_i64_in_words(v, s), v >> s, "{v} >> {s}");
+                assert_eq!(shr_i64(v, s), v >> s, "{v} >> {s}");
             }
         }
     }

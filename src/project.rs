@@ -14,7 +14,7 @@
 //! * Depth `q = near / w` in I2F30: `near · 2^30 < 2^61`.
 
 use crate::depth::Depth;
-use crate::math::{floor_div_i64, i16f16_from_f32, mul_wide};
+use crate::math::{floor_div_i64, i16f16_from_f32, mul_wide, shr_i64};
 use crate::vertex::EyePoint;
 use fixed::types::I16F16;
 
@@ -90,8 +90,9 @@ impl Scale {
     /// `floor(self · v)` for `|v| <= 2^31`.
     #[inline]
     pub fn apply(self, v: i32) -> i64 {
-        // The mantissa is below 2^25: a 32 × 32 → 64-bit product (no call on ARMv6-M).
-        mul_wide(self.mantissa, v) >> self.shift
+        // The mantissa is below 2^25: a 32 × 32 → 64-bit product, and the shift by a variable
+        // amount in 32-bit words (neither a call on ARMv6-M).
+        shr_i64(mul_wide(self.mantissa, v), self.shift)
     }
 }
 

@@ -983,9 +983,26 @@ pub fn signed_area<const S: u32>(v: &[ScreenVertex<S>; 3]) -> i64 {
 /// [`signed_area`] of the sub-pixel positions `(x, y)` of a triangle's vertices.
 #[inline]
 pub fn signed_area_xy(v: &[(i32, i32); 3]) -> i64 {
+    if NO_WIDE_MULTIPLY {
+        if let Some(area) = signed_area_in_words(v) {
+            return area;
+        }
+    }
     let [a, b, c] = *v;
     (b.0 as i64 - a.0 as i64) * (c.1 as i64 - a.1 as i64)
         - (c.0 as i64 - a.0 as i64) * (b.1 as i64 - a.1 as i64)
+}
+
+/// [`signed_area_xy`] from 32 × 32 → 64-bit products when the edges' differences fit 32 bits
+/// (every triangle near the screen), for the core without a wide multiply, where each `i64`
+/// product is a call; `None` otherwise. The same value (test `area_in_words_is_the_area`): each
+/// product is at most 2^62, their difference below 2^63.
+#[inline]
+fn signed_area_in_words(v: &[(i32, i32); 3]) -> Option<i64> {
+    let [a, b, c] = *v;
+    let e1 = (b.0.checked_sub(a.0)?, b.1.checked_sub(a.1)?);
+    let e2 = (c.0.checked_sub(a.0)?, c.1.checked_sub(a.1)?);
+    Some(mul_wide(e1.0, e2.1) - mul_wide(e2.0, e1.1))
 }
 
 /// The first row a triangle's walk would cover on a `width × height` screen, or `None` when
@@ -1704,5 +1721,45 @@ mod tests {
                 walk.next_row();
             }
         }
+    }
+
+    #[test]
+    fn area_in_words_is_the_area() {
+        let mut rng = crate::test_rng::XorShift64::new(0x5851_f42d_4c95_7f2du64);
+        let wide = |v: &[(i32, i32); 3]| {
+            let [a, b, c] = v.map(|(x, y)| (x as i64, y as i64));
+            (b.0 - a.0) * (c.1 - a.1) - (c.0 - a.0) * (b.1 - a.1)
+        };
+        // Coordinates within ±2^30, where the `i64` form cannot overflow; differences up to
+        // 2^31, so both sides of the 32-bit check are met.
+        let edges = [0, 1, -1, (1 << 30) - 1, 1 << 30, -(1 << 30), 3840, -3840];
+        let mut seen = (0, 0);
+        for k in 0..200_000u32 {
+            let x = rng.next_u64();
+            let p = |i: u32| match (k + i / 4) % 3 {
+                0 => (x >> (i * 5)) as i32 >> (1 + x % 30),
+                1 => edges[((x >> (i * 3)) % 8) as usize],
+                _ => ((x >> (i * 7)) as i32 % 4000) - 200,
+            };
+            let v = [(p(0), p(1)), (p(2), p(3)), (p(4), p(5))];
+            let fits = |p: i32, q: i32| p.checked_sub(q).is_some();
+            let narrow = fits(v[1].0, v[0].0)
+                && fits(v[1].1, v[0].1)
+                && fits(v[2].0, v[0].0)
+                && fits(v[2].1, v[0].1);
+            match signed_area_in_words(&v) {
+                Some(area) => {
+                    assert_eq!(area, wide(&v), "{v:?}");
+                    seen.0 += 1;
+                }
+                None => {
+                    assert!(!narrow, "{v:?}");
+                    seen.1 += 1;
+                }
+            }
+            assert_eq!(signed_area_xy(&v), wide(&v), "{v:?}");
+        }
+        // Both paths taken often.
+        assert!(seen.0 > 100_000 && seen.1 > 1_000, "{seen:?}");
     }
 }

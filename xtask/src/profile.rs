@@ -195,8 +195,8 @@ struct Counts {
     blocks: HashMap<u64, (u64, u64)>,
     per_function: HashMap<u64, u64>,
     per_site: HashMap<u64, u64>,
-    /// Per call site, the built-ins' instructions alone.
-    builtin_site: HashMap<u64, u64>,
+    /// Per call site and built-in block, the built-ins' instructions alone.
+    builtin_site: HashMap<(u64, u64), u64>,
     total: u64,
     builtin: u64,
 }
@@ -227,7 +227,7 @@ fn count_blocks(log: impl BufRead, syms: &[(u64, u64, String)]) -> Result<Counts
             *c.per_function.entry(pc).or_default() += len;
             if is_builtin {
                 c.builtin += len;
-                *c.builtin_site.entry(caller).or_default() += len;
+                *c.builtin_site.entry((caller, pc)).or_default() += len;
             } else {
                 caller = last;
             }
@@ -340,16 +340,20 @@ fn profile_elf(
         println!("{:6.2} %  {line}", percent(*n, total));
     }
     let mut builtin_sites: HashMap<String, u64> = HashMap::new();
-    for (site, n) in &c.builtin_site {
+    for ((site, pc), n) in &c.builtin_site {
         let (line, inlined) = lines.get(site).map_or(("", "?"), |(l, f)| (l.as_str(), f.as_str()));
         *builtin_sites
-            .entry(format!("{line} ({})", short_name(inlined)))
+            .entry(format!(
+                "{line} ({}): {}",
+                short_name(inlined),
+                short_name(name_of(&syms, *pc))
+            ))
             .or_default() += n;
     }
     let mut builtin_sites: Vec<_> = builtin_sites.into_iter().collect();
     builtin_sites.sort_by_key(|l| std::cmp::Reverse(l.1));
     println!("\nthe built-ins alone, by the source line that called them:");
-    for (line, n) in builtin_sites.iter().take(20) {
+    for (line, n) in builtin_sites.iter().take(30) {
         println!("{:6.2} %  {line}", percent(*n, total));
     }
     let mut by_inlined: Vec<_> = by_inlined.into_iter().collect();
