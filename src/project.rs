@@ -14,7 +14,7 @@
 //! * Depth `q = near / w` in I2F30: `near · 2^30 < 2^61`.
 
 use crate::depth::Depth;
-use crate::math::{floor_div_i64, i16f16_from_f32, mul_wide};
+use crate::math::{floor_div_i64, i16f16_from_f32, mul_wide, SoftDivisor, NO_HARDWARE_DIVIDE};
 use crate::vertex::EyePoint;
 use fixed::types::I16F16;
 
@@ -205,8 +205,19 @@ impl<const S: u32> Viewport<S> {
         let nx = self.ax.apply(p.x.to_bits());
         let ny = self.ay.apply(p.y.to_bits());
         // round(c/2 + n/w) = floor((c·w + 2n + w) / 2w)
-        let x = floor_div(cx * w + 2 * nx + w, 2 * w);
-        let y = floor_div(cy * w - 2 * ny + w, 2 * w);
+        let (nx, ny) = (cx * w + 2 * nx + w, cy * w - 2 * ny + w);
+        let (x, y) = match u32::try_from(2 * w) {
+            // Without a divider, x and y share one prepared divisor.
+            Ok(d) if NO_HARDWARE_DIVIDE => {
+                let by = SoftDivisor::new(d);
+                let div = |n: i64| match u32::try_from(n) {
+                    Ok(n) => by.div_rem(n).0 as i64,
+                    Err(_) => floor_div_i64(n, 2 * w),
+                };
+                (div(nx), div(ny))
+            }
+            _ => (floor_div(nx, 2 * w), floor_div(ny, 2 * w)),
+        };
         let q = if depth {
             floor_div_i64((self.near.to_bits() as i64) << 30, w)
         } else {
