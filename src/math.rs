@@ -89,20 +89,8 @@ pub(crate) const NO_WIDE_MULTIPLY: bool =
 pub(crate) const NO_HARDWARE_DIVIDE: bool =
     cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
 
-/// `(n / d, n % d)` for 32-bit operands (`d = 0` is taken as 1): on cores without a divider
-/// ([`NO_HARDWARE_DIVIDE`]) [`div_rem_u32_soft`], elsewhere the division (one instruction).
-/// The same pair either way (test `soft_division_is_exact`).
-#[inline]
-pub(crate) fn div_rem_u32(n: u32, d: u32) -> (u32, u32) {
-    if NO_HARDWARE_DIVIDE {
-        div_rem_u32_soft(n, d)
-    } else {
-        let d = d.max(1);
-        (n / d, n % d)
-    }
-}
-
-/// [`div_rem_u32`] from multiplies, on every target (tested on the host too): `n < d` by one
+/// `(n / d, n % d)` for 32-bit operands (`d = 0` is taken as 1) from multiplies, for cores
+/// without a divider ([`NO_HARDWARE_DIVIDE`]; on every target, tested on the host too): `n < d` by one
 /// comparison, quotients 1 and 2 by subtraction, else by a [`SoftDivisor`].
 #[inline]
 pub(crate) fn div_rem_u32_soft(n: u32, d: u32) -> (u32, u32) {
@@ -174,19 +162,6 @@ impl SoftDivisor {
             r = r.wrapping_sub(e.wrapping_mul(d));
         }
         (q, r)
-    }
-}
-
-/// `(d·2^s, s)` with the top bit of `d·2^s` set for `d >= 1`: by [`normalize`] when `soft`
-/// (the core without a divider has no `clz` either, [`NO_HARDWARE_DIVIDE`]), else by
-/// `leading_zeros` (one instruction). The same pair either way.
-#[inline(always)]
-fn normalize_any(d: u32, soft: bool) -> (u32, u32) {
-    if soft {
-        normalize(d)
-    } else {
-        let s = d.leading_zeros();
-        (d << s, s)
     }
 }
 
@@ -384,7 +359,11 @@ pub(crate) fn lambert_i64(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
     let square: u64 = s.iter().map(|&c| mul_wide(c, c) as u64).sum();
     // S < 3·2^60, so S' < 3·2^30; r >= 2^14 (S >= 2^58).
     let r = isqrt32((square >> 30) as u32).max(1);
-    let a = div_rem_u32((dot >> 29) as u32, r).0;
+    let a = if NO_HARDWARE_DIVIDE {
+        div_rem_u32_soft((dot >> 29) as u32, r).0
+    } else {
+        (dot >> 29) as u32 / r
+    };
     let lo = (a << 14).saturating_sub(a + 1);
     let hi = (a + 1).saturating_mul(1 << 14);
     Some(Lambert {
@@ -437,7 +416,11 @@ pub(crate) fn div_rem_u64_u32(n: u64, d: u32) -> (u64, u32) {
 fn div_rem_u64_u32_in_halves(n: u64, d: u32) -> (u64, u32) {
     let d = d.max(1);
     let (hi, lo) = ((n >> 32) as u32, n as u32);
-    let (q_hi, r_hi) = div_rem_u32(hi, d);
+    let (q_hi, r_hi) = if NO_HARDWARE_DIVIDE {
+        div_rem_u32_soft(hi, d)
+    } else {
+        (hi / d, hi % d)
+    };
     let (q_lo, r) = div_rem_below(r_hi, lo, d);
     (((q_hi as u64) << 32) | q_lo as u64, r)
 }
@@ -445,24 +428,18 @@ fn div_rem_u64_u32_in_halves(n: u64, d: u32) -> (u64, u32) {
 /// `(u1·2^32 + u0) / v` and its remainder for `u1 < v` (so the quotient fits 32 bits).
 #[inline]
 pub(crate) fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
-    div_rem_below_as(u1, u0, v, NO_HARDWARE_DIVIDE)
-}
-
-/// [`div_rem_below`], its 32-bit divisions by [`div_rem_u32_soft`] and [`SoftDivisor`] when
-/// `soft` (the core without a divider), else by `/` (on every target: tested on the host).
-#[inline(always)]
-fn div_rem_below_as(u1: u32, u0: u32, v: u32, soft: bool) -> (u32, u32) {
+    if NO_HARDWARE_DIVIDE {
+        return div_rem_below_soft(u1, u0, v);
+    }
     const B: u32 = 1 << 16;
     if u1 == 0 {
         // The common case (numerator below 2^32): one division.
-        if soft {
-            return div_rem_u32_soft(u0, v);
-        }
         let v = v.max(1);
         return (u0 / v, u0 % v);
     }
     // Normalize: the divisor's top bit set (u1 < v, so v > 0 and the shift is below 32).
-    let (v, s) = normalize_any(v, soft);
+    let s = v.leading_zeros();
+    let v = v << s;
     // `v`'s top bit is set, so `vn1 >= 2^15` already: or-ing that bit in changes nothing but
     // lets the compiler see it is not zero (no division-by-zero panic path: the panic-never
     // link check).
@@ -472,10 +449,43 @@ fn div_rem_below_as(u1: u32, u0: u32, v: u32, soft: bool) -> (u32, u32) {
     let (un1, un0) = (un10 >> 16, un10 & 0xFFFF);
     // One 16-bit digit of the quotient of `top·2^16 + next` (`top < v`): the estimate from
     // `vn1 >= 2^15` is at most two too large (Knuth, Algorithm D).
-    // Without a divider the two estimates share one prepared divisor.
+    let digit = |top: u32, next: u32| {
+        let mut q = top / vn1;
+        let mut rhat = top - q * vn1;
+        while q >= B || q * vn0 > (rhat << 16 | next) {
+            q -= 1;
+            rhat += vn1;
+            if rhat >= B {
+                break;
+            }
+        }
+        q
+    };
+    let q1 = digit(un32, un1);
+    let un21 = (un32 << 16 | un1).wrapping_sub(q1.wrapping_mul(v));
+    let q0 = digit(un21, un0);
+    let r = (un21 << 16 | un0).wrapping_sub(q0.wrapping_mul(v)) >> s;
+    (q1 << 16 | q0, r)
+}
+
+/// [`div_rem_below`] for the core without a divider ([`NO_HARDWARE_DIVIDE`]), on every target
+/// (tested on the host too): the same steps, with [`div_rem_u32_soft`] for a numerator below
+/// 2^32, the normalisation by [`normalize`] (no `__clzsi2` call), and each digit's first
+/// estimate `⌊top / vn1⌋` from one [`SoftDivisor`] shared by the two digits.
+#[inline]
+fn div_rem_below_soft(u1: u32, u0: u32, v: u32) -> (u32, u32) {
+    const B: u32 = 1 << 16;
+    if u1 == 0 {
+        return div_rem_u32_soft(u0, v);
+    }
+    let (v, s) = normalize(v);
+    let (vn1, vn0) = ((v >> 16) | 0x8000, v & 0xFFFF);
+    let un32 = (u1 << s) | if s == 0 { 0 } else { u0 >> (32 - s) };
+    let un10 = u0 << s;
+    let (un1, un0) = (un10 >> 16, un10 & 0xFFFF);
     let by = SoftDivisor::new(vn1);
     let digit = |top: u32, next: u32| {
-        let mut q = if soft { by.div_rem(top).0 } else { top / vn1 };
+        let mut q = by.div_rem(top).0;
         let mut rhat = top - q * vn1;
         while q >= B || q * vn0 > (rhat << 16 | next) {
             q -= 1;
@@ -557,10 +567,17 @@ impl Divisor32 {
     /// The divisor `d` (`0` is taken as 1).
     #[inline]
     pub(crate) fn new(d: u32) -> Self {
-        let (d, shift) = normalize_any(d.max(1), NO_HARDWARE_DIVIDE);
-        // The top bit is set: without a divider, or-ing it in tells the compiler so
-        // (`div_rem_below`'s normalisation by comparisons then folds away).
-        let d = if NO_HARDWARE_DIVIDE { d | 1 << 31 } else { d };
+        let d = d.max(1);
+        if NO_HARDWARE_DIVIDE {
+            // Normalised by comparisons; the top bit, set, or-ed in to tell the compiler so
+            // (`div_rem_below`'s own normalisation then folds away).
+            let (d, shift) = normalize(d);
+            let d = d | 1 << 31;
+            let v = div_rem_below(!d, u32::MAX, d).0;
+            return Divisor32 { d, v, shift };
+        }
+        let shift = d.leading_zeros();
+        let d = d << shift;
         // ν − β = ⌊((β − 1 − d)·β + β − 1) / d⌋, a quotient below β (β − 1 − d < d).
         let v = if cfg!(target_pointer_width = "64") {
             (u64::MAX / d as u64) as u32
@@ -996,7 +1013,7 @@ mod tests {
             let (hi, lo) = ((n >> 32) as u32, n as u32);
             let r_hi = hi % d;
             let want_lo = (want.0 as u32, want.1);
-            assert_eq!(div_rem_below_as(r_hi, lo, d, true), want_lo, "{n} / {d}");
+            assert_eq!(div_rem_below_soft(r_hi, lo, d), want_lo, "{n} / {d}");
         };
         for n in ns {
             for d in ds {
@@ -1048,12 +1065,10 @@ mod tests {
         }
     }
 
-    /// Quotient and remainder of `div_rem_u32_soft` (and so of `div_rem_u32` on every target)
-    /// against `/` and `%`, and the passes it takes.
+    /// Quotient and remainder of `div_rem_u32_soft` and of a `SoftDivisor` against `/` and `%`.
     fn check_soft(n: u32, d: u32) {
         let want = (n / d, n % d);
         assert_eq!(div_rem_u32_soft(n, d), want, "{n} / {d}");
-        assert_eq!(div_rem_u32(n, d), want, "{n} / {d}");
         assert_eq!(SoftDivisor::new(d).div_rem(n), want, "{n} / {d}");
     }
 
@@ -1107,7 +1122,6 @@ mod tests {
             }
         }
         assert_eq!(div_rem_u32_soft(12345, 0), (12345, 0));
-        assert_eq!(div_rem_u32(12345, 0), (12345, 0));
         let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1d);
         for _ in 0..4_000_000 {
             let x = rng.next_u64();
@@ -1199,7 +1213,7 @@ mod tests {
             // The 32-bit targets' reciprocal (the host divides `u64`), with and without a
             // divider.
             assert_eq!(div_rem_below(!by.d, u32::MAX, by.d).0, by.v, "{d}");
-            assert_eq!(div_rem_below_as(!by.d, u32::MAX, by.d, true).0, by.v, "{d}");
+            assert_eq!(div_rem_below_soft(!by.d, u32::MAX, by.d).0, by.v, "{d}");
             check(x >> (x % 64), &by, d);
             // Quotients and remainders at the word boundaries: n = q·d + r with chosen q, r.
             let q = (x >> 20) & 0xFFFF_FFFF;

@@ -205,18 +205,13 @@ impl<const S: u32> Viewport<S> {
         let nx = self.ax.apply(p.x.to_bits());
         let ny = self.ay.apply(p.y.to_bits());
         // round(c/2 + n/w) = floor((c·w + 2n + w) / 2w)
-        let (nx, ny) = (cx * w + 2 * nx + w, cy * w - 2 * ny + w);
-        let (x, y) = match u32::try_from(2 * w) {
-            // Without a divider, x and y share one prepared divisor.
-            Ok(d) if NO_HARDWARE_DIVIDE => {
-                let by = SoftDivisor::new(d);
-                let div = |n: i64| match u32::try_from(n) {
-                    Ok(n) => by.div_rem(n).0 as i64,
-                    Err(_) => floor_div_i64(n, 2 * w),
-                };
-                (div(nx), div(ny))
-            }
-            _ => (floor_div(nx, 2 * w), floor_div(ny, 2 * w)),
+        let (x, y) = if NO_HARDWARE_DIVIDE {
+            floor_div_pair(cx * w + 2 * nx + w, cy * w - 2 * ny + w, 2 * w)
+        } else {
+            (
+                floor_div(cx * w + 2 * nx + w, 2 * w),
+                floor_div(cy * w - 2 * ny + w, 2 * w),
+            )
         };
         let q = if depth {
             floor_div_i64((self.near.to_bits() as i64) << 30, w)
@@ -281,6 +276,24 @@ fn floor_div(n: i64, d: i64) -> i64 {
         }
     }
     floor_div_i64(n, d)
+}
+
+/// `(floor_div(a, d), floor_div(b, d))` for the core without a divider
+/// ([`NO_HARDWARE_DIVIDE`]): where `d` fits 32 bits, one [`SoftDivisor`] for both, each
+/// numerator that fits `u32` divided by it; else [`floor_div_i64`]. The same quotients.
+#[inline]
+fn floor_div_pair(a: i64, b: i64, d: i64) -> (i64, i64) {
+    match u32::try_from(d) {
+        Ok(d32) => {
+            let by = SoftDivisor::new(d32);
+            let div = |n: i64| match u32::try_from(n) {
+                Ok(n) => by.div_rem(n).0 as i64,
+                Err(_) => floor_div_i64(n, d),
+            };
+            (div(a), div(b))
+        }
+        Err(_) => (floor_div_i64(a, d), floor_div_i64(b, d)),
+    }
 }
 
 /// A projected vertex from its position and depth bits (within range after clipping; the

@@ -28,8 +28,8 @@
 
 use crate::depth::Depth;
 use crate::math::{
-    div_rem_u32, floor_div_i64, mul_i64_i32, mul_i64_u16, mul_wide, Divisor32, NO_HARDWARE_DIVIDE,
-    NO_WIDE_MULTIPLY,
+    div_rem_u32_soft, floor_div_i64, mul_i64_i32, mul_i64_u16, mul_wide, Divisor32,
+    NO_HARDWARE_DIVIDE, NO_WIDE_MULTIPLY,
 };
 use crate::project::ScreenVertex;
 use fixed::types::I16F16;
@@ -129,13 +129,13 @@ fn steep_slope(dx: i32, dy: i32) -> Option<(i32, i32)> {
     }
 }
 
-/// `(dx.div_euclid(dy), dx.rem_euclid(dy))` for `dy > 0` by [`div_rem_u32`] on the
+/// `(dx.div_euclid(dy), dx.rem_euclid(dy))` for `dy > 0` by [`div_rem_u32_soft`] on the
 /// magnitudes, for the core without a divider ([`NO_HARDWARE_DIVIDE`]). Test
 /// `floor_div_rem_i32_equals_the_division`.
 #[inline]
 fn floor_div_rem_i32(dx: i32, dy: i32) -> (i32, i32) {
     let d = dy.unsigned_abs();
-    let (q, r) = div_rem_u32(dx.unsigned_abs(), d);
+    let (q, r) = div_rem_u32_soft(dx.unsigned_abs(), d);
     if dx >= 0 {
         (q as i32, r as i32)
     } else if r == 0 {
