@@ -281,7 +281,7 @@ fn floor_div(n: i64, d: i64) -> i64 {
 /// `(floor_div(a, d), floor_div(b, d))` for the core without a divider
 /// ([`NO_HARDWARE_DIVIDE`]): where `d` fits 32 bits, one [`SoftDivisor`] for both, each
 /// numerator that fits `u32` divided by it; else [`floor_div_i64`]. The same quotients.
-#[inline]
+#[inline(always)]
 fn floor_div_pair(a: i64, b: i64, d: i64) -> (i64, i64) {
     match u32::try_from(d) {
         Ok(d32) => {
