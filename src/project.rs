@@ -266,8 +266,8 @@ impl<const S: u32> Viewport<S> {
 
 /// `floor(n / d)` for `d > 0`: a 32-bit division when both fit `u32` (an on-screen vertex at a
 /// moderate `w`: `n ≈ X · 2w`), else the 64-bit one. The same quotient either way; on 32-bit
-/// cores the first is one `UDIV` (Cortex-M4) or a 32-bit library call (Cortex-M0) instead of a
-/// 64-bit library division.
+/// cores the first is one `UDIV` (Cortex-M4) instead of a 64-bit library division. Cores
+/// without a divider (Cortex-M0) take [`floor_div_pair`] instead.
 #[inline]
 fn floor_div(n: i64, d: i64) -> i64 {
     if let (Ok(n32), Ok(d32)) = (u32::try_from(n), u32::try_from(d)) {

@@ -58,8 +58,8 @@ impl EdgeWalk {
     /// `None` if the edge is horizontal or upside down.
     pub fn new<const S: u32>(a: (i32, i32), b: (i32, i32), row: i32) -> Option<EdgeWalk> {
         // Doubled differences are below 2^24, so the slope's quotient and remainder take one
-        // 32-bit division (a single SDIV, or a 32-bit library call on thumbv6m, which a steep
-        // edge skips).
+        // 32-bit division (a single SDIV; on thumbv6m `floor_div_rem_i32`, by multiplies,
+        // which a steep edge skips).
         let dx = 2 * (b.0 - a.0);
         let dy = 2 * (b.1 - a.1);
         if dy <= 0 {
