@@ -82,12 +82,136 @@ impl MathBackend for Micromath {
 pub(crate) const NO_WIDE_MULTIPLY: bool =
     cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
 
-/// The core divides in software (ARMv6-M, as for [`NO_WIDE_MULTIPLY`]): even a 32-bit
-/// division is a call to `__aeabi_idiv` (tens of instructions), so quotients that a comparison
-/// can find are found that way there. Elsewhere (Cortex-M3/M4 `sdiv`, RV32 `M`, the host) a
+/// The core divides in software (ARMv6-M, as for [`NO_WIDE_MULTIPLY`]): the library's 32-bit
+/// division is a call of about 100–140 instructions, so quotients that a comparison can find
+/// are found that way there, and the others by [`div_rem_u32_soft`] or a [`SoftDivisor`]
+/// (multiplies, no library call). Elsewhere (Cortex-M3/M4 `sdiv`, RV32 `M`, the host) a
 /// division is one instruction.
 pub(crate) const NO_HARDWARE_DIVIDE: bool =
     cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
+
+/// `(n / d, n % d)` for 32-bit operands (`d = 0` is taken as 1) from multiplies, for cores
+/// without a divider ([`NO_HARDWARE_DIVIDE`]; on every target, tested on the host too): `n < d` by one
+/// comparison, quotients 1 and 2 by subtraction, else by a [`SoftDivisor`].
+#[inline]
+pub(crate) fn div_rem_u32_soft(n: u32, d: u32) -> (u32, u32) {
+    if n < d {
+        return (0, n);
+    }
+    // Quotients 1 and 2 (shallow edges' slopes) by subtraction.
+    let r = n - d;
+    if r < d {
+        return (1, r);
+    }
+    let r2 = r - d;
+    if r2 < d {
+        return (2, r2);
+    }
+    SoftDivisor::new(d).div_rem(n)
+}
+
+/// A 32-bit divisor `d >= 1` prepared for exact division by multiplies, for cores without a
+/// divider ([`NO_HARDWARE_DIVIDE`], where `compiler_builtins`' `u32_div_rem` takes about
+/// 35 instructions to normalise and 4–5 a quotient bit, 100–140 a call on the renderer's
+/// divisions).
+///
+/// Preparing: `d` is normalised by five comparisons (`D = d·2^s`, top bit set; no `clz` call),
+/// and its top half `Dh = ⌊D / 2^16⌋` (in `[2^15, 2^16)`) gives `a = Dh + 1` and a 16-bit
+/// reciprocal `R <= 2^31 / a` ([`reciprocal16`], within a few units of it). Since
+/// `D < a·2^16`, `d < a·2^(16−s)`.
+///
+/// Dividing: each pass estimates the quotient of the remainder `r` (at first `n`) as
+/// `e = ⌊⌊r·R / 2^16⌋ / 2^(31−s)⌋` (the product from 16-bit halves), and since
+/// `r·R / 2^(47−s) <= r / (a·2^(16−s)) < r / d`, `e·d < r`: the remainder `r − e·d` never
+/// wraps and the quotient never overshoots. A pass with `e = 0` (only when `r < 2d`) takes 1.
+/// Each pass leaves about `2^-13` of the quotient (the relative errors of `R`, of `a` and of
+/// the truncations) plus two, so a 16-bit quotient takes two or three passes, a 32-bit one
+/// four. The loop ends when `r < d`: then the sum of the estimates is `⌊n / d⌋` and `r`
+/// is `n mod d`, whatever the estimates' quality. Test `soft_division_is_exact`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SoftDivisor {
+    d: u32,
+    /// `R`, in `[2^15, 2^16)`.
+    recip: u32,
+    /// `31 − s`.
+    shift: u32,
+}
+
+impl SoftDivisor {
+    /// The divisor `d` (`0` is taken as 1).
+    #[inline]
+    pub(crate) fn new(d: u32) -> Self {
+        let d = d.max(1);
+        let (norm, s) = normalize(d);
+        SoftDivisor {
+            d,
+            recip: reciprocal16((norm >> 16) + 1),
+            shift: 31 - s,
+        }
+    }
+
+    /// `(n / d, n % d)`.
+    #[inline]
+    pub(crate) fn div_rem(&self, n: u32) -> (u32, u32) {
+        let (d, recip) = (self.d, self.recip);
+        let (mut q, mut r) = (0u32, n);
+        while r >= d {
+            // ⌊r·R / 2^16⌋ or one less: (2^16 − 1)·R + ((2^16 − 1)·R >> 16) < 2^32.
+            let p = (r >> 16) * recip + (((r & 0xFFFF) * recip) >> 16);
+            let e = (p >> (self.shift & 31)).max(1);
+            q = q.wrapping_add(e);
+            r = r.wrapping_sub(e.wrapping_mul(d));
+        }
+        (q, r)
+    }
+}
+
+/// `(d·2^s, s)` with the top bit of `d·2^s` set, for `d >= 1` (`d = 0` gives `(0, 31)`), by
+/// halving the range five times: inline comparisons, where `leading_zeros` is a call of
+/// `__clzsi2` on ARMv6-M.
+#[inline]
+fn normalize(d: u32) -> (u32, u32) {
+    let (mut x, mut s) = (d, 0);
+    if x >> 16 == 0 {
+        x <<= 16;
+        s = 16;
+    }
+    if x >> 24 == 0 {
+        x <<= 8;
+        s += 8;
+    }
+    if x >> 28 == 0 {
+        x <<= 4;
+        s += 4;
+    }
+    if x >> 30 == 0 {
+        x <<= 2;
+        s += 2;
+    }
+    if x >> 31 == 0 {
+        x <<= 1;
+        s += 1;
+    }
+    (x, s)
+}
+
+/// `R <= 2^31 / a` within a few units (in `[2^15, 2^16)`) for `a` in `(2^15, 2^16]`, without a
+/// table or a division: the line `x0 = 92,521 − ⌊a·61,681 / 2^16⌋` (`2^15·(48 − 32·t) / 17`
+/// for `t = a / 2^16`, the minimax line for `1 / t` on `[1/2, 1]`, within `1/17`), then two
+/// Newton steps `x ← x + x·(2^31 − a·x) / 2^31`. A Newton step for `1/a` never lands above it
+/// (`x·(2 − a·x) = 1/a − a·(x − 1/a)²`) and every truncation here rounds down, so each step
+/// ends at or below `2^31 / a`, the relative error squared: `2^-4.1`, `2^-8.2`, `2^-16.4`.
+/// Bits: `a·x0 < 2^31·(1 + 1/17)`, so the first error `2^31 − a·x0` is within `±2^27` and
+/// `x0·(e >> 12)` within `±2^31`; the second error is below `2^23`, so `x1·(e >> 7) < 2^32`.
+/// Test `reciprocal16_is_close_below`, over every `a`.
+#[inline]
+fn reciprocal16(a: u32) -> u32 {
+    let x0 = 92_521 - ((a * 61_681) >> 16);
+    let e0 = (1u32 << 31).wrapping_sub(a.wrapping_mul(x0)) as i32;
+    let x1 = (x0 as i32 + ((x0 as i32).wrapping_mul(e0 >> 12) >> 19)) as u32;
+    let e1 = (1u32 << 31).wrapping_sub(a.wrapping_mul(x1));
+    x1 + ((x1.wrapping_mul(e1 >> 7)) >> 24)
+}
 
 /// `a · b` as `i64`: on cores without a wide multiply ([`NO_WIDE_MULTIPLY`]) from four
 /// 32-bit multiplies of 16-bit halves, elsewhere the `i64` multiply (one instruction). The
@@ -284,7 +408,11 @@ pub(crate) fn lambert_i64(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
     let square: u64 = s.iter().map(|&c| mul_wide(c, c) as u64).sum();
     // S < 3·2^60, so S' < 3·2^30; r >= 2^14 (S >= 2^58).
     let r = isqrt32((square >> 30) as u32).max(1);
-    let a = (dot >> 29) as u32 / r;
+    let a = if NO_HARDWARE_DIVIDE {
+        div_rem_u32_soft((dot >> 29) as u32, r).0
+    } else {
+        (dot >> 29) as u32 / r
+    };
     let lo = (a << 14).saturating_sub(a + 1);
     let hi = (a + 1).saturating_mul(1 << 14);
     Some(Lambert {
@@ -320,8 +448,8 @@ pub(crate) fn floor_div_i64(n: i64, d: i64) -> i64 {
 /// from the normalized divisor's top half and corrected at most twice). Cores with a 32-bit
 /// divider (Cortex-M3/M4, RV32IM) have none for 64 bits, and `compiler_builtins` builds the
 /// 64-bit division from a software 32-bit one: this is several times cheaper there. On cores
-/// without any divider (Cortex-M0) each 32-bit division is a call, and the two cost about the
-/// same (the icosphere frame within 0.1 %). A 64-bit core divides natively: the same value.
+/// without any divider (Cortex-M0) its 32-bit divisions are [`div_rem_u32_soft`] and
+/// [`div_rem_below_soft`]'s. A 64-bit core divides natively: the same value.
 #[inline]
 pub(crate) fn div_rem_u64_u32(n: u64, d: u32) -> (u64, u32) {
     if cfg!(target_pointer_width = "64") {
@@ -337,7 +465,11 @@ pub(crate) fn div_rem_u64_u32(n: u64, d: u32) -> (u64, u32) {
 fn div_rem_u64_u32_in_halves(n: u64, d: u32) -> (u64, u32) {
     let d = d.max(1);
     let (hi, lo) = ((n >> 32) as u32, n as u32);
-    let (q_hi, r_hi) = (hi / d, hi % d);
+    let (q_hi, r_hi) = if NO_HARDWARE_DIVIDE {
+        div_rem_u32_soft(hi, d)
+    } else {
+        (hi / d, hi % d)
+    };
     let (q_lo, r) = div_rem_below(r_hi, lo, d);
     (((q_hi as u64) << 32) | q_lo as u64, r)
 }
@@ -345,6 +477,9 @@ fn div_rem_u64_u32_in_halves(n: u64, d: u32) -> (u64, u32) {
 /// `(u1·2^32 + u0) / v` and its remainder for `u1 < v` (so the quotient fits 32 bits).
 #[inline]
 pub(crate) fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
+    if NO_HARDWARE_DIVIDE {
+        return div_rem_below_soft(u1, u0, v);
+    }
     const B: u32 = 1 << 16;
     if u1 == 0 {
         // The common case (numerator below 2^32): one division.
@@ -365,6 +500,43 @@ pub(crate) fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
     // `vn1 >= 2^15` is at most two too large (Knuth, Algorithm D).
     let digit = |top: u32, next: u32| {
         let mut q = top / vn1;
+        let mut rhat = top - q * vn1;
+        while q >= B || q * vn0 > (rhat << 16 | next) {
+            q -= 1;
+            rhat += vn1;
+            if rhat >= B {
+                break;
+            }
+        }
+        q
+    };
+    let q1 = digit(un32, un1);
+    let un21 = (un32 << 16 | un1).wrapping_sub(q1.wrapping_mul(v));
+    let q0 = digit(un21, un0);
+    let r = (un21 << 16 | un0).wrapping_sub(q0.wrapping_mul(v)) >> s;
+    (q1 << 16 | q0, r)
+}
+
+/// [`div_rem_below`] for the core without a divider ([`NO_HARDWARE_DIVIDE`]), on every target
+/// (tested on the host too): the same steps, with [`div_rem_u32_soft`] for a numerator below
+/// 2^32, the normalisation by [`normalize`] (no `__clzsi2` call), and each digit's first
+/// estimate `⌊top / vn1⌋` from one [`SoftDivisor`] shared by the two digits. Always inlined:
+/// out of line (one copy for `Divisor32::new`'s normalised divisors and for the others) the
+/// demo frame on thumbv6m took 2 % more.
+#[inline(always)]
+fn div_rem_below_soft(u1: u32, u0: u32, v: u32) -> (u32, u32) {
+    const B: u32 = 1 << 16;
+    if u1 == 0 {
+        return div_rem_u32_soft(u0, v);
+    }
+    let (v, s) = normalize(v);
+    let (vn1, vn0) = ((v >> 16) | 0x8000, v & 0xFFFF);
+    let un32 = (u1 << s) | if s == 0 { 0 } else { u0 >> (32 - s) };
+    let un10 = u0 << s;
+    let (un1, un0) = (un10 >> 16, un10 & 0xFFFF);
+    let by = SoftDivisor::new(vn1);
+    let digit = |top: u32, next: u32| {
+        let mut q = by.div_rem(top).0;
         let mut rhat = top - q * vn1;
         while q >= B || q * vn0 > (rhat << 16 | next) {
             q -= 1;
@@ -406,8 +578,8 @@ fn mul_wide_u32_in_halves(a: u32, b: u32) -> u64 {
 
 /// A 32-bit divisor `D >= 1` prepared for several divisions: one reciprocal, then every
 /// quotient from multiplies and at most two corrections, exactly `u64` division's quotient and
-/// remainder ([`div_rem_u64_u32`]'s). On cores without a divider (Cortex-M0) a 64 / 32-bit
-/// division costs three calls of the software 32-bit division, the reciprocal two.
+/// remainder ([`div_rem_u64_u32`]'s). On cores without a divider (Cortex-M0) the reciprocal is
+/// [`div_rem_below_soft`]'s two digits, by multiplies.
 ///
 /// The step is Möller and Granlund's (“Improved division by invariant integers”, 2011,
 /// Algorithm 4). Why it is exact, with `β = 2^32`, `d = D·2^s` normalized (`β/2 <= d < β`),
@@ -447,6 +619,14 @@ impl Divisor32 {
     #[inline]
     pub(crate) fn new(d: u32) -> Self {
         let d = d.max(1);
+        if NO_HARDWARE_DIVIDE {
+            // Normalised by comparisons; the top bit, set, or-ed in to tell the compiler so
+            // (`div_rem_below`'s own normalisation then folds away).
+            let (d, shift) = normalize(d);
+            let d = d | 1 << 31;
+            let v = div_rem_below(!d, u32::MAX, d).0;
+            return Divisor32 { d, v, shift };
+        }
         let shift = d.leading_zeros();
         let d = d << shift;
         // ν − β = ⌊((β − 1 − d)·β + β − 1) / d⌋, a quotient below β (β − 1 − d < d).
@@ -909,6 +1089,11 @@ mod tests {
             let want = (n / d as u64, (n % d as u64) as u32);
             assert_eq!(div_rem_u64_u32_in_halves(n, d), want, "{n} / {d}");
             assert_eq!(div_rem_u64_u32(n, d), want, "{n} / {d}");
+            // The low word's division as the core without a divider does it.
+            let (hi, lo) = ((n >> 32) as u32, n as u32);
+            let r_hi = hi % d;
+            let want_lo = (want.0 as u32, want.1);
+            assert_eq!(div_rem_below_soft(r_hi, lo, d), want_lo, "{n} / {d}");
         };
         for n in ns {
             for d in ds {
@@ -934,6 +1119,126 @@ mod tests {
         for n in [i64::MIN, i64::MIN + 1, -1, 0, 1, i64::MAX] {
             for d in [1i64, 2, 3, u32::MAX as i64, 1 << 32, i64::MAX] {
                 assert_eq!(floor_div_i64(n, d), n.div_euclid(d), "{n} / {d}");
+            }
+        }
+    }
+
+    #[test]
+    fn reciprocal16_is_close_below() {
+        for a in (1u32 << 15) + 1..=1 << 16 {
+            let (r, exact) = (reciprocal16(a) as u64, (1u64 << 31) / a as u64);
+            assert!(r <= exact && r + 4 >= exact, "{a}: {r} vs {exact}");
+            assert!(r < 1 << 16, "{a}: {r}");
+        }
+    }
+
+    #[test]
+    fn normalize_sets_the_top_bit() {
+        for s in 0..32 {
+            for d in [1u32 << s, (1 << s) | 1, ((1u64 << (s + 1)) - 1) as u32] {
+                assert_eq!(
+                    normalize(d),
+                    (d << d.leading_zeros(), d.leading_zeros()),
+                    "{d}"
+                );
+            }
+        }
+    }
+
+    /// Quotient and remainder of `div_rem_u32_soft` and of a `SoftDivisor` against `/` and `%`.
+    fn check_soft(n: u32, d: u32) {
+        let want = (n / d, n % d);
+        assert_eq!(div_rem_u32_soft(n, d), want, "{n} / {d}");
+        assert_eq!(SoftDivisor::new(d).div_rem(n), want, "{n} / {d}");
+    }
+
+    #[test]
+    fn soft_division_is_exact() {
+        let mut ds = std::vec![
+            1u32,
+            2,
+            3,
+            5,
+            7,
+            10,
+            0xFFFF,
+            0x1_0001,
+            u32::MAX,
+            u32::MAX - 1
+        ];
+        for s in 0..32 {
+            let p = 1u32 << s;
+            ds.extend([p, p - 1, p.wrapping_add(1), p | (p >> 1), p + (p >> 9)]);
+        }
+        ds.retain(|&d| d != 0);
+        for &d in &ds {
+            let mut ns = std::vec![
+                0u32,
+                1,
+                2,
+                u32::MAX,
+                u32::MAX - 1,
+                d,
+                d - 1,
+                d.wrapping_add(1)
+            ];
+            for k in [
+                2u32,
+                3,
+                7,
+                100,
+                0xFFFF,
+                0x1_0000,
+                0x1_0001,
+                0x7FFF_FFFF,
+                u32::MAX,
+            ] {
+                if let Some(kd) = k.checked_mul(d) {
+                    ns.extend([kd, kd - 1, kd.wrapping_add(1), kd.wrapping_add(d - 1)]);
+                }
+            }
+            for n in ns {
+                check_soft(n, d);
+            }
+        }
+        assert_eq!(div_rem_u32_soft(12345, 0), (12345, 0));
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1d);
+        for _ in 0..4_000_000 {
+            let x = rng.next_u64();
+            // Any width of either operand, and quotients of every length with any remainder.
+            let n = (x as u32) >> ((x >> 32) % 32);
+            let d = (((x >> 37) as u32) >> ((x >> 59) % 32)).max(1);
+            check_soft(n, d);
+            let q = (x >> 40) as u32 >> ((x >> 35) % 24);
+            if let Some(n) = q.checked_mul(d).and_then(|qd| qd.checked_add(n % d)) {
+                check_soft(n, d);
+            }
+        }
+    }
+
+    /// Every divisor below 2^12 and every divisor's top-16-bit class (`d = h·2^16 + low` for
+    /// every `h` with a few `low`), each against 4,100 numerators spread over `u32` and those
+    /// numerators' multiples of `d`; every numerator below 2^28 for three divisors. Ignored:
+    /// 17 s (`cargo test -p scanline3d --release --lib soft_division -- --ignored`).
+    #[test]
+    #[ignore]
+    fn soft_division_is_exact_exhaustively() {
+        let small = 1u32..1 << 12;
+        let classes =
+            (1u32..1 << 16).flat_map(|h| [h << 16, (h << 16) | 0xFFFF, (h << 16) | 0x8001]);
+        for d in small.chain(classes) {
+            for n in (0..=u32::MAX)
+                .step_by(1_048_573)
+                .chain([u32::MAX, d - 1, d])
+            {
+                check_soft(n, d);
+                check_soft(n.wrapping_sub(n % d), d);
+            }
+        }
+        // Every numerator below 2^28 for a few divisors.
+        for d in [3u32, 0xFFFF, 0x8001] {
+            for n in 0..1 << 28 {
+                assert_eq!(div_rem_u32_soft(n, d), (n / d, n % d), "{n} / {d}");
             }
         }
     }
@@ -990,8 +1295,10 @@ mod tests {
             let x = rng.next_u64();
             let d = (((x >> 7) as u32) >> ((x >> 40) % 32)).max(1);
             let by = Divisor32::new(d);
-            // The 32-bit targets' reciprocal (the host divides `u64`).
+            // The 32-bit targets' reciprocal (the host divides `u64`), with and without a
+            // divider.
             assert_eq!(div_rem_below(!by.d, u32::MAX, by.d).0, by.v, "{d}");
+            assert_eq!(div_rem_below_soft(!by.d, u32::MAX, by.d).0, by.v, "{d}");
             check(x >> (x % 64), &by, d);
             // Quotients and remainders at the word boundaries: n = q·d + r with chosen q, r.
             let q = (x >> 20) & 0xFFFF_FFFF;

@@ -14,7 +14,9 @@
 //! * Depth `q = near / w` in I2F30: `near · 2^30 < 2^61`.
 
 use crate::depth::Depth;
-use crate::math::{floor_div_i64, i16f16_from_f32, mul_wide, shr_i64};
+use crate::math::{
+    floor_div_i64, i16f16_from_f32, mul_wide, shr_i64, SoftDivisor, NO_HARDWARE_DIVIDE,
+};
 use crate::vertex::EyePoint;
 use fixed::types::I16F16;
 
@@ -206,8 +208,14 @@ impl<const S: u32> Viewport<S> {
         let nx = self.ax.apply(p.x.to_bits());
         let ny = self.ay.apply(p.y.to_bits());
         // round(c/2 + n/w) = floor((c·w + 2n + w) / 2w)
-        let x = floor_div(cx * w + 2 * nx + w, 2 * w);
-        let y = floor_div(cy * w - 2 * ny + w, 2 * w);
+        let (x, y) = if NO_HARDWARE_DIVIDE {
+            floor_div_pair(cx * w + 2 * nx + w, cy * w - 2 * ny + w, 2 * w)
+        } else {
+            (
+                floor_div(cx * w + 2 * nx + w, 2 * w),
+                floor_div(cy * w - 2 * ny + w, 2 * w),
+            )
+        };
         let q = if depth {
             floor_div_i64((self.near.to_bits() as i64) << 30, w)
         } else {
@@ -261,8 +269,8 @@ impl<const S: u32> Viewport<S> {
 
 /// `floor(n / d)` for `d > 0`: a 32-bit division when both fit `u32` (an on-screen vertex at a
 /// moderate `w`: `n ≈ X · 2w`), else the 64-bit one. The same quotient either way; on 32-bit
-/// cores the first is one `UDIV` (Cortex-M4) or a 32-bit library call (Cortex-M0) instead of a
-/// 64-bit library division.
+/// cores the first is one `UDIV` (Cortex-M4) instead of a 64-bit library division. Cores
+/// without a divider (Cortex-M0) take [`floor_div_pair`] instead.
 #[inline]
 fn floor_div(n: i64, d: i64) -> i64 {
     if let (Ok(n32), Ok(d32)) = (u32::try_from(n), u32::try_from(d)) {
@@ -271,6 +279,24 @@ fn floor_div(n: i64, d: i64) -> i64 {
         }
     }
     floor_div_i64(n, d)
+}
+
+/// `(floor_div(a, d), floor_div(b, d))` for the core without a divider
+/// ([`NO_HARDWARE_DIVIDE`]): where `d` fits 32 bits, one [`SoftDivisor`] for both, each
+/// numerator that fits `u32` divided by it; else [`floor_div_i64`]. The same quotients.
+#[inline(always)]
+fn floor_div_pair(a: i64, b: i64, d: i64) -> (i64, i64) {
+    match u32::try_from(d) {
+        Ok(d32) => {
+            let by = SoftDivisor::new(d32);
+            let div = |n: i64| match u32::try_from(n) {
+                Ok(n) => by.div_rem(n).0 as i64,
+                Err(_) => floor_div_i64(n, d),
+            };
+            (div(a), div(b))
+        }
+        Err(_) => (floor_div_i64(a, d), floor_div_i64(b, d)),
+    }
 }
 
 /// A projected vertex from its position and depth bits (within range after clipping; the

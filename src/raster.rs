@@ -28,8 +28,8 @@
 
 use crate::depth::Depth;
 use crate::math::{
-    floor_div_i64, mul_i64_i32, mul_i64_u16, mul_wide, Divisor32, NO_HARDWARE_DIVIDE,
-    NO_WIDE_MULTIPLY,
+    div_rem_u32_soft, floor_div_i64, mul_i64_i32, mul_i64_u16, mul_wide, Divisor32,
+    NO_HARDWARE_DIVIDE, NO_WIDE_MULTIPLY,
 };
 use crate::project::ScreenVertex;
 use fixed::types::I16F16;
@@ -58,8 +58,8 @@ impl EdgeWalk {
     /// `None` if the edge is horizontal or upside down.
     pub fn new<const S: u32>(a: (i32, i32), b: (i32, i32), row: i32) -> Option<EdgeWalk> {
         // Doubled differences are below 2^24, so the slope's quotient and remainder take one
-        // 32-bit division (a single SDIV, or a 32-bit library call on thumbv6m, which a steep
-        // edge skips).
+        // 32-bit division (a single SDIV; on thumbv6m `floor_div_rem_i32`, by multiplies,
+        // which a steep edge skips).
         let dx = 2 * (b.0 - a.0);
         let dy = 2 * (b.1 - a.1);
         if dy <= 0 {
@@ -72,6 +72,7 @@ impl EdgeWalk {
         };
         let (step, step_rem) = match slope {
             Some(s) => s,
+            None if NO_HARDWARE_DIVIDE => floor_div_rem_i32(dx, dy),
             None => (dx.div_euclid(dy), dx.rem_euclid(dy)),
         };
         // Edge x at the row centre is ax + t·dx/dy with t = yc − ay.
@@ -125,6 +126,22 @@ fn steep_slope(dx: i32, dy: i32) -> Option<(i32, i32)> {
         Some((0, dx))
     } else {
         Some((-1, dx + dy))
+    }
+}
+
+/// `(dx.div_euclid(dy), dx.rem_euclid(dy))` for `dy > 0` by [`div_rem_u32_soft`] on the
+/// magnitudes, for the core without a divider ([`NO_HARDWARE_DIVIDE`]). Test
+/// `floor_div_rem_i32_equals_the_division`.
+#[inline]
+fn floor_div_rem_i32(dx: i32, dy: i32) -> (i32, i32) {
+    let d = dy.unsigned_abs();
+    let (q, r) = div_rem_u32_soft(dx.unsigned_abs(), d);
+    if dx >= 0 {
+        (q as i32, r as i32)
+    } else if r == 0 {
+        ((q as i32).wrapping_neg(), 0)
+    } else {
+        ((q as i32).wrapping_neg().wrapping_sub(1), (d - r) as i32)
     }
 }
 
@@ -1503,6 +1520,45 @@ mod tests {
                 }
                 None => assert!(dx.unsigned_abs() >= dy as u32, "{dx} / {dy}"),
             }
+        }
+    }
+
+    #[test]
+    fn floor_div_rem_i32_equals_the_division() {
+        let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
+        let mut next = || rng.next_u64();
+        let mut pairs = std::vec![
+            (i32::MIN, 1),
+            (i32::MIN, 2),
+            (i32::MIN, 3),
+            (i32::MIN, i32::MAX)
+        ];
+        for dy in [1, 2, 3, 1 << 30, i32::MAX] {
+            for dx in [
+                0,
+                1,
+                -1,
+                dy,
+                -dy,
+                dy - 1,
+                1 - dy,
+                dy.wrapping_add(1),
+                (-dy).wrapping_sub(1),
+                i32::MAX,
+                i32::MIN + 1,
+            ] {
+                pairs.push((dx, dy));
+            }
+        }
+        for _ in 0..1_000_000 {
+            let dy = ((next() as u32 >> 1) >> (next() % 31)).max(1) as i32;
+            let dx = (next() as i32) >> (next() % 32);
+            pairs.push((dx, dy));
+            pairs.push((dx.wrapping_sub(dx % dy), dy));
+        }
+        for (dx, dy) in pairs {
+            let want = (dx.div_euclid(dy), dx.rem_euclid(dy));
+            assert_eq!(floor_div_rem_i32(dx, dy), want, "{dx} / {dy}");
         }
     }
 
