@@ -170,7 +170,7 @@ impl SoftDivisor {
 /// halving the range five times: inline comparisons, where `leading_zeros` is a call of
 /// `__clzsi2` on ARMv6-M.
 #[inline]
-fn normalize(d: u32) -> (u32, u32) {
+const fn normalize(d: u32) -> (u32, u32) {
     let (mut x, mut s) = (d, 0);
     if x >> 16 == 0 {
         x <<= 16;
@@ -713,7 +713,8 @@ pub const fn isqrt32_bitwise(v: u32) -> u32 {
     let mut rem = v;
     let mut root = 0u32;
     // The highest power of 4 not above v.
-    let mut bit = 1u32 << ((31 - v.leading_zeros()) & !1);
+    // (`normalize`'s comparisons: `leading_zeros` is a call on ARMv6-M, the core this serves.)
+    let mut bit = 1u32 << ((31 - normalize(v).1) & !1);
     while bit != 0 {
         if rem >= root + bit {
             rem -= root + bit;
@@ -817,6 +818,32 @@ fn isqrt_u62(n: u64) -> u64 {
     r1 - (r1 * r1 > n) as u64
 }
 
+/// `64 − v.leading_zeros()`: on ARMv6-M, which has no count-leading-zeros instruction (each
+/// `leading_zeros` is a call of `__clzsi2`, [`NO_HARDWARE_DIVIDE`]'s cores), by [`normalize`]'s
+/// comparisons on the high or the low word; elsewhere the instruction. The same either way
+/// (test `bit_length_is_64_minus_leading_zeros`).
+#[inline]
+fn bit_length_u64(v: u64) -> u32 {
+    if NO_HARDWARE_DIVIDE {
+        bit_length_u64_in_words(v)
+    } else {
+        64 - v.leading_zeros()
+    }
+}
+
+/// [`bit_length_u64`] from [`normalize`], on every target (tested on the host too).
+#[inline]
+fn bit_length_u64_in_words(v: u64) -> u32 {
+    let (hi, lo) = ((v >> 32) as u32, v as u32);
+    if hi != 0 {
+        64 - normalize(hi).1
+    } else if lo != 0 {
+        32 - normalize(lo).1
+    } else {
+        0
+    }
+}
+
 /// `v` shifted (left or right, the same for every component) so that its largest component
 /// has exactly `bits` significant bits (`2^(bits-1) <= max |c| <= 2^bits`), for `bits <= 30`;
 /// `None` for the zero vector. Scaling small vectors up keeps the integer square root of
@@ -833,7 +860,7 @@ pub(crate) fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i32; 3]> {
     if max == 0 {
         return None;
     }
-    let len = 64 - max.leading_zeros();
+    let len = bit_length_u64(max);
     Some(if len > bits {
         // |c >> s| <= 2^bits.
         let s = len - bits;
@@ -1031,6 +1058,28 @@ mod tests {
                 assert_eq!(mul_i64_u16_in_words(a, b), want, "{a} * {b}");
                 assert_eq!(mul_i64_u16(a, b), want, "{a} * {b}");
             }
+        }
+    }
+
+    #[test]
+    fn bit_length_is_64_minus_leading_zeros() {
+        let mut rng = crate::test_rng::XorShift64::new(0x2d35_8dcc_aa6c_78a5u64);
+        for k in 0..64 {
+            for v in [
+                1u64 << k,
+                (1u64 << k) - 1,
+                (1u64 << k) + 1,
+                u64::MAX >> k,
+                0,
+            ] {
+                assert_eq!(bit_length_u64_in_words(v), 64 - v.leading_zeros(), "{v}");
+                assert_eq!(bit_length_u64(v), 64 - v.leading_zeros(), "{v}");
+            }
+        }
+        for _ in 0..100_000 {
+            let x = rng.next_u64();
+            let v = x >> (x % 64);
+            assert_eq!(bit_length_u64_in_words(v), 64 - v.leading_zeros(), "{v}");
         }
     }
 

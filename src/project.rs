@@ -15,7 +15,7 @@
 
 use crate::depth::Depth;
 use crate::math::{
-    floor_div_i64, i16f16_from_f32, mul_wide, shr_i64, SoftDivisor, NO_HARDWARE_DIVIDE,
+    floor_div_i64, i16f16_from_f32, mul_i64_i32, mul_wide, shr_i64, SoftDivisor, NO_HARDWARE_DIVIDE,
 };
 use crate::vertex::EyePoint;
 use fixed::types::I16F16;
@@ -209,7 +209,13 @@ impl<const S: u32> Viewport<S> {
         let ny = self.ay.apply(p.y.to_bits());
         // round(c/2 + n/w) = floor((c·w + 2n + w) / 2w)
         let (x, y) = if NO_HARDWARE_DIVIDE {
-            floor_div_pair(cx * w + 2 * nx + w, cy * w - 2 * ny + w, 2 * w)
+            // `c·w` by `mul_i64_i32` (`w` fits 32 bits): no `i64` multiply call on ARMv6-M.
+            let w32 = p.w.to_bits();
+            floor_div_pair(
+                mul_i64_i32(cx, w32) + 2 * nx + w,
+                mul_i64_i32(cy, w32) - 2 * ny + w,
+                2 * w,
+            )
         } else {
             (
                 floor_div(cx * w + 2 * nx + w, 2 * w),
