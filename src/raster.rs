@@ -77,7 +77,7 @@ impl EdgeWalk {
         };
         // Edge x at the row centre is ax + t·dx/dy with t = yc − ay.
         let t = (((2 * row as i64) + 1) << S) - 2 * a.1 as i64;
-        let placed = if NARROW_PLACEMENT {
+        let placed = if NO_WIDE_MULTIPLY {
             place_narrow::<S>(a.0, t, dx, dy, step, step_rem)
         } else {
             None
@@ -185,7 +185,9 @@ fn place_wide<const S: u32>(ax: i32, t: i64, dy: i32, step: i32, step_rem: i32) 
     )
 }
 
-/// [`place_wide`] in 32-bit arithmetic, for Arm cores ([`NARROW_PLACEMENT`]): `None` unless the row is the first centre row at or below `a`
+/// [`place_wide`] in 32-bit arithmetic, for the core without a 32 × 32 → 64-bit multiply
+/// ([`NO_WIDE_MULTIPLY`], where every `i64` product or comparison is several instructions or
+/// a call): `None` unless the row is the first centre row at or below `a`
 /// (`0 <= t < 2^(S+1)`) and `|dx|, dy < 2^(28−S)`, `|ax| < 2^28` (every on-screen edge with
 /// `S <= 4`). Then `|p| < 2^31` (`|step| <= |dx|`) and `0 <= m' + den − 1 < 3·den < 2^31`,
 /// so the same steps in `i32` give the same column and remainder (test
@@ -224,12 +226,6 @@ fn place_narrow<const S: u32>(
     }
     Some((x, r >> (S + 1)))
 }
-
-/// [`EdgeWalk::new`] tries [`place_narrow`] before [`place_wide`] on Arm: on ARMv6-M every
-/// `i64` product and comparison of the wide form is several instructions or a call, and on
-/// Cortex-M4 the 32-bit form measured 1.3 % fewer instructions a frame too (docs/speed.md
-/// item 17). On RISC-V the wide form is the cheaper one (RV32 `mulh` gives the high word).
-const NARROW_PLACEMENT: bool = cfg!(target_arch = "arm");
 
 /// A triangle being walked row by row: a long edge on one side, two short edges on the other.
 #[derive(Clone, Copy, Debug)]

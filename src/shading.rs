@@ -310,46 +310,6 @@ impl<const N: u32> Interpolation for PerSegment<N> {
     }
 }
 
-/// Whether [`Flat`]'s span fill runs from the span's right end ([`fill_backwards`]): on Arm
-/// cores with a 32 × 32 → 64-bit multiply (Cortex-M3/M4/M7), where that loop measured about
-/// 1 % to 1.7 % fewer instructions a frame (docs/speed.md item 18); on ARMv6-M it measured
-/// slower (its loop reloads the step from the stack) and on RISC-V the forward loop unrolls.
-const FILL_BACKWARDS: bool = cfg!(all(target_arch = "arm", target_has_atomic = "32"));
-
-/// [`Flat`]'s fill from the span's right end down to its left: the same pixels, depths and
-/// count as the forward loop. The depth runs back from its value at the last pixel, the same
-/// wrapping sums as walking forward (test `backward_fill_equals_forward`).
-#[inline(always)]
-fn fill_backwards<P: RowPixel, Z: DepthFormat>(
-    color: &P,
-    span: SpanDepth,
-    depth: &mut [Z],
-    pixels: &mut [P],
-) -> u32 {
-    let n = depth.len().min(pixels.len());
-    let mut written = 0;
-    let mut q = span
-        .q
-        .wrapping_add(span.dq.wrapping_mul((n as i32).wrapping_sub(1)));
-    let mut i = n;
-    while i > 0 {
-        i -= 1;
-        // One pixel per iteration (see the forward loop).
-        core::hint::black_box(());
-        if let (Some(z), Some(p)) = (depth.get_mut(i), pixels.get_mut(i)) {
-            // Strictly nearer wins: on an exact tie the surface drawn first keeps the pixel.
-            let stored = Z::store(q);
-            if stored > *z {
-                *z = stored;
-                *p = *color;
-                written += 1;
-            }
-        }
-        q = q.wrapping_sub(span.dq);
-    }
-    written
-}
-
 impl sealed::Sealed for Flat {}
 impl sealed::Sealed for Unlit {}
 impl<I: Interpolation> sealed::Sealed for Gouraud<I> {}
@@ -376,9 +336,6 @@ impl Shading for Flat {
         depth: &mut [Z],
         pixels: &mut [P],
     ) -> u32 {
-        if FILL_BACKWARDS {
-            return fill_backwards(color, span, depth, pixels);
-        }
         let mut q = span.q;
         let mut written = 0;
         for (z, p) in depth.iter_mut().zip(pixels.iter_mut()) {
@@ -568,49 +525,6 @@ mod tests {
     use crate::project::SubPx;
     use fixed::types::I16F16;
     use std::vec::Vec;
-
-    #[test]
-    fn backward_fill_equals_forward() {
-        use crate::depth::Depth16;
-        use embedded_graphics::pixelcolor::Rgb565;
-        let mut rng = crate::test_rng::XorShift64::new(0x1405_7b7e_f767_814fu64);
-        fn both<Z: DepthFormat>(
-            rng: &mut crate::test_rng::XorShift64,
-            cell: impl Fn(u64) -> Z,
-        ) -> u32 {
-            let n = (rng.next_u64() % 41) as usize;
-            let x = rng.next_u64();
-            let span = SpanDepth {
-                x0: 0,
-                y: 0,
-                q: x as i32,
-                // Small, large and wrapping steps.
-                dq: match x % 3 {
-                    0 => (x >> 40) as i32 >> (x % 20),
-                    1 => (x >> 32) as i32,
-                    _ => i32::MIN,
-                },
-            };
-            let depth: Vec<Z> = (0..n).map(|_| cell(rng.next_u64())).collect();
-            let pixels: Vec<Rgb565> = (0..n)
-                .map(|_| Rgb565::new(rng.next_u64() as u8 & 31, 7, 9))
-                .collect();
-            let color = Rgb565::new(1, 2, 3);
-            let (mut d0, mut p0) = (depth.clone(), pixels.clone());
-            let (mut d1, mut p1) = (depth, pixels);
-            let forward = Flat::fill(&color, span, &mut d0, &mut p0);
-            let backward = fill_backwards(&color, span, &mut d1, &mut p1);
-            assert_eq!((forward, &d0, &p0), (backward, &d1, &p1), "{span:?}");
-            forward
-        }
-        let mut written = 0;
-        for _ in 0..20_000 {
-            written += both(&mut rng, |v| Depth::from_bits(v as i32));
-            written += both(&mut rng, |v| Depth16::from_bits(v as u16));
-        }
-        // Both outcomes of the depth test are met.
-        assert!(written > 100_000, "{written}");
-    }
 
     /// A triangle receding steeply to the right: vertex depths `q` 1.0 on the left and 0.05 on
     /// the right (20× farther), red left, blue right. Screen positions in pixels at 4 sub-bits.
