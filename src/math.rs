@@ -449,7 +449,7 @@ pub(crate) fn floor_div_i64(n: i64, d: i64) -> i64 {
 /// divider (Cortex-M3/M4, RV32IM) have none for 64 bits, and `compiler_builtins` builds the
 /// 64-bit division from a software 32-bit one: this is several times cheaper there. On cores
 /// without any divider (Cortex-M0) its 32-bit divisions are [`div_rem_u32_soft`] and
-/// [`div_rem_below_soft`]'s. A 64-bit core divides natively: the same value.
+/// those of [`div_rem_below_with`]'s soft path. A 64-bit core divides natively: the same value.
 #[inline]
 pub(crate) fn div_rem_u64_u32(n: u64, d: u32) -> (u64, u32) {
     if cfg!(target_pointer_width = "64") {
@@ -477,18 +477,33 @@ fn div_rem_u64_u32_in_halves(n: u64, d: u32) -> (u64, u32) {
 /// `(u1·2^32 + u0) / v` and its remainder for `u1 < v` (so the quotient fits 32 bits).
 #[inline]
 pub(crate) fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
-    if NO_HARDWARE_DIVIDE {
-        return div_rem_below_soft(u1, u0, v);
-    }
+    div_rem_below_with::<NO_HARDWARE_DIVIDE>(u1, u0, v)
+}
+
+/// [`div_rem_below`]'s steps (Knuth, Algorithm D, two 16-bit digits), on every target with
+/// either `SOFT` (tested on the host too). With `SOFT` (the core without a divider): [`div_rem_u32_soft`] for a numerator below 2^32, the normalisation by
+/// [`normalize`] (no `__clzsi2` call), and each digit's first estimate `⌊top / vn1⌋` from one
+/// [`SoftDivisor`] shared by the two digits; else the division instruction and
+/// `leading_zeros`. Always inlined: out of line (one copy for `Divisor32::new`'s normalised
+/// divisors and for the others) the demo frame on thumbv6m took 2 % more.
+#[inline(always)]
+fn div_rem_below_with<const SOFT: bool>(u1: u32, u0: u32, v: u32) -> (u32, u32) {
     const B: u32 = 1 << 16;
     if u1 == 0 {
         // The common case (numerator below 2^32): one division.
+        if SOFT {
+            return div_rem_u32_soft(u0, v);
+        }
         let v = v.max(1);
         return (u0 / v, u0 % v);
     }
     // Normalize: the divisor's top bit set (u1 < v, so v > 0 and the shift is below 32).
-    let s = v.leading_zeros();
-    let v = v << s;
+    let (v, s) = if SOFT {
+        normalize(v)
+    } else {
+        let s = v.leading_zeros();
+        (v << s, s)
+    };
     // `v`'s top bit is set, so `vn1 >= 2^15` already: or-ing that bit in changes nothing but
     // lets the compiler see it is not zero (no division-by-zero panic path: the panic-never
     // link check).
@@ -496,47 +511,11 @@ pub(crate) fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
     let un32 = (u1 << s) | if s == 0 { 0 } else { u0 >> (32 - s) };
     let un10 = u0 << s;
     let (un1, un0) = (un10 >> 16, un10 & 0xFFFF);
-    // One 16-bit digit of the quotient of `top·2^16 + next` (`top < v`): the estimate from
-    // `vn1 >= 2^15` is at most two too large (Knuth, Algorithm D).
-    let digit = |top: u32, next: u32| {
-        let mut q = top / vn1;
-        let mut rhat = top - q * vn1;
-        while q >= B || q * vn0 > (rhat << 16 | next) {
-            q -= 1;
-            rhat += vn1;
-            if rhat >= B {
-                break;
-            }
-        }
-        q
-    };
-    let q1 = digit(un32, un1);
-    let un21 = (un32 << 16 | un1).wrapping_sub(q1.wrapping_mul(v));
-    let q0 = digit(un21, un0);
-    let r = (un21 << 16 | un0).wrapping_sub(q0.wrapping_mul(v)) >> s;
-    (q1 << 16 | q0, r)
-}
-
-/// [`div_rem_below`] for the core without a divider ([`NO_HARDWARE_DIVIDE`]), on every target
-/// (tested on the host too): the same steps, with [`div_rem_u32_soft`] for a numerator below
-/// 2^32, the normalisation by [`normalize`] (no `__clzsi2` call), and each digit's first
-/// estimate `⌊top / vn1⌋` from one [`SoftDivisor`] shared by the two digits. Always inlined:
-/// out of line (one copy for `Divisor32::new`'s normalised divisors and for the others) the
-/// demo frame on thumbv6m took 2 % more.
-#[inline(always)]
-fn div_rem_below_soft(u1: u32, u0: u32, v: u32) -> (u32, u32) {
-    const B: u32 = 1 << 16;
-    if u1 == 0 {
-        return div_rem_u32_soft(u0, v);
-    }
-    let (v, s) = normalize(v);
-    let (vn1, vn0) = ((v >> 16) | 0x8000, v & 0xFFFF);
-    let un32 = (u1 << s) | if s == 0 { 0 } else { u0 >> (32 - s) };
-    let un10 = u0 << s;
-    let (un1, un0) = (un10 >> 16, un10 & 0xFFFF);
     let by = SoftDivisor::new(vn1);
+    // One 16-bit digit of the quotient of `top·2^16 + next` (`top < v`): the estimate from
+    // `vn1 >= 2^15` is at most two too large.
     let digit = |top: u32, next: u32| {
-        let mut q = by.div_rem(top).0;
+        let mut q = if SOFT { by.div_rem(top).0 } else { top / vn1 };
         let mut rhat = top - q * vn1;
         while q >= B || q * vn0 > (rhat << 16 | next) {
             q -= 1;
@@ -579,7 +558,7 @@ fn mul_wide_u32_in_halves(a: u32, b: u32) -> u64 {
 /// A 32-bit divisor `D >= 1` prepared for several divisions: one reciprocal, then every
 /// quotient from multiplies and at most two corrections, exactly `u64` division's quotient and
 /// remainder ([`div_rem_u64_u32`]'s). On cores without a divider (Cortex-M0) the reciprocal is
-/// [`div_rem_below_soft`]'s two digits, by multiplies.
+/// the two digits of [`div_rem_below_with`]'s soft path, by multiplies.
 ///
 /// The step is Möller and Granlund's (“Improved division by invariant integers”, 2011,
 /// Algorithm 4). Why it is exact, with `β = 2^32`, `d = D·2^s` normalized (`β/2 <= d < β`),
@@ -1142,7 +1121,11 @@ mod tests {
             let (hi, lo) = ((n >> 32) as u32, n as u32);
             let r_hi = hi % d;
             let want_lo = (want.0 as u32, want.1);
-            assert_eq!(div_rem_below_soft(r_hi, lo, d), want_lo, "{n} / {d}");
+            assert_eq!(
+                div_rem_below_with::<true>(r_hi, lo, d),
+                want_lo,
+                "{n} / {d}"
+            );
         };
         for n in ns {
             for d in ds {
@@ -1347,7 +1330,11 @@ mod tests {
             // The 32-bit targets' reciprocal (the host divides `u64`), with and without a
             // divider.
             assert_eq!(div_rem_below(!by.d, u32::MAX, by.d).0, by.v, "{d}");
-            assert_eq!(div_rem_below_soft(!by.d, u32::MAX, by.d).0, by.v, "{d}");
+            assert_eq!(
+                div_rem_below_with::<true>(!by.d, u32::MAX, by.d).0,
+                by.v,
+                "{d}"
+            );
             check(x >> (x % 64), &by, d);
             // Quotients and remainders at the word boundaries: n = q·d + r with chosen q, r.
             let q = (x >> 20) & 0xFFFF_FFFF;
