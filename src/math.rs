@@ -802,7 +802,7 @@ fn isqrt_u62(n: u64) -> u64 {
 /// comparisons on the high or the low word; elsewhere the instruction. The same either way
 /// (test `bit_length_is_64_minus_leading_zeros`).
 #[inline]
-fn bit_length_u64(v: u64) -> u32 {
+pub(crate) fn bit_length_u64(v: u64) -> u32 {
     if NO_HARDWARE_DIVIDE {
         bit_length_u64_in_words(v)
     } else {
@@ -960,7 +960,14 @@ impl NormalPrecision for NarrowNormals {
 /// is in I2F30 bits with its low 15 bits zero.
 pub(crate) fn cosine_i32(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
     let s = fit_bits(v, 15)?;
-    let len = s.iter().map(|&c| (c * c) as u32).sum::<u32>().isqrt();
+    let square = s.iter().map(|&c| (c * c) as u32).sum::<u32>();
+    // Without a divider, core's `isqrt` and `/` are library calls: the bitwise root and the
+    // soft division give the same values from shifts and multiplies.
+    let len = if NO_HARDWARE_DIVIDE {
+        isqrt32_bitwise(square)
+    } else {
+        square.isqrt()
+    };
     if len == 0 {
         return None;
     }
@@ -969,7 +976,11 @@ pub(crate) fn cosine_i32(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
     let dot = (0..3).fold(0i32, |acc, k| {
         acc.wrapping_add(s[k].wrapping_mul(unit[k] >> 15))
     });
-    let q = (dot.unsigned_abs() / len) as i32;
+    let q = if NO_HARDWARE_DIVIDE {
+        div_rem_u32_soft(dot.unsigned_abs(), len).0
+    } else {
+        dot.unsigned_abs() / len
+    } as i32;
     Some((if dot < 0 { -q } else { q }) << 15)
 }
 

@@ -15,7 +15,8 @@
 
 use crate::depth::Depth;
 use crate::math::{
-    floor_div_i64, i16f16_from_f32, mul_i64_i32, mul_wide, shr_i64, SoftDivisor, NO_HARDWARE_DIVIDE,
+    bit_length_u64, floor_div_i64, i16f16_from_f32, mul_i64_i32, mul_wide, shr_i64, SoftDivisor,
+    NO_HARDWARE_DIVIDE,
 };
 use crate::vertex::EyePoint;
 use fixed::types::I16F16;
@@ -95,6 +96,14 @@ impl Scale {
         // The mantissa is below 2^25: a 32 × 32 → 64-bit product, and the shift by a variable
         // amount in 32-bit words (neither a call on ARMv6-M).
         shr_i64(mul_wide(self.mantissa, v), self.shift)
+    }
+
+    /// `floor(self · v) >> k` for `|v| <= 2^31`, `k < 64`, as one shift: floors by powers
+    /// of two compose (`(a >> s) >> k = a >> (s + k)`, and from 63 on every shift gives the
+    /// sign).
+    #[inline]
+    fn apply_shifted(self, v: i32, k: u32) -> i64 {
+        shr_i64(mul_wide(self.mantissa, v), (self.shift + k).min(63))
     }
 }
 
@@ -254,18 +263,45 @@ impl<const S: u32> Viewport<S> {
         if w <= 0 {
             return None;
         }
-        let k = (32 - w.leading_zeros()).saturating_sub(16);
-        let wn = (w as u32) >> k;
+        // On ARMv6-M (no divider, no wide multiply, no count-leading-zeros instruction) the
+        // bit length, the division, the shifts and the products below are written out in
+        // 32-bit operations instead of library calls; every value is the same.
+        let length = if NO_HARDWARE_DIVIDE {
+            bit_length_u64(w as u64)
+        } else {
+            32 - w.leading_zeros()
+        };
+        let k = length.saturating_sub(16);
         // wn >= 1: w > 0 and k keeps its top bit.
-        let r = (u32::MAX / wn.max(1)) as i64;
-        let offset = |n: i64| ((n >> k) * r) >> (32 - F);
+        let wn = ((w as u32) >> k).max(1);
+        let r = if NO_HARDWARE_DIVIDE {
+            SoftDivisor::new(wn).div_rem(u32::MAX).0
+        } else {
+            u32::MAX / wn
+        } as i64;
+        // r fits i32 unless wn = 1 (w of one bit, below any near plane).
+        let times_r = |v: i64| match i32::try_from(r) {
+            Ok(r) if NO_HARDWARE_DIVIDE => mul_i64_i32(v, r),
+            _ => v * r,
+        };
+        // ⌊n / 2^k⌋ · r / 2^(32 − F) for n = ⌊scale · v⌋.
+        let offset = |scale: Scale, v: I16F16| {
+            // One variable 64-bit shift instead of two where those are written out in words;
+            // the two shifts are the shorter code where they are instructions.
+            let n = if NO_HARDWARE_DIVIDE {
+                scale.apply_shifted(v.to_bits(), k)
+            } else {
+                scale.apply(v.to_bits()) >> k
+            };
+            times_r(n) >> (32 - F)
+        };
         let half = 1i64 << (F - 1);
         let cx = (self.width as i64) << (S + F - 1);
         let cy = (self.height as i64) << (S + F - 1);
-        let x = (cx + offset(self.ax.apply(p.x.to_bits())) + half) >> F;
-        let y = (cy - offset(self.ay.apply(p.y.to_bits())) + half) >> F;
+        let x = (cx + offset(self.ax, p.x) + half) >> F;
+        let y = (cy - offset(self.ay, p.y) + half) >> F;
         let q = if depth {
-            ((self.near.to_bits() as i64) * r) >> (2 + k)
+            shr_i64(times_r(self.near.to_bits() as i64), 2 + k)
         } else {
             0
         };
@@ -502,6 +538,47 @@ pub(crate) mod tests {
                 let q = exact.q.to_bits() as f64;
                 assert!(((fast.q.to_bits() - exact.q.to_bits()).abs() as f64) <= q / 16384.0 + 1.0);
             }
+        }
+    }
+
+    /// One shift by `shift + k` (capped at 63) is the scaled value shifted by `k`: every shift
+    /// of a scale (its exponent over the whole range, the cap at 62), both signs, `k` up to 63.
+    #[test]
+    fn shifted_scale_is_the_scale_shifted() {
+        let mut rng = crate::test_rng::XorShift32::new(0x9e37_79b9u32);
+        for e in 1..152u32 {
+            let scale = Scale::new(f32::from_bits(e << 23 | (rng.next_u32() & 0x7F_FFFF)));
+            let Some(scale) = scale else { continue };
+            for v in [
+                0,
+                1,
+                -1,
+                i32::MAX,
+                i32::MIN,
+                rng.next_u32() as i32,
+                -(rng.next_u32() as i32 >> 7),
+            ] {
+                for k in 0..64 {
+                    assert_eq!(
+                        scale.apply_shifted(v, k),
+                        scale.apply(v) >> k,
+                        "{scale:?} {v} {k}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The reciprocal projection's soft division (its ARMv6-M form) is `u32::MAX / wn` for
+    /// every `wn` it can take (a 16-bit top of `w`), so both forms project alike.
+    #[test]
+    fn soft_reciprocal_is_the_division() {
+        for wn in 1..=u16::MAX as u32 {
+            assert_eq!(
+                SoftDivisor::new(wn).div_rem(u32::MAX).0,
+                u32::MAX / wn,
+                "{wn}"
+            );
         }
     }
 
