@@ -762,8 +762,8 @@ fn isqrt_u64(n: u64) -> u64 {
 /// `floor(sqrt(n))` for `n < 2^62` in 32-bit operations (a larger `n` is taken as
 /// `2^62 - 1`): the 32-bit root of `n`'s top bits, then one Newton step and one
 /// correction, each step in the forms that need no library call on ARMv6-M
-/// ([`bit_length_u64`], [`shr_low_word`], [`div_rem_u64_u32`], [`mul_wide_u32`]). `core`'s `u64::isqrt` works in 64-bit integers throughout, several times the
-/// cost on a 32-bit core.
+/// ([`bit_length_u64`], [`shr_low_word`], [`div_rem_u64_u32`], [`mul_wide_u32`]). `core`'s
+/// `u64::isqrt` works in 64-bit integers throughout, several times the cost on a 32-bit core.
 ///
 /// Why it is exact: with `n >> 2k` below 2^32 and at least 2^30 (`k` chosen so), the root
 /// `r0 = isqrt32(n >> 2k) · 2^k` is at most `√n` and at least `2^(15+k)`, and

@@ -22,9 +22,9 @@
 //! scene, instructions on thumbv7em and thumbv6m for the demo orbit and every corpus scene, host
 //! time, flash), with the default and single-knob variations beside the presets. On thumbv6m,
 //! which multiplies and divides 64-bit integers in software, `Fast` takes about 1.3× fewer
-//! instructions per demo frame than `Exact` and `Balanced` slightly fewer than the default. [`Micromath`] set-up is in no preset: its camera
-//! error moves vertices beyond the sub-pixel error bound (real mismatches) and saves under 1 KB
-//! of flash.
+//! instructions per demo frame than `Exact`, and `Balanced` slightly fewer than the default.
+//! [`Micromath`] set-up is in no preset: its camera error moves vertices beyond the sub-pixel
+//! error bound (real mismatches) and saves under 1 KB of flash.
 //!
 //! A preset gives the [`RenderOptions`] and the [`Camera`] of a frame:
 //!
