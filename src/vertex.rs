@@ -396,12 +396,35 @@ fn face_normal(v: [&Vertex; 3]) -> [i64; 3] {
     let d = |a: &Vertex, b: &Vertex, k: usize| b[k].to_bits().wrapping_sub(a[k].to_bits());
     let e1 = [0, 1, 2].map(|k| d(v[0], v[1], k));
     let e2 = [0, 1, 2].map(|k| d(v[0], v[2], k));
+    if NO_WIDE_MULTIPLY {
+        if let Some(n) = short_edge_normal(e1, e2) {
+            return n;
+        }
+    }
     let cross = |a: i32, b: i32, c: i32, d: i32| mul_wide(a, b) - mul_wide(c, d);
     [
         cross(e1[1], e2[2], e1[2], e2[1]),
         cross(e1[2], e2[0], e1[0], e2[2]),
         cross(e1[0], e2[1], e1[1], e2[0]),
     ]
+}
+
+/// [`face_normal`] for edges `e1`, `e2` whose components are all below 2^15 in magnitude (half
+/// a unit: most meshes' triangles), `None` for others: each product is then below 2^30 and each
+/// difference below 2^31, so one 32-bit multiply each gives the cross product where a 64-bit
+/// product takes four (ARMv6-M). The same values (test `short_edge_normal_is_the_cross_product`).
+#[inline]
+fn short_edge_normal(e1: [i32; 3], e2: [i32; 3]) -> Option<[i64; 3]> {
+    let or = e1.iter().chain(&e2).fold(0, |m, c| m | c.unsigned_abs());
+    if or >= 1 << 15 {
+        return None;
+    }
+    let cross = |a: i32, b: i32, c: i32, d: i32| (a * b - c * d) as i64;
+    Some([
+        cross(e1[1], e2[2], e1[2], e2[1]),
+        cross(e1[2], e2[0], e1[0], e2[2]),
+        cross(e1[0], e2[1], e1[1], e2[0]),
+    ])
 }
 
 impl Lighting {
@@ -662,6 +685,34 @@ mod tests {
     /// The face normal from `i32` edges equals the cross product in `i128` for vertices at
     /// the ends of the model envelope (every corner of the ±2^28-bit cube, and edges of
     /// ±2^29 on every axis), and for random ones inside it.
+    #[test]
+    fn short_edge_normal_is_the_cross_product() {
+        let wide = |a: [i32; 3], b: [i32; 3]| {
+            let c = |i: usize, j: usize| a[i] as i64 * b[j] as i64 - a[j] as i64 * b[i] as i64;
+            [c(1, 2), c(2, 0), c(0, 1)]
+        };
+        let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15);
+        let edges = [0, 1, -1, (1 << 15) - 1, -(1 << 15) + 1, 1 << 15, -(1 << 15)];
+        let mut pick = |k: u64| match k % 4 {
+            0 => edges[(rng.next_u64() % edges.len() as u64) as usize],
+            _ => (rng.next_u64() as i32) >> (rng.next_u64() % 32),
+        };
+        let (mut short, mut long) = (0, 0);
+        for k in 0..400_000u64 {
+            let (a, b) = ([(); 3].map(|_| pick(k)), [(); 3].map(|_| pick(k >> 2)));
+            let fits = a.iter().chain(&b).all(|c| c.unsigned_abs() < 1 << 15);
+            match short_edge_normal(a, b) {
+                Some(n) => {
+                    assert_eq!(n, wide(a, b), "{a:?} {b:?}");
+                    short += 1;
+                }
+                None => long += 1,
+            }
+            assert_eq!(short_edge_normal(a, b).is_some(), fits, "{a:?} {b:?}");
+        }
+        assert!(short > 10_000 && long > 10_000, "{short} {long}");
+    }
+
     #[test]
     fn face_normal_at_the_extremes() {
         use crate::scene::MAX_MODEL_COORD;
