@@ -410,7 +410,7 @@ fn face_normal(v: [&Vertex; 3]) -> [i64; 3] {
 }
 
 /// [`face_normal`] for edges `e1`, `e2` whose components are all below 2^15 in magnitude (half
-/// a unit: most meshes' triangles), `None` for others: each product is then below 2^30 and each
+/// a unit, raw I16F16), `None` for others: each product is then below 2^30 and each
 /// difference below 2^31, so one 32-bit multiply each gives the cross product where a 64-bit
 /// product takes four (ARMv6-M). The same values (test `short_edge_normal_is_the_cross_product`).
 #[inline]
@@ -682,9 +682,8 @@ mod tests {
         assert_eq!(m.vertex::<W>(&v(0.0, 0.0, -3.0)), I2F30::from_bits(1 << 30));
     }
 
-    /// The face normal from `i32` edges equals the cross product in `i128` for vertices at
-    /// the ends of the model envelope (every corner of the ±2^28-bit cube, and edges of
-    /// ±2^29 on every axis), and for random ones inside it.
+    /// The short-edge face normal is the exact cross product wherever it answers, and it
+    /// answers exactly when every edge component is below 2^15 (both sides of the bound).
     #[test]
     fn short_edge_normal_is_the_cross_product() {
         let wide = |a: [i32; 3], b: [i32; 3]| {
@@ -713,6 +712,9 @@ mod tests {
         assert!(short > 10_000 && long > 10_000, "{short} {long}");
     }
 
+    /// The face normal from `i32` edges equals the cross product in `i128` for vertices at
+    /// the ends of the model envelope (every corner of the ±2^28-bit cube, and edges of
+    /// ±2^29 on every axis), and for random ones inside it.
     #[test]
     fn face_normal_at_the_extremes() {
         use crate::scene::MAX_MODEL_COORD;
