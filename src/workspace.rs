@@ -40,6 +40,22 @@ pub(crate) struct SpanZBuffer<'a, P, Z> {
     dirty: (usize, usize),
 }
 
+/// `row.fill(value)`, four elements to each loop test. `fill` of a value known only at run
+/// time (the background pixel) compiles to one store and one end test per pixel, about three
+/// instructions a pixel on Cortex-M; this loop takes about half that.
+#[inline]
+pub(crate) fn fill_by_fours<T: Copy>(row: &mut [T], value: T) {
+    let mut fours = row.chunks_exact_mut(4);
+    for four in &mut fours {
+        if let [a, b, c, d] = four {
+            (*a, *b, *c, *d) = (value, value, value, value);
+        }
+    }
+    for x in fours.into_remainder() {
+        *x = value;
+    }
+}
+
 impl<'a, P: RowPixel, Z: DepthFormat> SpanZBuffer<'a, P, Z> {
     pub(crate) fn new(depth: &'a mut [Z], pixels: &'a mut [P], background: P) -> Self {
         let width = pixels.len();
@@ -59,7 +75,7 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for SpanZBuffer<'_, 
         let (lo, hi) = self.dirty;
         if let (Some(d), Some(p)) = (self.depth.get_mut(lo..hi), self.pixels.get_mut(lo..hi)) {
             d.fill(Z::FAR);
-            p.fill(self.background);
+            fill_by_fours(p, self.background);
         } else {
             // Only a clean row (lo > hi: nothing written) has no range to clear.
             debug_assert!(
@@ -424,5 +440,25 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat, const INSTANCES: usize, B: BucketH
     ) -> Result<FrameStats, RenderError<K::Error>> {
         let (width, height) = (self.pixels.len(), self.heads.len());
         self.render_sized(width, height, scene, options, sink)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fill_by_fours;
+
+    #[test]
+    fn fill_by_fours_is_fill() {
+        // Every remainder of four, every offset into the row, over a row that is not the
+        // value to begin with: exactly the slice's elements change, all to the value.
+        for len in 0..=13 {
+            for start in 0..=3 {
+                let mut row = [7u16; 20];
+                let mut expected = row;
+                expected[start..start + len].fill(0xBEEF);
+                fill_by_fours(&mut row[start..start + len], 0xBEEF);
+                assert_eq!(row, expected, "len {len} start {start}");
+            }
+        }
     }
 }
