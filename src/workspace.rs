@@ -44,7 +44,7 @@ pub(crate) struct SpanZBuffer<'a, P, Z> {
 /// time (the background pixel) compiles to one store and one end test per pixel, about three
 /// instructions a pixel on Cortex-M; this loop takes about half that.
 #[inline]
-pub(crate) fn fill_by_fours<T: Copy>(row: &mut [T], value: T) {
+fn fill_by_fours<T: Copy>(row: &mut [T], value: T) {
     let mut fours = row.chunks_exact_mut(4);
     for four in &mut fours {
         if let [a, b, c, d] = four {
