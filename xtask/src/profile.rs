@@ -4,7 +4,9 @@
 //! (`icosphere`, ...) every view of that scene alone (`--cfg scanline3d_corpus_only`). QEMU logs every translated block and every block it executes
 //! (`-d in_asm,exec,nochain`); the count of each block times its length gives exact
 //! instructions per block. Prints the share of compiler built-ins (64-bit multiply and divide,
-//! memcpy), the top functions, and the top source lines of this repository, with the
+//! memcpy), the top functions, the top source lines of this repository and the top functions
+//! of its sources counted whether inlined or not (an instruction counts for the innermost one
+//! it comes from: `PlaneSolver::new` inlined into the set-up is `PlaneSolver::new`), with the
 //! built-ins charged to the call site that entered them (`llvm-addr2line`; the release profile
 //! keeps debug info). `cargo xtask profile trace [pure|hybrid] [TARGET]` does the same for the
 //! traced firmware's frame in one mode (thumbv7em unless a TARGET is named), and also prints per
@@ -77,17 +79,58 @@ fn is_builtin(name: &str) -> bool {
     name.starts_with("__") || name.contains("compiler_builtins")
 }
 
-/// Per address, the innermost frame that lies in this repository's `src/` or
-/// `firmware/examples/`, as `path:line`, and the outermost function inlined at it (the one called
-/// in the symbol's own body; the symbol itself when nothing is inlined there)
-/// (`llvm-addr2line -a -f -i -C`: an address line, then function and `path:line` lines for its
-/// inline chain, innermost first).
-fn source_lines(
-    elf: &std::path::Path,
-    addrs: &[u64],
-) -> Result<HashMap<u64, (String, String)>, String> {
+/// Where an executed instruction comes from.
+struct Site {
+    /// The innermost frame that lies in this repository's `src/` or `firmware/examples/`, as
+    /// `path:line` (empty when none does).
+    line: String,
+    /// The function that frame is in, inlined or not, as [`function_name`] prints it (empty
+    /// when none).
+    function: String,
+    /// The outermost function inlined at the address (the one called in the symbol's own
+    /// body; the symbol itself when nothing is inlined there).
+    inlined: String,
+}
+
+/// A function's name as the tables print it: no hash, no crate path, no generic arguments,
+/// and a trait method under its type (`<Flat as Shading>::fill` is `shading::Flat::fill`).
+fn function_name(name: &str) -> String {
+    let name = short_name(name).replace("..", "::");
+    // `<A as B>::f` → `A::f`.
+    let name = match name.strip_prefix('<').and_then(|rest| {
+        let mut depth = 1usize;
+        let end = rest.char_indices().find_map(|(i, c)| {
+            match c {
+                '<' => depth += 1,
+                '>' => depth -= 1,
+                _ => {}
+            }
+            (depth == 0).then_some(i)
+        })?;
+        let (inner, tail) = (&rest[..end], &rest[end + 1..]);
+        Some(format!("{}{tail}", inner.split(" as ").next().unwrap_or(inner)))
+    }) {
+        Some(n) => n,
+        None => name,
+    };
+    let mut out = String::new();
+    let mut depth = 0usize;
+    for c in name.chars() {
+        match c {
+            '<' => depth += 1,
+            '>' => depth = depth.saturating_sub(1),
+            _ if depth == 0 => out.push(c),
+            _ => {}
+        }
+    }
+    out.replace("scanline3d::", "").replace("_{{closure}}", "{closure}")
+}
+
+/// Per address, its [`Site`] (`llvm-addr2line -a -f -i -C`: an address line, then function and
+/// `path:line` lines for its inline chain, innermost first).
+fn source_lines(elf: &std::path::Path, addrs: &[u64]) -> Result<HashMap<u64, Site>, String> {
     let repo = root().to_string_lossy().into_owned() + "/";
-    let mut out: HashMap<u64, (String, String)> = HashMap::new();
+    let mut out: HashMap<u64, Site> = HashMap::new();
     for chunk in addrs.chunks(2000) {
         let text = Command::new("llvm-addr2line")
             .args(["-a", "-f", "-i", "-C", "-e"])
@@ -111,18 +154,26 @@ fn source_lines(
                 let function = lines.next().unwrap_or_default();
                 chain.push((function, lines.next().unwrap_or_default()));
             }
-            let line = chain.iter().find_map(|(_, place)| {
+            // The innermost place in our sources, and the function it is in (inlined or not).
+            let ours = chain.iter().find_map(|(function, place)| {
                 place
                     .strip_prefix(&repo)
                     .filter(|p| p.starts_with("src/") || p.starts_with("firmware/examples/"))
+                    .map(|p| (p, *function))
             });
             let outermost = chain.len().checked_sub(2).or(chain.len().checked_sub(1));
             let inlined = outermost.and_then(|i| chain.get(i)).map_or("?", |c| c.0);
-            if let Some(line) = line {
-                out.insert(a, (line.to_string(), inlined.to_string()));
-            } else {
-                out.insert(a, (String::new(), inlined.to_string()));
-            }
+            let (line, function) = ours.map_or((String::new(), String::new()), |(p, f)| {
+                (p.to_string(), function_name(f))
+            });
+            out.insert(
+                a,
+                Site {
+                    line,
+                    function,
+                    inlined: inlined.to_string(),
+                },
+            );
         }
     }
     Ok(out)
@@ -189,11 +240,16 @@ pub fn profile_patch(target: &str) -> Result<(), String> {
     profile_elf(target, &elf, "patch", |l| l.starts_with("frame "))
 }
 
-/// Per block start, its instruction count and last instruction; per executed block, its count.
+/// What the log says ran: per block and per instruction address, with the built-ins apart.
 #[derive(Default)]
 struct Counts {
-    blocks: HashMap<u64, (u64, u64)>,
+    /// Per translated block, by its first address, the addresses of its instructions.
+    blocks: HashMap<u64, Vec<u64>>,
+    /// Per block of code other than the built-ins, how many times it ran.
+    runs: HashMap<u64, u64>,
     per_function: HashMap<u64, u64>,
+    /// Per instruction address outside the built-ins, the instructions executed there and in
+    /// the built-ins it called.
     per_site: HashMap<u64, u64>,
     /// Per call site and built-in block, the built-ins' instructions alone.
     builtin_site: HashMap<(u64, u64), u64>,
@@ -201,8 +257,8 @@ struct Counts {
     builtin: u64,
 }
 
-/// Reads QEMU's `-d in_asm,exec,nochain` log: each executed block's instructions, with the
-/// built-ins charged to the call site that entered them.
+/// Reads QEMU's `-d in_asm,exec,nochain` log: each executed block's instructions, each charged
+/// to its own address, with the built-ins charged to the call site that entered them.
 fn count_blocks(log: impl BufRead, syms: &[(u64, u64, String)]) -> Result<Counts, String> {
     // QEMU lists a block when it translates it, before it first runs.
     let mut c = Counts::default();
@@ -219,7 +275,9 @@ fn count_blocks(log: impl BufRead, syms: &[(u64, u64, String)]) -> Result<Counts
             else {
                 continue;
             };
-            let (len, last) = c.blocks.get(&pc).copied().unwrap_or((1, pc));
+            let block = c.blocks.get(&pc);
+            let len = block.map_or(1, |b| b.len() as u64);
+            let last = block.and_then(|b| b.last().copied()).unwrap_or(pc);
             let is_builtin = *builtin_of
                 .entry(pc)
                 .or_insert_with(|| is_builtin(name_of(syms, pc)));
@@ -228,10 +286,11 @@ fn count_blocks(log: impl BufRead, syms: &[(u64, u64, String)]) -> Result<Counts
             if is_builtin {
                 c.builtin += len;
                 *c.builtin_site.entry((caller, pc)).or_default() += len;
+                *c.per_site.entry(caller).or_default() += len;
             } else {
                 caller = last;
+                *c.runs.entry(pc).or_default() += 1;
             }
-            *c.per_site.entry(caller).or_default() += len;
         } else if line.starts_with("IN:") || line.trim().is_empty() {
             listing = None;
         } else if let Some(addr) = line
@@ -239,9 +298,17 @@ fn count_blocks(log: impl BufRead, syms: &[(u64, u64, String)]) -> Result<Counts
             .and_then(|l| l.split(':').next())
             .and_then(|a| u64::from_str_radix(a, 16).ok())
         {
-            let start = *listing.get_or_insert(addr);
-            let b = c.blocks.entry(start).or_insert((0, addr));
-            *b = (b.0 + 1, addr);
+            // A block translated again (after a flush) is listed again: its new listing counts.
+            let start = *listing.get_or_insert_with(|| {
+                c.blocks.insert(addr, Vec::new());
+                addr
+            });
+            c.blocks.entry(start).or_default().push(addr);
+        }
+    }
+    for (pc, runs) in &c.runs {
+        for addr in c.blocks.get(pc).map_or(&[*pc][..], Vec::as_slice) {
+            *c.per_site.entry(*addr).or_default() += runs;
         }
     }
     Ok(c)
@@ -249,8 +316,8 @@ fn count_blocks(log: impl BufRead, syms: &[(u64, u64, String)]) -> Result<Counts
 
 /// Runs `elf` on QEMU with every executed block logged into a named pipe that is read as QEMU
 /// writes it (no multi-gigabyte file), and prints the output lines `frame_line` picks, the share
-/// of compiler built-ins, the top functions, the top source lines and the functions inlined
-/// into each symbol.
+/// of compiler built-ins, the top functions, the top source lines, the top functions of our
+/// sources (inlined or not) and the functions inlined into each symbol.
 fn profile_elf(
     target: &str,
     elf: &std::path::Path,
@@ -319,15 +386,23 @@ fn profile_elf(
     let sites: Vec<u64> = c.per_site.keys().copied().collect();
     let lines = source_lines(elf, &sites)?;
     let mut by_line: HashMap<&str, u64> = HashMap::new();
+    let mut by_function: HashMap<&str, u64> = HashMap::new();
     let mut by_inlined: HashMap<String, u64> = HashMap::new();
     for (site, n) in &c.per_site {
-        let (line, inlined) = lines.get(site).map_or(("", "?"), |(l, f)| (l.as_str(), f.as_str()));
-        let line = if line.is_empty() {
-            "(no line in src/ or firmware/examples/)"
+        let (line, function, inlined) = lines.get(site).map_or(("", "", "?"), |s| {
+            (s.line.as_str(), s.function.as_str(), s.inlined.as_str())
+        });
+        let (line, function) = if line.is_empty() {
+            (
+                "(no line in src/ or firmware/examples/)",
+                "(no function in src/ or firmware/examples/)",
+            )
         } else {
-            line
+            (line, function)
         };
+
         *by_line.entry(line).or_default() += n;
+        *by_function.entry(function).or_default() += n;
         let symbol = short_name(name_of(&syms, *site));
         *by_inlined
             .entry(format!("{symbol} > {}", short_name(inlined)))
@@ -339,9 +414,19 @@ fn profile_elf(
     for (line, n) in by_line.iter().take(40) {
         println!("{:6.2} %  {line}", percent(*n, total));
     }
+    let mut by_function: Vec<_> = by_function.into_iter().collect();
+    by_function.sort_by_key(|f| std::cmp::Reverse(f.1));
+    println!(
+        "\nfunctions of src/ and firmware/examples/, inlined or not (the innermost one an instruction comes from), with the built-ins they call:"
+    );
+    for (function, n) in by_function.iter().take(40) {
+        println!("{:6.2} %  {function}", percent(*n, total));
+    }
     let mut builtin_sites: HashMap<String, u64> = HashMap::new();
     for ((site, pc), n) in &c.builtin_site {
-        let (line, inlined) = lines.get(site).map_or(("", "?"), |(l, f)| (l.as_str(), f.as_str()));
+        let (line, inlined) = lines
+            .get(site)
+            .map_or(("", "?"), |s| (s.line.as_str(), s.inlined.as_str()));
         *builtin_sites
             .entry(format!(
                 "{line} ({}): {}",
@@ -382,3 +467,4 @@ fn short_name(name: &str) -> String {
         .replace("$u7b$", "{")
         .replace("$u7d$", "}")
 }
+
