@@ -237,6 +237,18 @@ fn mul_wide_in_halves(a: i32, b: i32) -> i64 {
     (((ah * bh) as i64) << 32) + (cross << 16) + low
 }
 
+/// `a · b` for two `i64` whose product does not overflow: on cores without a wide multiply
+/// ([`NO_WIDE_MULTIPLY`]) [`mul_wide`] when both fit 32 bits (the `i64` multiply is a call
+/// there), elsewhere the `i64` multiply. The same value either way (test
+/// `narrow_products_are_exact`).
+#[inline]
+pub(crate) fn mul_i64(a: i64, b: i64) -> i64 {
+    match i32::try_from(b) {
+        Ok(b) if NO_WIDE_MULTIPLY => mul_i64_i32(a, b),
+        _ => a * b,
+    }
+}
+
 /// `a · b` for an `a` that fits `i64` times `b`, where the product does not overflow: on
 /// cores without a wide multiply ([`NO_WIDE_MULTIPLY`]) [`mul_wide`] when `a` fits 32 bits
 /// (the `i64` multiply is a call there), elsewhere the `i64` multiply. The same value either
@@ -1039,6 +1051,9 @@ mod tests {
                 (a >> 33) + i32::MAX as i64,
             ] {
                 assert_eq!(mul_i64_i32(a, b), a * b as i64, "{a} * {b}");
+                // Either factor wider than 32 bits, or both within.
+                assert_eq!(mul_i64(a, b as i64), a * b as i64, "{a} * {b}");
+                assert_eq!(mul_i64(b as i64, a), a * b as i64, "{b} * {a}");
             }
             for b in [(x >> 48) as u16, 0, 1, u16::MAX, (x >> 20) as u16 & 0x7FF] {
                 let want = a.wrapping_mul(b as i64);

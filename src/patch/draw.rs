@@ -16,7 +16,7 @@ use crate::arithmetic::Arithmetic;
 use crate::cache::CachedVertex;
 use crate::clip::{ClipVertex, Clipped, Clipping};
 use crate::depth::Depth;
-use crate::math::floor_div_i64;
+use crate::math::{floor_div_i64, mul_i64, mul_i64_i32, mul_wide};
 use crate::options::RenderOptions;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{color_channels, first_row, signed_area, xy, TriangleWalk};
@@ -415,7 +415,7 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         let cy = (self.vp.height as i64) << SUB;
         // w > near > 0 here, so `floor_div_i64` is `div_euclid` (by 32-bit divisions).
         let div = |n: i64| floor_div_i64(n, 2 * w);
-        Some([div(cx * w + 2 * nx), div(cy * w - 2 * ny)])
+        Some([div(mul_i64(cx, w) + 2 * nx), div(mul_i64(cy, w) - 2 * ny)])
     }
 
     /// The projected control points of `net`.
@@ -924,18 +924,68 @@ struct Vertex {
 
 /// Whether the camera (at the eye-space origin) sees the back of triangle `t`: its normal
 /// `(b − a) × (c − a)` (in `(x, y, −w)`, counter-clockwise = front) points away from the eye.
-/// Coordinates are cut to 22 bits first, so the cross product is below 2^47 and its dot
-/// product with a point below 2^70 (`i128`).
+/// Coordinates are cut to 24 bits first (`>> 8` of I16F16 bits), so edges fit 25 bits, the
+/// cross product 50 bits and its dot product with a point 75 bits: [`dot_is_positive`] takes
+/// its sign exactly in 64-bit arithmetic.
 fn shows_back(t: [&Vertex; 3]) -> bool {
-    let v = t.map(|v| [v.p.x, v.p.y, v.p.w].map(|c| (c.to_bits() >> 8) as i64));
+    let v = t.map(|v| [v.p.x, v.p.y, v.p.w].map(|c| c.to_bits() >> 8));
     let v = v.map(|p| [p[0], p[1], -p[2]]);
-    let d = |a: [i64; 3], b: [i64; 3]| [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let d = |a: [i32; 3], b: [i32; 3]| [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let (e1, e2) = (d(v[0], v[1]), d(v[0], v[2]));
     let n = [
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
+        mul_wide(e1[1], e2[2]) - mul_wide(e1[2], e2[1]),
+        mul_wide(e1[2], e2[0]) - mul_wide(e1[0], e2[2]),
+        mul_wide(e1[0], e2[1]) - mul_wide(e1[1], e2[0]),
     ];
-    let dot: i128 = (0..3).map(|k| n[k] as i128 * v[0][k] as i128).sum();
-    dot > 0
+    dot_is_positive(n, v[0])
+}
+
+/// Whether `n · p > 0` for `|n_k| < 2^54` and `|p_k| < 2^31`, exactly, without 128-bit
+/// products (a library call on 32-bit cores): with `n_k = h_k·2^24 + l_k`, `l_k` in
+/// [0, 2^24), the dot product is `H·2^24 + L` (`H = Σ h_k·p_k`, `L = Σ l_k·p_k`, both far
+/// inside `i64`), and with `L = q·2^24 + r`, `r` in [0, 2^24), it is `s·2^24 + r` for
+/// `s = H + q`: positive exactly when `s > 0`, or `s = 0` and `r > 0`. Test
+/// `dot_sign_is_the_wide_sign`.
+fn dot_is_positive(n: [i64; 3], p: [i32; 3]) -> bool {
+    let (mut high, mut low) = (0i64, 0i64);
+    for (n, p) in n.iter().zip(p) {
+        high += mul_wide((n >> 24) as i32, p);
+        low += mul_i64_i32(n & 0xFF_FFFF, p);
+    }
+    let s = high + (low >> 24);
+    s > 0 || (s == 0 && low & 0xFF_FFFF > 0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dot_sign_is_the_wide_sign() {
+        let mut rng = crate::test_rng::XorShift64::new(0x51ce_5eed_0bad_cafe);
+        let wide = |n: [i64; 3], p: [i32; 3]| {
+            (0..3).map(|k| n[k] as i128 * p[k] as i128).sum::<i128>() > 0
+        };
+        let check = |n: [i64; 3], p: [i32; 3]| {
+            assert_eq!(dot_is_positive(n, p), wide(n, p), "{n:?} {p:?}");
+        };
+        // Exact zeros, and sums one unit either side of zero through the low part.
+        check([0; 3], [5, -7, 9]);
+        check([1 << 24, -(1 << 24), 0], [3, 3, 1]);
+        check([(1 << 24) + 1, -(1 << 24), 0], [3, 3, 1]);
+        check([(1 << 24) - 1, -(1 << 24), 0], [3, 3, 1]);
+        check([-1, 1, 0], [1, 1, 0]);
+        check([(1 << 54) - 1; 3], [i32::MAX, i32::MIN, 1]);
+        check([-(1 << 54) + 1; 3], [i32::MAX, i32::MIN, i32::MAX]);
+        for case in 0..200_000u32 {
+            let bits = 1 + case % 54;
+            let mut n = || (rng.next_u64() as i64) >> (64 - bits);
+            let n = [n(), n(), n()];
+            let mut p = || (rng.next_u64() >> 32) as i32 >> (case % 31);
+            let p = [p(), p(), p()];
+            check(n, p);
+            // A near-cancelling pair: the same terms with one sign flipped.
+            check([n[0], -n[0], n[2] & 0xFF], [p[0], p[0], p[2]]);
+        }
+    }
 }

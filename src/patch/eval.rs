@@ -12,7 +12,7 @@
 //! of the projected surface `H_u·ω − H·ω_u` multiplies them by a weight (2^20): below 2^56.
 
 use super::{PatchModel, Weight, PARAM_ONE};
-use crate::math::fit_bits;
+use crate::math::{fit_bits, mul_i64, NO_WIDE_MULTIPLY};
 use crate::scene::Vertex;
 use fixed::types::I16F16;
 
@@ -31,7 +31,30 @@ trait Lerp: Copy {
 /// The formula, one lane.
 #[inline(always)]
 fn lerp(a: i64, b: i64, t: u32) -> i64 {
-    a + (((b - a) * t as i64 + (1 << 15)) >> 16)
+    a + scale_rounded(b - a, t)
+}
+
+/// `(d·t + 2^15) >> 16` for a parameter `t` in [0, 2^16]. On ARMv6-M, where an `i64` multiply
+/// is a library call (about 40 instructions), a `d` that fits `i32` (every difference of a
+/// patch within a few thousand units of the eye) takes two 32-bit multiplies: with
+/// `d = dh·2^16 + dl`, `dl` in [0, 2^16), the result is `dh·t + ⌊(dl·t + 2^15) / 2^16⌋`
+/// exactly (`dh·t·2^16` is a multiple of 2^16; `|dh·t| < 2^31`; `dl·t + 2^15 < 2^32`). The
+/// same value every way (test `scale_rounded_is_the_i64_formula`).
+#[inline(always)]
+fn scale_rounded(d: i64, t: u32) -> i64 {
+    if NO_WIDE_MULTIPLY && t <= 1 << 16 {
+        if let Ok(d) = i32::try_from(d) {
+            return scale_rounded_in_halves(d, t);
+        }
+    }
+    (d * t as i64 + (1 << 15)) >> 16
+}
+
+/// [`scale_rounded`] for a `d` that fits `i32` and `t` at most 2^16, in 32-bit multiplies.
+#[inline(always)]
+fn scale_rounded_in_halves(d: i32, t: u32) -> i64 {
+    let (dh, dl) = (d >> 16, (d & 0xFFFF) as u32);
+    i64::from(dh * t as i32) + i64::from((dl * t + (1 << 15)) >> 16)
 }
 
 /// Weights alone.
@@ -42,7 +65,7 @@ impl Lerp for i64 {
     }
     #[inline(always)]
     fn slope(self, b: i64) -> i64 {
-        3 * (b - self)
+        triple(b - self)
     }
 }
 
@@ -57,8 +80,33 @@ impl Lerp for Hom {
     }
     #[inline(always)]
     fn slope(self, b: Hom) -> Hom {
-        [0, 1, 2, 3].map(|k| 3 * (b[k] - self[k]))
+        [0, 1, 2, 3].map(|k| triple(b[k] - self[k]))
     }
+}
+
+/// `3·d` (not overflowing). On ARMv6-M LLVM makes `3 * d` of an `i64`, and `(d << 1) + d`
+/// too, a call to the 64-bit multiply; there it is two 32-bit additions with carries
+/// (test `triple_in_words_is_three_times`).
+#[inline(always)]
+fn triple(d: i64) -> i64 {
+    if NO_WIDE_MULTIPLY {
+        triple_in_words(d)
+    } else {
+        3 * d
+    }
+}
+
+/// [`triple`] in 32-bit words: the low word added twice with its carries into three times
+/// the high word.
+#[inline(always)]
+fn triple_in_words(d: i64) -> i64 {
+    let (low, high) = (d as u32, (d >> 32) as i32);
+    let (twice, c1) = low.overflowing_add(low);
+    let (thrice, c2) = twice.overflowing_add(low);
+    let high = high
+        .wrapping_mul(3)
+        .wrapping_add(i32::from(c1) + i32::from(c2));
+    (i64::from(high) << 32) | i64::from(thrice)
 }
 
 /// The weights of cubic `q`, or `None` if it has one weight throughout (then every
@@ -178,9 +226,9 @@ impl Net {
         for ((out, p), w) in h.iter_mut().zip(points).zip(weights) {
             let w = w.to_bits() as i64;
             *out = [
-                (p[0].to_bits() as i64 * w) >> 16,
-                (p[1].to_bits() as i64 * w) >> 16,
-                (p[2].to_bits() as i64 * w) >> 16,
+                mul_i64(p[0].to_bits() as i64, w) >> 16,
+                mul_i64(p[1].to_bits() as i64, w) >> 16,
+                mul_i64(p[2].to_bits() as i64, w) >> 16,
                 w,
             ];
         }
@@ -315,7 +363,7 @@ impl TangentColumn {
         let tangent = |d: Hom| -> Option<[i64; 3]> {
             let w = h[3] >> 4;
             let dw = d[3] >> 4;
-            let t = [0, 1, 2].map(|k| (d[k] >> 4) * w - (h[k] >> 4) * dw);
+            let t = [0, 1, 2].map(|k| mul_i64(d[k] >> 4, w) - mul_i64(h[k] >> 4, dw));
             // Below this a tangent is rounding noise (a few units of its last bits), and
             // scaling it up would invent a direction.
             let largest = t.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
@@ -326,9 +374,9 @@ impl TangentColumn {
         };
         let (a, b) = (tangent(hu)?, tangent(hv)?);
         let n = [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
+            mul_i64(a[1], b[2]) - mul_i64(a[2], b[1]),
+            mul_i64(a[2], b[0]) - mul_i64(a[0], b[2]),
+            mul_i64(a[0], b[1]) - mul_i64(a[1], b[0]),
         ];
         // Tangents that are (nearly) parallel give no usable direction.
         let largest = n.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
@@ -357,6 +405,67 @@ pub(crate) fn dehomogenize(h: Hom) -> Vertex {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn triple_in_words_is_three_times() {
+        let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15);
+        let limit = i64::MAX / 3;
+        for d in [
+            0,
+            1,
+            -1,
+            limit,
+            -limit,
+            u32::MAX as i64,
+            -(u32::MAX as i64),
+            1 << 32,
+        ] {
+            assert_eq!(triple_in_words(d), 3 * d, "{d}");
+        }
+        for case in 0..200_000u32 {
+            let d = (rng.next_u64() as i64) >> (2 + case % 62);
+            assert_eq!(triple_in_words(d), 3 * d, "{d}");
+            assert_eq!(triple(d), 3 * d, "{d}");
+        }
+    }
+
+    #[test]
+    fn scale_rounded_is_the_i64_formula() {
+        let mut rng = crate::test_rng::XorShift64::new(0x0123_4567_89ab_cdef);
+        let formula = |d: i64, t: u32| (d * t as i64 + (1 << 15)) >> 16;
+        let edges = [
+            0i64,
+            1,
+            -1,
+            1 << 15,
+            -(1 << 15),
+            i32::MAX as i64,
+            i32::MIN as i64,
+        ];
+        for d in edges
+            .into_iter()
+            .chain([1i64 << 31, -(1i64 << 31) - 1, 1 << 40])
+        {
+            for t in [0u32, 1, 1 << 15, (1 << 16) - 1, 1 << 16] {
+                assert_eq!(scale_rounded(d, t), formula(d, t), "{d} {t}");
+            }
+        }
+        for case in 0..200_000u32 {
+            let d = (rng.next_u64() as i64) >> (64 - (1 + case % 40));
+            let t = (rng.next_u64() % ((1 << 16) + 1)) as u32;
+            assert_eq!(scale_rounded(d, t), formula(d, t), "{d} {t}");
+            // The ARMv6-M form, on every target.
+            let d = d as i32;
+            let want = formula(i64::from(d), t);
+            assert_eq!(scale_rounded_in_halves(d, t), want, "{d} {t}");
+        }
+        for d in [0, 1, -1, i32::MAX, i32::MIN, 0xFFFF, -0x10000] {
+            for t in [0u32, 1, (1 << 16) - 1, 1 << 16] {
+                let want = formula(i64::from(d), t);
+                assert_eq!(scale_rounded_in_halves(d, t), want, "{d} {t}");
+            }
+        }
+    }
     use crate::patch::{PatchColors, PatchModel};
     use embedded_graphics::pixelcolor::Rgb888;
 

@@ -24,6 +24,7 @@
 //! `max + min/2` of `|dx|, |dy|`.
 
 use super::{MAX_LEVEL, PARAM_ONE};
+use crate::math::mul_i64;
 
 /// A parameter pair `(u, v)`, I16F16 bits.
 pub(crate) type Uv = [u32; 2];
@@ -167,7 +168,7 @@ pub(crate) fn grid(index: u32, level: u8) -> u32 {
 /// Twice the signed area of `a b c` in the `(u, v)` plane (positive: counter-clockwise).
 pub(crate) fn area2(a: Uv, b: Uv, c: Uv) -> i64 {
     let d = |a: Uv, b: Uv, k: usize| b[k] as i64 - a[k] as i64;
-    d(a, b, 0) * d(a, c, 1) - d(a, c, 0) * d(a, b, 1)
+    mul_i64(d(a, b, 0), d(a, c, 1)) - mul_i64(d(a, c, 0), d(a, b, 1))
 }
 
 /// `t` with its vertices in counter-clockwise order in the `(u, v)` plane (`u` right, `v`
