@@ -549,7 +549,7 @@ fn div_rem_below_with<const SOFT: bool>(u1: u32, u0: u32, v: u32) -> (u32, u32) 
 /// ([`NO_WIDE_MULTIPLY`]) from four 32-bit multiplies of 16-bit halves, elsewhere the `u64`
 /// multiply (`umull`). The same value either way (test `narrow_products_are_exact`).
 #[inline]
-fn mul_wide_u32(a: u32, b: u32) -> u64 {
+pub(crate) fn mul_wide_u32(a: u32, b: u32) -> u64 {
     if NO_WIDE_MULTIPLY {
         mul_wide_u32_in_halves(a, b)
     } else {
@@ -565,6 +565,18 @@ fn mul_wide_u32_in_halves(a: u32, b: u32) -> u64 {
     let (bh, bl) = (b >> 16, b & 0xFFFF);
     let cross = (ah * bl) as u64 + (al * bh) as u64;
     (((ah * bh) as u64) << 32) + (cross << 16) + (al * bl) as u64
+}
+
+/// `a · b` for a signed and an unsigned 32-bit factor, exactly `a as i64 * b as i64`, from four
+/// 32-bit multiplies of 16-bit halves (`a`'s high half signed; `al·bh` and `al·bl` unsigned):
+/// for ARMv6-M, where the `i64` multiply is a call (tests `wide_is_the_i64_product` in
+/// `trace::vector`, `mul_in_words_is_mul` in `metaball`).
+#[inline]
+pub const fn wide_by_unsigned(a: i32, b: u32) -> i64 {
+    let (ah, al) = (a >> 16, (a & 0xFFFF) as u32);
+    let (bh, bl) = (b >> 16, b & 0xFFFF);
+    let cross = (ah * bl as i32) as i64 + (al * bh) as i64;
+    (((ah * bh as i32) as i64) << 32) + (cross << 16) + (al * bl) as i64
 }
 
 /// A 32-bit divisor `D >= 1` prepared for several divisions: one reciprocal, then every

@@ -88,6 +88,7 @@ pub use animation::{AnimatedBall, Animation, BallKey, KeyCoord};
 pub use cast::{CastError, CastStats, Caster, MetaCamera, EPSILON_T, MAX_STEPS};
 pub use polygonize::{PolyMesh, PolyStats, PolygonizeError, Polygonizer, MAX_SAMPLES};
 
+use crate::math::{mul_wide_u32, wide_by_unsigned, NO_WIDE_MULTIPLY};
 use cast::quotient;
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::{I16F16, I32F32};
@@ -280,6 +281,9 @@ impl<'a> Metaballs<'a> {
 /// Wraps where `*` would overflow; the module's bit budget keeps every product in range.
 #[inline(always)]
 pub(crate) fn mul(a: Wide, b: Wide) -> Wide {
+    if NO_WIDE_MULTIPLY {
+        return Wide::from_bits(mul_in_words(a.to_bits(), b.to_bits()));
+    }
     let (a, b) = (a.to_bits(), b.to_bits());
     let (a_high, a_low) = (a >> 32, i64::from(a as u32));
     let (b_high, b_low) = (b >> 32, i64::from(b as u32));
@@ -291,6 +295,22 @@ pub(crate) fn mul(a: Wide, b: Wide) -> Wide {
             .wrapping_add(a_low.wrapping_mul(b_high))
             .wrapping_add(low),
     )
+}
+
+/// [`mul`]'s bits from 32 × 32-bit products, for cores without a 32 × 32 → 64-bit multiply
+/// (ARMv6-M, where each of [`mul`]'s four `i64` products is a library call): `ah·bh` only for
+/// its low word (shifted out of `i64` otherwise), `ah·bl` and `bh·al` as signed by unsigned
+/// products, `al·bl` for its high word, each in 16-bit halves. The same bits (test
+/// `mul_in_words_is_mul`).
+#[inline(always)]
+fn mul_in_words(a: i64, b: i64) -> i64 {
+    let (ah, al) = ((a >> 32) as i32, a as u32);
+    let (bh, bl) = ((b >> 32) as i32, b as u32);
+    let low = (mul_wide_u32(al, bl) >> 32) as i64;
+    let cross = wide_by_unsigned(ah, bl).wrapping_add(wide_by_unsigned(bh, al));
+    (i64::from(ah.wrapping_mul(bh)) << 32)
+        .wrapping_add(cross)
+        .wrapping_add(low)
 }
 
 /// `f(s)` in I32F32 for `0 ≤ s < 1` (Horner; every partial sum within ±3).
@@ -436,6 +456,46 @@ mod tests {
                 + 2.0 * FIELD_COEFFICIENTS[2] * s
                 + 3.0 * FIELD_COEFFICIENTS[3] * s * s;
             assert!((field_slope(Wide::from_num(s)).to_num::<f64>() - dfds).abs() < 1e-8);
+        }
+    }
+
+    #[test]
+    fn mul_in_words_is_mul() {
+        // `mul` without the ARMv6-M branch: the four i64 products, wrapping.
+        fn wide(a: i64, b: i64) -> i64 {
+            let (ah, al) = (a >> 32, i64::from(a as u32));
+            let (bh, bl) = (b >> 32, i64::from(b as u32));
+            let low = ((al as u64).wrapping_mul(bl as u64) >> 32) as i64;
+            (ah.wrapping_mul(bh) << 32)
+                .wrapping_add(ah.wrapping_mul(bl))
+                .wrapping_add(al.wrapping_mul(bh))
+                .wrapping_add(low)
+        }
+        let mut rng = crate::test_rng::XorShift64::new(0x0f1e_2d3c_4b5a_6978u64);
+        let edges = [
+            0,
+            1,
+            -1,
+            i64::MAX,
+            i64::MIN,
+            u32::MAX as i64,
+            -(1i64 << 32),
+            1 << 32,
+        ];
+        for a in edges {
+            for b in edges {
+                assert_eq!(mul_in_words(a, b), wide(a, b), "{a} × {b}");
+            }
+        }
+        for k in 0..400_000u32 {
+            let x = rng.next_u64();
+            let a = (x as i64) >> (k % 64);
+            let b = (rng.next_u64() as i64) >> (x % 64);
+            assert_eq!(mul_in_words(a, b), wide(a, b), "{a} × {b}");
+            assert_eq!(
+                mul(Wide::from_bits(a), Wide::from_bits(b)).to_bits(),
+                wide(a, b)
+            );
         }
     }
 

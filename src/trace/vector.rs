@@ -13,7 +13,7 @@
 //! wrapped number.
 
 use crate::math::div_rem_below;
-pub use crate::math::{isqrt32, isqrt32_bitwise, isqrt32_newton};
+pub use crate::math::{isqrt32, isqrt32_bitwise, isqrt32_newton, wide_by_unsigned};
 use fixed::types::{I16F16, I32F32};
 
 /// The largest scene coordinate magnitude (any axis), in world units: 2^12.
@@ -182,17 +182,6 @@ pub const fn wide(a: i32, b: i32) -> i64 {
     } else {
         a as i64 * b as i64
     }
-}
-
-/// `a · b` for a signed and an unsigned 32-bit factor, exactly `a as i64 * b as i64`, from four
-/// 32-bit multiplies of 16-bit halves (`a`'s high half signed; `al·bh` and `al·bl` unsigned):
-/// for ARMv6-M, where the `i64` multiply is a call (test `wide_is_the_i64_product`).
-#[inline]
-pub const fn wide_by_unsigned(a: i32, b: u32) -> i64 {
-    let (ah, al) = (a >> 16, (a & 0xFFFF) as u32);
-    let (bh, bl) = (b >> 16, b & 0xFFFF);
-    let cross = (ah * bl as i32) as i64 + (al * bh) as i64;
-    (((ah * bh as i32) as i64) << 32) + (cross << 16) + (al * bl) as i64
 }
 
 /// [`wide`] from 32-bit multiplies, on every target: with `a = ah·2^16 + al` (`ah` signed, `al`
