@@ -20,6 +20,9 @@ fn main() {
     println!("cargo::rustc-check-cfg=cfg(scanline3d_corpus)");
     // `--cfg scanline3d_corpus_only`: the corpus alone, without the demo orbit (`cargo xtask profile`).
     println!("cargo::rustc-check-cfg=cfg(scanline3d_corpus_only)");
+    // `--cfg scanline3d_no_render`: everything but the render call (`cargo xtask scene-ram`'s
+    // baseline, whose stack the render's is measured against).
+    println!("cargo::rustc-check-cfg=cfg(scanline3d_no_render)");
     // `examples/firmware.rs` and `examples/tradeoff.rs` with `--cfg scanline3d_vertex_cache`
     // render with a vertex cache (`cargo xtask firmware` and `cargo xtask speed` measure both).
     println!("cargo::rustc-check-cfg=cfg(scanline3d_vertex_cache)");

@@ -95,7 +95,13 @@ fn frame<
     #[cfg(not(target_os = "none"))]
     let mut sink = Tee(HashSink::new(), ByteHashSink::new());
     let counter = count();
+    #[cfg(not(scanline3d_no_render))]
     let stats = ws.render(scene, options, &mut sink).map_err(|_| "render")?;
+    #[cfg(scanline3d_no_render)]
+    let stats = {
+        core::hint::black_box((&mut *ws, scene, options, &mut sink));
+        scanline3d::FrameStats::default()
+    };
     let instructions = counter.stop();
     #[cfg(target_os = "none")]
     let hash = sink.hash();
@@ -348,6 +354,13 @@ mod corpus_views {
             options: RenderOptions<S, FrustumClip, A>,
         ) -> Result<(), &'static str> {
             let mut ws = fresh(|| CorpusWs::<Sh, Z>::new(Rgb565::new(0, 0, 0)));
+            // A scene rendered alone (`cargo xtask profile VARIANT [cache] TARGET SCENE`, its
+            // workspace sized for it) reports its workspace and the stack's peak, which holds
+            // the workspace, the render call's stack and the firmware's own frames (no static
+            // RAM); `cargo xtask scene-ram` takes the render call's share against a build
+            // without it (`--cfg scanline3d_no_render`).
+            #[cfg(all(target_os = "none", scanline3d_corpus_only))]
+            let painted_bottom = measure::paint_stack();
             for s in &corpus::SCENES {
                 let instances = [Instance {
                     mesh: mesh_for::<Sh>(s),
@@ -365,6 +378,18 @@ mod corpus_views {
                     let result = frame(&mut ws, &scene, &options, self.count)?;
                     (self.report)(name, s.name, k, result);
                 }
+            }
+            #[cfg(all(target_os = "none", scanline3d_corpus_only))]
+            {
+                let low_water = measure::stack_low_water();
+                if low_water <= painted_bottom + 256 {
+                    return Err("the render call's stack went below the painted stack");
+                }
+                semihosting::println!(
+                    "summary corpus_workspace {} peak_stack {}",
+                    CorpusWs::<Sh, Z>::BYTES,
+                    &raw const measure::_stack_start as usize - low_water
+                );
             }
             Ok(())
         }
@@ -411,7 +436,7 @@ fn main() -> Result<(), &'static str> {
 #[path = "common/arch.rs"]
 mod arch;
 #[cfg(target_os = "none")]
-#[allow(dead_code)] // only the counter check is used here
+#[allow(dead_code)] // the counter check, and the stack of a scene rendered alone
 #[path = "common/measure.rs"]
 mod measure;
 

@@ -82,7 +82,7 @@ pub(crate) fn cargo() -> Command {
 
 /// The commands compiled only with the `host` feature (see Cargo.toml), in the usage line's order.
 #[cfg(not(feature = "host"))]
-const HOST_TASKS: [&str; 13] = [
+const HOST_TASKS: [&str; 14] = [
     "firmware",
     "trace",
     "metaball",
@@ -94,6 +94,7 @@ const HOST_TASKS: [&str; 13] = [
     "peers",
     "tradeoff",
     "profile",
+    "scene-ram",
     "speed",
     "fuzz",
 ];
@@ -108,7 +109,7 @@ fn main() -> ExitCode {
             Some(result) => result,
             None => {
                 eprintln!(
-                    "usage: cargo xtask test | package | firmware | trace | metaball | metaball-trade | patch | patch-trade | lean | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | profile trace [pure|hybrid] [TARGET] | profile patch [TARGET] | speed [before|after|doc] | fuzz [SECONDS]"
+                    "usage: cargo xtask test | package | firmware | trace | metaball | metaball-trade | patch | patch-trade | lean | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | profile trace [pure|hybrid] [TARGET] | profile patch [TARGET] | scene-ram SCENE [TARGET...] | speed [before|after|doc] | fuzz [SECONDS]"
                 );
                 return ExitCode::from(2);
             }
@@ -185,6 +186,23 @@ fn host_task(task: &str) -> Option<Result<(), String>> {
                 .find(|a| *a != "cache" && a.as_str() != target)
                 .map(String::as_str);
             install().and_then(|_| profile::profile(&variant, cache, target, scene))
+        }
+        "scene-ram" => {
+            let args: Vec<String> = std::env::args().skip(2).collect();
+            let named: Vec<&str> = args
+                .iter()
+                .filter(|a| a.contains("-none-") || a.contains("-unknown-"))
+                .map(String::as_str)
+                .collect();
+            let targets = if named.is_empty() {
+                FIRMWARE.map(|(t, _)| t).to_vec()
+            } else {
+                named
+            };
+            match args.iter().find(|a| !targets.contains(&a.as_str())) {
+                Some(scene) => install().and_then(|_| profile::scene_ram(scene, &targets)),
+                None => Err("scene-ram: name a corpus scene (icosphere, heightfield, ...)".into()),
+            }
         }
         // The host renders build whole-frame workspaces (megabytes at 60,000 polygons) by value:
         // give them a thread with room for that.

@@ -1,7 +1,9 @@
 //! `cargo xtask profile [VARIANT [cache] [TARGET] [SCENE]]`: where a trade-off variant's frames
 //! spend their instructions (with `cache`, rendered with a vertex cache), on thumbv6m unless a
 //! TARGET (`thumbv7em-none-eabihf`, ...) is named; the demo orbit, or with a corpus SCENE
-//! (`icosphere`, ...) every view of that scene alone (`--cfg scanline3d_corpus_only`). QEMU logs every translated block and every block it executes
+//! (`icosphere`, ...) every view of that scene alone (`--cfg scanline3d_corpus_only`) in a
+//! workspace sized for it, printing the renderer's RAM too (the workspace and the render call's
+//! stack). QEMU logs every translated block and every block it executes
 //! (`-d in_asm,exec,nochain`); the count of each block times its length gives exact
 //! instructions per block. Prints the share of compiler built-ins (64-bit multiply and divide,
 //! memcpy), the top functions, the top source lines of this repository and the top functions
@@ -23,23 +25,53 @@ use std::process::Command;
 /// The target profiled unless one is named.
 pub const DEFAULT_TARGET: &str = "thumbv6m-none-eabi";
 
-/// The corpus source with `scene` the only entry of `SCENES`.
+/// The corpus source with `scene` the only entry of `SCENES` and the workspace sized for it.
 fn only_scene(source: &str, scene: &str) -> Result<String, String> {
     let entry = format!("CorpusScene {{ name: {scene:?},");
     if !source.contains(&entry) {
         return Err(format!("no corpus scene {scene:?}"));
     }
-    Ok(source
+    // The workspace sized for this scene alone: its own budget (the same margin) and vertex
+    // count instead of the largest over the corpus (the constants after `SCENES`).
+    let (modules, tail) = source
+        .split_once("pub static SCENES: [CorpusScene; ")
+        .ok_or("corpus source without `SCENES`")?;
+    let module = modules
+        .split_once(&format!("pub mod {} {{", scene.replace('-', "_")))
+        .map(|(_, m)| m.split_once("\npub mod ").map_or(m, |(m, _)| m))
+        .ok_or_else(|| format!("no module for corpus scene {scene:?}"))?;
+    let find = |prefix: &str, end: char| -> Result<String, String> {
+        module
+            .lines()
+            .find_map(|l| l.strip_prefix(prefix))
+            .and_then(|rest| rest.split(end).next())
+            .map(str::to_string)
+            .ok_or_else(|| format!("corpus scene {scene:?}: no `{prefix}`"))
+    };
+    let tris = find("pub const MAX_TRIANGLES: usize = ", ';')?;
+    let active = find("pub const MAX_ACTIVE: usize = ", ';')?;
+    let vertices = find("pub static VERTICES: [Vertex; ", ']')?;
+    let tail = tail
         .lines()
+        .map(|l| {
+            if l.starts_with("pub const MAX_TRIANGLES: usize = ") {
+                format!("pub const MAX_TRIANGLES: usize = {tris};")
+            } else if l.starts_with("pub const MAX_ACTIVE: usize = ") {
+                format!("pub const MAX_ACTIVE: usize = {active};")
+            } else if l.starts_with("pub const MAX_VERTICES: usize = ") {
+                format!("pub const MAX_VERTICES: usize = {vertices};")
+            } else {
+                l.to_string()
+            }
+        })
         .filter(|l| !l.trim_start().starts_with("CorpusScene { name:") || l.contains(&entry))
-        .map(
-            |l| match l.strip_prefix("pub static SCENES: [CorpusScene; ") {
-                Some(_) => "pub static SCENES: [CorpusScene; 1] = [",
-                None => l,
-            },
-        )
         .collect::<Vec<_>>()
-        .join("\n"))
+        .join("\n");
+    // `tail` starts with the rest of the `SCENES` line (its length).
+    let tail = tail.split_once('\n').map_or("", |(_, rest)| rest);
+    Ok(format!(
+        "{modules}pub static SCENES: [CorpusScene; 1] = [\n{tail}\n"
+    ))
 }
 
 /// Function symbols of `elf`: (start, size, name), sorted.
@@ -212,8 +244,66 @@ pub fn profile(
     let generated = scene.map(|_| (CORPUS, corpus_file.as_path()));
     let elf = build_example_with_cfgs("tradeoff", Some(target), &cfgs, generated)?;
     profile_elf(target, &elf, variant, |l| {
-        l.starts_with("variant ") || l.starts_with("corpus ")
+        l.starts_with("variant ") || l.starts_with("corpus ") || l.starts_with("summary ")
     })
+}
+
+/// `cargo xtask scene-ram SCENE [TARGET...]`: the renderer's RAM for one corpus scene as a
+/// firmware for that scene alone has it (every target unless some are named): the default
+/// options with a vertex cache holding every vertex, the workspace sized for the scene, built
+/// as `cargo xtask profile default cache TARGET SCENE` builds it. The render call's stack is
+/// that image's peak stack less the peak of the same image built without the render call
+/// (`--cfg scanline3d_no_render`): what the compiler inlines into the caller's frame counts,
+/// as `cargo xtask lean` measures its builds against its baseline. Prints view 0's
+/// instructions and each figure.
+pub fn scene_ram(scene: &str, targets: &[&str]) -> Result<(), String> {
+    let corpus = scanline3d_sim::export::corpus_source(240, 240, 10)?;
+    let dir = root().join("target/scene-ram-corpus");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let corpus_file = dir.join("corpus.rs");
+    std::fs::write(&corpus_file, only_scene(&corpus, scene)?).map_err(|e| e.to_string())?;
+    let field = |out: &str, key: &str| -> Result<u64, String> {
+        out.lines()
+            .filter(|l| l.starts_with("summary ") || l.starts_with("corpus "))
+            .find_map(|l| {
+                let words: Vec<&str> = l.split_whitespace().collect();
+                let at = words.iter().position(|w| *w == key)?;
+                words.get(at + 1)?.parse().ok()
+            })
+            .ok_or_else(|| format!("no `{key}` in the firmware's output:\n{out}"))
+    };
+    let mut rows = Vec::new();
+    for target in targets {
+        let mut cfgs = vec![
+            "scanline3d_variant=\"default\"".to_string(),
+            "scanline3d_vertex_cache".into(),
+            "scanline3d_corpus_only".into(),
+        ];
+        let generated = Some((CORPUS, corpus_file.as_path()));
+        step(&format!("corpus scene {scene} alone, default with a vertex cache, {target}"));
+        let elf = build_example_with_cfgs("tradeoff", Some(target), &cfgs, generated)?;
+        let out = run_on_qemu_with(target, &elf, &[])?;
+        print!("{out}");
+        let (workspace, peak) = (field(&out, "corpus_workspace")?, field(&out, "peak_stack")?);
+        let instructions = field(&out, "instructions")?;
+        step(&format!("the same without the render call, {target}"));
+        cfgs.push("scanline3d_no_render".into());
+        let elf = build_example_with_cfgs("tradeoff", Some(target), &cfgs, generated)?;
+        let out = run_on_qemu_with(target, &elf, &[])?;
+        print!("{out}");
+        let render_stack = peak.saturating_sub(field(&out, "peak_stack")?);
+        rows.push(format!(
+            "| {target} | {instructions} | {workspace} B | {render_stack} B | {} B |",
+            workspace + render_stack
+        ));
+    }
+    println!("\ncorpus scene {scene}, view 0, default options, vertex cache:\n");
+    println!("| target | instructions, view 0 | workspace | render call stack | renderer RAM |");
+    println!("|---|---:|---:|---:|---:|");
+    for row in rows {
+        println!("{row}");
+    }
+    Ok(())
 }
 
 /// `cargo xtask profile trace [pure|hybrid] [TARGET]`: the traced firmware's frame in one mode

@@ -22,18 +22,21 @@ pub fn static_ram() -> usize {
 const PAINTED: usize = 64 * 1024;
 const PAINT: u32 = 0x5AA5_C33C;
 
-/// Fills the stack below the current frame with a pattern. Writes below the stack pointer
-/// only, into memory nothing uses yet.
+/// Fills the stack below the current frame with a pattern and returns the lowest painted
+/// address: a high-water mark at or below it means the stack went deeper than the painting.
+/// Writes below the stack pointer only, into memory nothing uses yet.
 #[inline(never)]
-pub fn paint_stack() {
+pub fn paint_stack() -> usize {
     let top = arch::sp() - 256; // leave this function's own frame alone
-    let mut p = top - PAINTED;
+    let bottom = top - PAINTED;
+    let mut p = bottom;
     while p < top {
         // SAFETY: [top - PAINTED, top) is unused stack below the live frames (RAM is 4 MiB
         // on the MPS2 boards, 16 MiB on virt).
         unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
         p += 4;
     }
+    bottom
 }
 
 /// Deepest stack address reached since painting, found as the lowest overwritten word.
