@@ -53,7 +53,8 @@ pub(crate) fn lean() -> Result<(), String> {
 /// the host's render of the OBJ the scene was exported from. `with_table` also prints the flash
 /// and RAM of the minimal and full builds, with the renderer's share measured against the
 /// renderer-less baseline (meaningful for the `lean` profile only: the test command checks the
-/// hashes of a `firmware`-profile build, whose dependencies it has already built).
+/// hashes of a `firmware`-profile build, whose dependencies it has already built, and neither
+/// builds nor runs the baseline, which renders nothing).
 pub(crate) fn lean_runs(profile: &str, with_table: bool) -> Result<(), String> {
     use scanline3d_sim::scene::{MeshData, SceneSpec};
     let mesh = MeshData::load_obj(&root().join(LEAN_OBJ))?;
@@ -110,7 +111,10 @@ pub(crate) fn lean_runs(profile: &str, with_table: bool) -> Result<(), String> {
             summary_field(&out, "peak_stack")
         ));
         let mut flash = std::collections::HashMap::new();
-        for variant in LEAN_VARIANTS {
+        for variant in LEAN_VARIANTS
+            .into_iter()
+            .filter(|v| with_table || *v != "baseline")
+        {
             step(&format!(
                 "lean firmware ({variant}) on QEMU {machine}, {target}"
             ));
@@ -125,6 +129,9 @@ pub(crate) fn lean_runs(profile: &str, with_table: bool) -> Result<(), String> {
             }
             let elf_path = firmware_elf(target, profile, &format!("lean_{variant}"));
             flash.insert(variant, (flash_bytes(&elf_path)?, out));
+        }
+        if !with_table {
+            continue;
         }
         let (base_flash, base_out) = &flash["baseline"];
         let base_stack = summary_field(base_out, "peak_stack");
