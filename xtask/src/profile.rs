@@ -2,8 +2,9 @@
 //! spend their instructions (with `cache`, rendered with a vertex cache), on thumbv6m unless a
 //! TARGET (`thumbv7em-none-eabihf`, ...) is named; the demo orbit, or with a corpus SCENE
 //! (`icosphere`, ...) every view of that scene alone (`--cfg scanline3d_corpus_only`) in a
-//! workspace sized for it, printing the renderer's RAM too (the workspace and the render call's
-//! stack). QEMU logs every translated block and every block it executes
+//! workspace sized for it, printing its workspace and the stack's peak too (`cargo xtask
+//! scene-ram SCENE` gives the render call's share). QEMU logs every translated block and every
+//! block it executes
 //! (`-d in_asm,exec,nochain`); the count of each block times its length gives exact
 //! instructions per block. Prints the share of compiler built-ins (64-bit multiply and divide,
 //! memcpy), the top functions, the top source lines of this repository and the top functions
