@@ -203,21 +203,77 @@ fn scale_axes(v: Vec3, s: Vec3) -> Vec3 {
     Vec3::from_bits(m(a[0], b[0]), m(a[1], b[1]), m(a[2], b[2]))
 }
 
-/// The roots of `A t² + 2B t + C = 0` (A, B, C in I32F32), sorted, or `None` if there are
-/// none or `A` is 0. The discriminant `B² − AC` is formed in 128 bits.
-fn quadratic(a: I32F32, b: I32F32, c: I32F32) -> Option<(I16F16, I16F16)> {
-    let disc = (b.to_bits() as i128 * b.to_bits() as i128)
-        .checked_sub(a.to_bits() as i128 * c.to_bits() as i128)?;
-    if disc < 0 {
+/// `num / den` for two I32F32 values as an I16F16, truncated and saturated to the I16F16
+/// range, or `None` if `den` is 0. A root of a quadratic beyond the range lies beyond every
+/// window, which the saturated bound keeps it.
+#[inline]
+fn quotient_saturating(num: I32F32, den: I32F32) -> Option<I16F16> {
+    let (num, den) = (num.to_bits(), den.to_bits());
+    if den == 0 {
         return None;
     }
+    // The 64-bit quotient where num · 2^16 fits (the envelope's), else the 128-bit one.
+    let q = match num.checked_mul(1 << 16).and_then(|n| n.checked_div(den)) {
+        Some(q) => i128::from(q),
+        None => (i128::from(num) << 16).checked_div(i128::from(den))?,
+    };
+    Some(I16F16::from_bits(
+        q.clamp(i128::from(i32::MIN), i128::from(i32::MAX)) as i32,
+    ))
+}
+
+/// What [`quadratic`] found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Roots {
+    /// No real root: the quadratic keeps the sign of `A` everywhere.
+    None,
+    /// The two real roots, sorted, each saturated to the I16F16 range.
+    Two(I16F16, I16F16),
+    /// `A` is 0, or the values are beyond the arithmetic's range (outside the envelope).
+    Unknown,
+}
+
+/// The roots of `A t² + 2B t + C = 0` (A, B, C in I32F32). The discriminant `B² − AC` is
+/// formed in 128 bits. "No real root" and "a root beyond the I16F16 range" are told apart: a
+/// frustum steeper than its side is inside everywhere in the first case, but in the second
+/// only on one side of the other root.
+///
+/// The roots are `q / A` and `C / q` with `q = −B − sign(B)·√(B² − AC)`, whose two terms never
+/// cancel: `(−B ± √(B² − AC)) / A` loses the smaller root to cancellation when `AC` is small
+/// against `B²`, as for a ray nearly parallel to a cone's side, where `A` is at the size of
+/// its own rounding and the quotient turns that error into any root at all.
+fn quadratic(a: I32F32, b: I32F32, c: I32F32) -> Roots {
+    let Some(disc) = (b.to_bits() as i128 * b.to_bits() as i128)
+        .checked_sub(a.to_bits() as i128 * c.to_bits() as i128)
+    else {
+        return Roots::Unknown;
+    };
+    if disc < 0 {
+        return Roots::None;
+    }
     // 64 fraction bits → I32F32.
-    let disc = i64::try_from(disc >> 32).ok()?;
+    let Ok(disc) = i64::try_from(disc >> 32) else {
+        return Roots::Unknown;
+    };
     let root = I32F32::from(sqrt(I32F32::from_bits(disc)));
-    let nb = b.checked_neg()?;
-    let t1 = quotient(nb.checked_sub(root)?, a)?;
-    let t2 = quotient(nb.checked_add(root)?, a)?;
-    Some(if t1 <= t2 { (t1, t2) } else { (t2, t1) })
+    let q = if b >= I32F32::ZERO {
+        b.checked_add(root).and_then(I32F32::checked_neg)
+    } else {
+        root.checked_sub(b)
+    };
+    let roots = q.and_then(|q| {
+        if q == I32F32::ZERO {
+            // B = 0 and B² = AC, so C = 0: the double root 0.
+            return Some((I16F16::ZERO, I16F16::ZERO));
+        }
+        let t1 = quotient_saturating(q, a)?;
+        let t2 = quotient_saturating(c, q)?;
+        Some(if t1 <= t2 { (t1, t2) } else { (t2, t1) })
+    });
+    match roots {
+        Some((t1, t2)) => Roots::Two(t1, t2),
+        None => Roots::Unknown,
+    }
 }
 
 /// The interval in which the ray is inside the ellipsoid: a sphere of radius `scale_radius`
@@ -226,7 +282,10 @@ fn ellipsoid_span(e: &Ellipsoid, ray: &Ray) -> Option<(I16F16, I16F16)> {
     let o = scale_axes(ray.origin.sub(e.centre), e.scale);
     let d = scale_axes(ray.dir, e.scale);
     let r = e.scale_radius;
-    quadratic(d.dot(d), d.dot(o), o.dot(o) - r.wide_mul(r))
+    match quadratic(d.dot(d), d.dot(o), o.dot(o) - r.wide_mul(r)) {
+        Roots::Two(t1, t2) => Some((t1, t2)),
+        Roots::None | Roots::Unknown => None,
+    }
 }
 
 /// The interval in which the ray is inside the capped frustum: the side's quadratic clipped
@@ -260,21 +319,27 @@ fn frustum_span(f: &Frustum, ray: &Ray) -> Option<(I16F16, I16F16)> {
     // where the side function a t² + 2b t + c ≤ 0; the frustum is convex, so that set meets
     // the slab's interval in an interval.
     if a > I32F32::ZERO {
-        let (r1, r2) = quadratic(a, b, c)?;
+        let Roots::Two(r1, r2) = quadratic(a, b, c) else {
+            return None;
+        };
         t_in = t_in.max(r1);
         t_out = t_out.min(r2);
     } else if a < I32F32::ZERO {
         // Steeper than the side: inside outside the roots (everywhere without roots).
-        if let Some((r1, r2)) = quadratic(a, b, c) {
-            if t_out <= r1 || t_in >= r2 {
-                // The whole slab interval is inside.
-            } else if t_in < r1 {
-                t_out = r1;
-            } else if t_out > r2 {
-                t_in = r2;
-            } else {
-                return None;
+        match quadratic(a, b, c) {
+            Roots::None => {}
+            Roots::Two(r1, r2) => {
+                if t_out <= r1 || t_in >= r2 {
+                    // The whole slab interval is inside.
+                } else if t_in < r1 {
+                    t_out = r1;
+                } else if t_out > r2 {
+                    t_in = r2;
+                } else {
+                    return None;
+                }
             }
+            Roots::Unknown => return None,
         }
     } else if b == I32F32::ZERO {
         // Parallel to the side (to the axis, for a cylinder): inside throughout or never.
@@ -283,7 +348,7 @@ fn frustum_span(f: &Frustum, ray: &Ray) -> Option<(I16F16, I16F16)> {
         }
     } else {
         // 2b t + c ≤ 0.
-        let t = quotient(-c, b.checked_mul_int(2)?)?;
+        let t = quotient_saturating(c.checked_neg()?, b.checked_mul_int(2)?)?;
         if b > I32F32::ZERO {
             t_out = t_out.min(t);
         } else {
@@ -554,6 +619,102 @@ mod tests {
         let tri = Shape::Triangle(Triangle::new([l[0], l[1], l[5]]).unwrap());
         assert!(tri.hit(&down(0.4, 0.4), I16F16::ZERO, FAR).is_some());
         assert!(tri.hit(&down(1.1, 1.1), I16F16::ZERO, FAR).is_none());
+    }
+
+    /// Rays parallel to a frustum's side, just outside it or just inside, the case where the
+    /// side's quadratic coefficient `A` is at the size of its own rounding: outside they miss
+    /// (once a root beyond the I16F16 range read as "no root" and the whole slab as inside),
+    /// inside they hit. Frusta narrowing and widening, lines around the axis, offsets from
+    /// 2^-6 to 2 units.
+    #[test]
+    fn rays_along_a_frustums_side_hit_only_inside_it() {
+        let mut checked = 0;
+        for (r0, r1) in [(2.0f32, 1.0f32), (1.0, 2.0), (4.0, 0.0), (0.5, 3.5)] {
+            let frustum = Frustum::new(v(0.0, 0.0, 0.0), f(r0), v(0.0, 2.0, 0.0), f(r1)).unwrap();
+            let shape = Shape::Frustum(frustum);
+            for k in 0..12 {
+                let angle = k as f32 * core::f32::consts::TAU / 12.0;
+                let (c, s) = (libm::cosf(angle), libm::sinf(angle));
+                // The side's line from radius r0 at y = 0 to r1 at y = 2, its unit direction
+                // and the outward normal in its plane through the axis.
+                let (dr, len) = (r1 - r0, libm::sqrtf((r1 - r0) * (r1 - r0) + 4.0));
+                let g = [dr * c / len, 2.0 / len, dr * s / len];
+                let n = [2.0 * c / len, -dr / len, 2.0 * s / len];
+                for offset in [-1.0 / 64.0, -0.1, -0.5, 1.0 / 64.0, 0.01, 0.1, 2.0] {
+                    // Along the line at mid-height, pushed `offset` along the normal, from ten
+                    // units back.
+                    let mid = [(r0 + r1) / 2.0 * c, 1.0, (r0 + r1) / 2.0 * s];
+                    let o: [f32; 3] =
+                        core::array::from_fn(|i| mid[i] + offset * n[i] - 10.0 * g[i]);
+                    let ray = Ray {
+                        origin: v(o[0], o[1], o[2]),
+                        dir: v(g[0], g[1], g[2]).normalized().unwrap(),
+                    };
+                    let hit = shape.hit(&ray, I16F16::ZERO, FAR);
+                    assert_eq!(
+                        hit.is_some(),
+                        offset < 0.0,
+                        "{r0} {r1} {angle} {offset}: {hit:?}"
+                    );
+                    checked += 1;
+                }
+            }
+        }
+        assert_eq!(checked, 4 * 12 * 7);
+    }
+
+    /// The stable roots against f64, for quadratics from balanced to nearly linear (`A` a
+    /// millionth of `B`), with and without real roots: a root within range agrees to a few
+    /// steps of 2^-16 relative to its size, one beyond it is saturated, and "no real root" is
+    /// only said where there is none.
+    #[test]
+    fn quadratic_roots_are_stable() {
+        let mut rng = crate::test_rng::XorShift64::new(0x5851_f42d_4c95_7f2du64);
+        let mut unit = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+        let (mut two, mut none) = (0, 0);
+        for i in 0..20_000 {
+            let a = unit() * [1.0, 1e-3, 1e-6][i % 3];
+            let (b, c) = (unit() * 200.0, unit() * 20_000.0);
+            let fx = |x: f64| I32F32::from_num(x);
+            let (fa, fb, fc) = (fx(a), fx(b), fx(c));
+            if fa == I32F32::ZERO {
+                continue;
+            }
+            let (a, b, c) = (fa.to_num::<f64>(), fb.to_num::<f64>(), fc.to_num::<f64>());
+            let disc = b * b - a * c;
+            match quadratic(fa, fb, fc) {
+                Roots::Two(t1, t2) => {
+                    assert!(disc >= -1e-6 * b * b, "{a} {b} {c}: no real root expected");
+                    let s = libm::sqrt(disc.max(0.0));
+                    let q = if b >= 0.0 { -b - s } else { s - b };
+                    let (mut e1, mut e2) = (q / a, c / q);
+                    if e1 > e2 {
+                        (e1, e2) = (e2, e1);
+                    }
+                    for (got, want) in [(t1, e1), (t2, e2)] {
+                        let got = got.to_num::<f64>();
+                        if want.abs() < 32_000.0 {
+                            let tol = 1e-3 + want.abs() * 1e-4;
+                            assert!((got - want).abs() <= tol, "{a} {b} {c}: {got} vs {want}");
+                        } else {
+                            assert_eq!(got.signum(), want.signum(), "{a} {b} {c}");
+                            assert!(got.abs() > 32_000.0, "{a} {b} {c}: {got} vs {want}");
+                        }
+                    }
+                    two += 1;
+                }
+                Roots::None => {
+                    assert!(disc < 0.0, "{a} {b} {c}");
+                    none += 1;
+                }
+                Roots::Unknown => panic!("{a} {b} {c}: inside the range"),
+            }
+        }
+        assert!(two > 10_000 && none > 1_000, "{two} {none}");
+    }
+
+    fn f(x: f32) -> I16F16 {
+        I16F16::from_num(x)
     }
 
     #[test]
