@@ -12,28 +12,13 @@
 //! and reduces its triangle list to the fewest triangles that still fail.
 
 use embedded_graphics::pixelcolor::Rgb888;
+use scanline3d_sim::draw::Draw;
 use scanline3d_sim::metrics::{self, ErrorBound};
 use scanline3d_sim::scene::{Algorithm, CameraSpec, LightSpec, MeshData, SceneSpec};
 use std::collections::BTreeMap;
 
 const W: usize = 48;
 const H: usize = 36;
-
-/// Xorshift draws, so a seed names its cases.
-struct Draw(u64);
-
-impl Draw {
-    fn in_range(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        lo + (hi - lo) * (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn point(&mut self, r: f64) -> [f64; 3] {
-        [0; 3].map(|_| self.in_range(-r, r))
-    }
-}
 
 /// One random case: a triangle soup, a camera and whether back faces are culled.
 struct Case {
@@ -140,7 +125,7 @@ fn main() {
     let cases = arg(1).unwrap_or(120) as usize;
     let seed = arg(2).unwrap_or(1);
     let only = arg(3).map(|c| c as usize);
-    let mut d = Draw(0x9e37_79b9_7f4a_7c15 ^ seed.wrapping_mul(0x2545_f491_4f6c_dd1d));
+    let mut d = Draw::new(0x9e37_79b9_7f4a_7c15 ^ seed.wrapping_mul(0x2545_f491_4f6c_dd1d));
     let mut failures: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     let mut judged = 0;
     for k in 0..cases {

@@ -11,6 +11,8 @@ pub mod analyze;
 pub mod bsp;
 #[cfg(not(target_os = "none"))]
 pub mod corpus;
+#[cfg(not(target_os = "none"))]
+pub mod draw;
 #[cfg(all(not(target_os = "none"), feature = "tools"))]
 pub mod export;
 #[cfg(not(target_os = "none"))]

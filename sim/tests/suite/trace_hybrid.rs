@@ -6,6 +6,7 @@ use crate::run::{scratch, sim};
 use embedded_graphics::pixelcolor::Rgb565;
 use scanline3d::sink::HashSink;
 use scanline3d::trace::{ScreenBound, ShadowCandidate, TraceOptions, Tracer};
+use scanline3d_sim::draw::Draw;
 use scanline3d_sim::scene::CameraSpec;
 use scanline3d_sim::trace::{corpus, fixed, scene::TracedScene};
 use std::path::Path;
@@ -96,20 +97,7 @@ fn assert_same_images(a: &fixed::FixedFrame, b: &fixed::FixedFrame, what: &str) 
 /// range taken for "no root"), which only the structures' boxes hid: about 1 scene in 350.
 #[test]
 fn every_search_gives_the_same_frame_on_random_scenes() {
-    /// Xorshift, so every run draws the same scenes.
-    struct Draw(u64);
-    impl Draw {
-        fn in_range(&mut self, lo: f64, hi: f64) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            lo + (hi - lo) * (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-        fn point(&mut self, scale: f64) -> [f64; 3] {
-            [0; 3].map(|_| self.in_range(-scale, scale))
-        }
-    }
-    let mut d = Draw(0x2545_f491_4f6c_dd1d);
+    let mut d = Draw::new(0x2545_f491_4f6c_dd1d);
     let (mut frames, mut hit) = (0, 0);
     for case in 0..3_000usize {
         let scale = [1.0, 10.0, 100.0, 2000.0][case % 4];
