@@ -204,8 +204,8 @@ fn scale_axes(v: Vec3, s: Vec3) -> Vec3 {
 }
 
 /// `num / den` for two I32F32 values as an I16F16, truncated and saturated to the I16F16
-/// range, or `None` if `den` is 0. A root of a quadratic beyond the range lies beyond every
-/// window, which the saturated bound keeps it.
+/// range, or `None` if `den` is 0. A root beyond the range lies beyond every window, and so
+/// does the saturated one.
 #[inline]
 fn quotient_saturating(num: I32F32, den: I32F32) -> Option<I16F16> {
     let (num, den) = (num.to_bits(), den.to_bits());
