@@ -57,11 +57,14 @@
 //!
 //! The rounded parts are only used to find the order. What is painted is the original
 //! piece, cut by a *split tree*: each split records the screen lines between its parts (the
-//! line through the two rounded cut points, and the diagonal of a four-sided part), and every
+//! line where the cutting plane crosses the original's plane, through its crossings of the
+//! original's edges to 2^−8 sub-pixel, and the diagonal of a four-sided part), and every
 //! pixel centre of the original goes to exactly one side of each line. So the parts tile the
 //! original exactly, whatever the rounding: no crack where a rounded cut point falls inside
 //! an outer edge, no T-junction where a later cut meets an earlier one, and the original's
-//! coverage is the span z-buffer's.
+//! coverage is the span z-buffer's. The cut is not the line through the rounded cut points:
+//! across a thin piece those lie a few sub-pixels apart, and the line through them can turn
+//! far enough to send pixel centres a pixel away to the wrong side of the plane.
 //!
 //! # Ties
 //!
@@ -103,9 +106,10 @@
 //!
 //! A [`NewellWorkspace`] holds, in bytes:
 //!
-//! * `PIECES · 89`: the kept pieces ([`StoredTriangle`], 52), the list (2), a key per piece
+//! * `PIECES · 107`: the kept pieces ([`StoredTriangle`], 52), the list (2), a key per piece
 //!   (4: its activation rank while sorting, then its position), a mark (1), a bucket link (2),
-//!   a split-tree link (4) and a split-tree cut (24: two points and two links);
+//!   a split-tree link (4), the piece's original (2) and a split-tree cut (40: two points in
+//!   fine units and two links);
 //! * `2·H` bucket heads, `size_of::<P>()·W + 4·W` for one row of pixels and their positions,
 //!   and `ACTIVE` active triangles (about 112 bytes each for flat shading, with the sort key).
 //!
@@ -217,6 +221,7 @@ pub struct NewellWorkspace<
     marked: [bool; PIECES],
     next: [u16; PIECES],
     tree: [u32; PIECES],
+    origin: [u16; PIECES],
     nodes: [Cut; PIECES],
     heads: [u16; H],
     pixels: [P; W],
@@ -259,6 +264,7 @@ impl<
             marked: [false; PIECES],
             next: [NO_ENTRY; PIECES],
             tree: [0; PIECES],
+            origin: [0; PIECES],
             nodes: [Cut::EMPTY; PIECES],
             heads: [NO_ENTRY; H],
             pixels: [background; W],
@@ -317,8 +323,15 @@ impl<
         )?;
         let collected = n;
         // Each original is a whole tree of one piece until it is split.
-        for (i, t) in self.tree.iter_mut().take(n).enumerate() {
+        for (i, (t, o)) in self
+            .tree
+            .iter_mut()
+            .zip(&mut self.origin)
+            .take(n)
+            .enumerate()
+        {
             *t = LEAF | i as u32;
+            *o = i as u16;
         }
         let mut sort = Sort {
             store: &mut self.store,
@@ -326,6 +339,7 @@ impl<
             marked: &mut self.marked,
             list: &mut self.list,
             tree: &mut self.tree,
+            origin: &mut self.origin,
             nodes: &mut self.nodes,
             originals: n,
             n,
@@ -533,6 +547,8 @@ struct Sort<'a> {
     /// or [`NOTHING`]). Per piece made by a split: where it hangs ([`ROOT`]` | original`, or
     /// `cut << 1 | side`, side 0 for the cut's `pos`).
     tree: &'a mut [u32],
+    /// Per piece: the original it is a part of (an original: itself).
+    origin: &'a mut [u16],
     /// The cuts made so far are `nodes[..cuts]`.
     nodes: &'a mut [Cut],
     cuts: usize,
@@ -784,6 +800,19 @@ impl Sort<'_> {
             self.stats.rounded_apart += 1;
             parts = apart;
         }
+        // The split tree cuts the original where the plane crosses the original's plane (the
+        // piece's own crossing if the plane misses the original), not along the rounded cut
+        // points (see `crossing_line`).
+        let origin = internal(self.origin.get(x as usize).copied(), x);
+        let ([a, b, _], on_plane) = rotated(&t, &plane);
+        // Part 0 lies on the side of the lone vertex `a`, or of `b` when `a` is on the plane.
+        let first = if on_plane { b } else { a };
+        let side = plane.at(&t, first.k).signum();
+        if let Some(line) = crossing_line(self.piece(origin), &plane, side)
+            .or_else(|| crossing_line(&t, &plane, side))
+        {
+            parts.lines[0] = line;
+        }
         if parts.parts.iter().all(Option::is_none) {
             // No part keeps any area on the grid, but the piece's region of the original may
             // still hold pixel centres (a sliver along a column of them): dropping it would
@@ -837,14 +866,16 @@ impl Sort<'_> {
                 self.n - 1
             });
             *r = Some(LEAF | i as u32);
-            if let (Some(s), Some(k), Some(m)) = (
+            if let (Some(s), Some(k), Some(m), Some(o)) = (
                 self.store.get_mut(i),
                 self.keys.get_mut(i),
                 self.marked.get_mut(i),
+                self.origin.get_mut(i),
             ) {
                 *s = part;
                 *k = rank;
                 *m = false;
+                *o = origin;
             } else {
                 // The store had room: checked above.
                 debug_assert!(false, "internal error: no store entry {i} for a part");
@@ -947,38 +978,80 @@ const NOTHING: u32 = u32::MAX;
 /// Where a piece hangs when it is a whole tree: `ROOT | original`.
 const ROOT: u32 = 1 << 31;
 
-/// A line through two points of the sub-pixel grid, and a point off it.
+/// A line through two screen points and a point off it, in fine units ([`FineXy`]).
 #[derive(Clone, Copy, Debug)]
 struct Line {
-    a: [i32; 2],
-    b: [i32; 2],
-    inside: [i32; 2],
+    a: FineXy,
+    b: FineXy,
+    inside: FineXy,
 }
 
 impl Line {
-    /// `(b − a) × (p − a)`: its sign says on which side of the line `p` is.
-    fn side(&self, p: [i32; 2]) -> i64 {
-        let d = |k: usize| self.b[k] as i64 - self.a[k] as i64;
-        d(0) * (p[1] as i64 - self.a[1] as i64) - d(1) * (p[0] as i64 - self.a[0] as i64)
+    /// The line through the grid points of `a` and `b`, `inside` off it.
+    fn through(a: &Vertex, b: &Vertex, inside: &Vertex) -> Line {
+        Line {
+            a: a.fine(),
+            b: b.fine(),
+            inside: inside.fine(),
+        }
     }
 
-    /// [`Line::side`] of a point in fine units ([`FineXy`]), with the same sign.
-    fn side_fine(&self, p: FineXy) -> i128 {
+    /// `(b − a) × (p − a)`: its sign says on which side of the line `p` is.
+    fn side(&self, p: FineXy) -> i128 {
         let d = |k: usize| self.b[k] as i128 - self.a[k] as i128;
-        let from = |k: usize| p[k] as i128 - ((self.a[k] as i128) << FINE);
+        let from = |k: usize| p[k] as i128 - self.a[k] as i128;
         d(0) * from(1) - d(1) * from(0)
     }
 }
 
+/// The line where `plane` cuts the plane of `o`: through the points where it crosses `o`'s
+/// edges (or passes through its vertices), each within half a fine unit, with `inside` a
+/// vertex of `o` on the side of `plane` whose sign is `side`. `None` if the plane does not
+/// cross `o` with a vertex on that side.
+///
+/// A split tree cuts with this line, not with the line through the rounded cut points: two
+/// rounded points close together (a cut across a thin piece) give a line whose direction is
+/// off by up to a sub-pixel over their distance, which sends pixel centres far along it to
+/// the wrong part.
+fn crossing_line(o: &StoredTriangle, plane: &PlaneEq, side: i128) -> Option<Line> {
+    let v = [0, 1, 2].map(|k| Vertex::of(o, k));
+    let s = [0, 1, 2].map(|k| plane.at(o, k));
+    let mut points: [Option<FineXy>; 2] = [None; 2];
+    for k in 0..3 {
+        let (u, su) = (v.get(k)?, *s.get(k)?);
+        let (w, sw) = (v.get((k + 1) % 3)?, *s.get((k + 1) % 3)?);
+        let point = if su == 0 {
+            u.fine()
+        } else if su.signum() * sw.signum() < 0 {
+            u.toward_fine(w, su, su - sw)
+        } else {
+            continue;
+        };
+        match points {
+            [None, _] => points[0] = Some(point),
+            [Some(first), None] if first != point => points[1] = Some(point),
+            _ => {}
+        }
+    }
+    let inside =
+        (0..3).find(|&k| side != 0 && s.get(k).map(|s| s.signum()) == Some(side.signum()))?;
+    let line = Line {
+        a: points[0]?,
+        b: points[1]?,
+        inside: v.get(inside)?.fine(),
+    };
+    (line.side(line.inside) != 0).then_some(line)
+}
+
 /// A node of a split tree: the original piece's region is cut by the line through `a` and `b`
-/// (sub-pixel points); pixel centres `p` where `(b − a) × (p − a) ≥ 0` go to `pos`, the
+/// (points in fine units); pixel centres `p` where `(b − a) × (p − a) ≥ 0` go to `pos`, the
 /// others to `neg` (each a [`LEAF`] piece, another cut or [`NOTHING`]). Every pixel centre of
 /// the original goes to exactly one leaf, whatever the rounding of the cut points, so the
 /// parts of a split tile the original without cracks or overlap.
 #[derive(Clone, Copy, Debug)]
 struct Cut {
-    a: [i32; 2],
-    b: [i32; 2],
+    a: FineXy,
+    b: FineXy,
     pos: u32,
     neg: u32,
 }
@@ -993,16 +1066,17 @@ impl Cut {
 
     /// On row `y`, the side of column `x`'s centre (`true`: `pos`) and the first column after
     /// `x` where the side changes, if any (sub-pixel bits `SUB`). Exact: the side is a linear
-    /// function `A·x + B` of the column, in `i128` (`|A| < 2^33`, `|B| < 2^80`).
+    /// function `A·x + B` of the column, in `i128` (fine coordinates below 2^30: `|A| < 2^49`,
+    /// `|B| < 2^66`).
     fn side_and_end<const SUB: u32>(&self, x: i32, y: i32) -> (bool, Option<i128>) {
         let (dx, dy) = (
             self.b[0] as i128 - self.a[0] as i128,
             self.b[1] as i128 - self.a[1] as i128,
         );
-        // Doubled coordinates: a centre is at (2c + 1) · 2^SUB halves.
-        let cx = |c: i128| ((2 * c + 1) << SUB) - 2 * self.a[0] as i128;
-        let cy = ((2 * y as i128 + 1) << SUB) - 2 * self.a[1] as i128;
-        let slope = -(dy << (SUB + 1));
+        // Doubled fine coordinates: a centre is at (2c + 1) · 2^(SUB + FINE) halves.
+        let cx = |c: i128| ((2 * c + 1) << (SUB + FINE)) - 2 * self.a[0] as i128;
+        let cy = ((2 * y as i128 + 1) << (SUB + FINE)) - 2 * self.a[1] as i128;
+        let slope = -(dy << (SUB + FINE + 1));
         let at0 = dx * cy - dy * cx(0);
         let here = slope * x as i128 + at0;
         // (Checked divisions: the divisor is positive, so `None` only stands for no change.)
@@ -1181,11 +1255,7 @@ fn assemble(
     points: [Vertex; 2],
 ) -> Parts {
     let tri = |p: [Vertex; 3]| make(t, p);
-    let line = |a: &Vertex, b: &Vertex, inside: &Vertex| Line {
-        a: [a.x, a.y],
-        b: [b.x, b.y],
-        inside: [inside.x, inside.y],
-    };
+    let line = Line::through;
     let [i1, i2] = points;
     if on_plane {
         // b and c lie on opposite sides.
@@ -1233,7 +1303,7 @@ fn round_apart(t: &StoredTriangle, plane: &PlaneEq, parts: &Parts, grid: Grid) -
     let (v, on_plane) = rotated(t, plane);
     let [a, b, c] = &v;
     let none = parts.parts.each_ref().map(Option::is_none);
-    let fine = |u: &Vertex| [(u.x as i64) << FINE, (u.y as i64) << FINE];
+    let fine = Vertex::fine;
     let exact = |u: &Vertex, w: &Vertex| {
         let (su, sw) = (plane.at(t, u.k), plane.at(t, w.k));
         u.toward_fine(w, su, su - sw)
@@ -1305,7 +1375,7 @@ fn round_apart(t: &StoredTriangle, plane: &PlaneEq, parts: &Parts, grid: Grid) -
                 .flatten()
                 .all(|p| signed_area(p).signum() == orientation);
             let [l0, _] = candidate.lines;
-            let side = |u: &Vertex| l0.side([u.x, u.y]).signum();
+            let side = |u: &Vertex| l0.side(u.fine()).signum();
             let separates = if on_plane {
                 side(b) * side(c) < 0
             } else {
@@ -1314,7 +1384,7 @@ fn round_apart(t: &StoredTriangle, plane: &PlaneEq, parts: &Parts, grid: Grid) -
             if !(kept && oriented && separates) {
                 continue;
             }
-            let on_inside = |p: FineXy| (l0.side_fine(p) >= 0) == (l0.side(l0.inside) >= 0);
+            let on_inside = |p: FineXy| (l0.side(p) >= 0) == (l0.side(l0.inside) >= 0);
             if !for_each_centre(region, grid, |p| on_inside(p) == inside) {
                 continue;
             }
@@ -1443,6 +1513,11 @@ struct Vertex {
 }
 
 impl Vertex {
+    /// The vertex's grid point in fine units.
+    fn fine(&self) -> FineXy {
+        [(self.x as i64) << FINE, (self.y as i64) << FINE]
+    }
+
     fn of(t: &StoredTriangle, k: usize) -> Vertex {
         Vertex {
             k,
@@ -1555,11 +1630,7 @@ mod tests {
         let line = apart.lines[0];
         let centre: FineXy = [2264 << FINE, 1592 << FINE];
         let inside = line.side(line.inside) >= 0;
-        assert_eq!(
-            line.side_fine(centre) >= 0,
-            inside,
-            "and the centre goes to it"
-        );
+        assert_eq!(line.side(centre) >= 0, inside, "and the centre goes to it");
         for p in apart.parts.iter().flatten() {
             assert!(!plane.straddled_by(p), "{p:?}");
         }
@@ -1574,19 +1645,21 @@ mod tests {
 
     #[test]
     fn a_cut_sends_each_pixel_centre_to_one_side_and_finds_where_it_changes() {
-        // Lines at various slopes through sub-pixel points (4 bits), against the sign of the
-        // cross product at each centre of a row.
+        // Lines at various slopes through points in fine units (4 sub-pixel bits), against
+        // the sign of the cross product at each centre of a row.
         for (a, b) in [
-            ([3, 5], [200, 90]),
-            ([40, 0], [41, 300]),
-            ([0, 17], [150, 17]),
-            ([100, 8], [20, 250]),
-            ([64, 0], [64, 99]),
+            ([3 << FINE, 5 << FINE], [200 << FINE, 90 << FINE]),
+            ([40 << FINE, 0], [41 << FINE, 300 << FINE]),
+            ([0, 17 << FINE], [150 << FINE, 17 << FINE]),
+            ([100 << FINE, 8 << FINE], [20 << FINE, 250 << FINE]),
+            ([64 << FINE, 0], [64 << FINE, 99 << FINE]),
+            ([1000, 1337], [51_000, 9_001]),
+            ([-77, 4_100], [3, 76_543]),
         ] {
             let cut = Cut { a, b, ..Cut::EMPTY };
             let side = |c: i32, y: i32| {
                 let line = Line { a, b, inside: a };
-                line.side([c * 16 + 8, y * 16 + 8]) >= 0
+                line.side([((c * 16 + 8) as i64) << FINE, ((y * 16 + 8) as i64) << FINE]) >= 0
             };
             for y in 0..16 {
                 for x in 0..20 {
