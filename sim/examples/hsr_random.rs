@@ -12,42 +12,13 @@
 //! and reduces its triangle list to the fewest triangles that still fail.
 
 use embedded_graphics::pixelcolor::Rgb888;
-use scanline3d_sim::draw::Draw;
+use scanline3d_sim::draw::Soup;
 use scanline3d_sim::metrics::{self, ErrorBound};
 use scanline3d_sim::scene::{Algorithm, CameraSpec, LightSpec, MeshData, SceneSpec};
 use std::collections::BTreeMap;
 
 const W: usize = 48;
 const H: usize = 36;
-
-/// One random case: a triangle soup, a camera and whether back faces are culled.
-struct Case {
-    vertices: Vec<[f64; 3]>,
-    camera: CameraSpec,
-    cull: bool,
-}
-
-impl Case {
-    fn draw(d: &mut Draw, case: usize) -> Case {
-        let triangles = 1 + (d.in_range(0.0, 1.0) * 40.0) as usize;
-        let spread = [0.5, 3.0, 3.0, 30.0][case % 4];
-        let vertices = (0..3 * triangles).map(|_| d.point(spread)).collect();
-        let camera = CameraSpec {
-            eye: d.point(8.0),
-            target: d.point(1.0),
-            up: [0.0, 1.0, 0.0],
-            fovy: d.in_range(20.0, 120.0),
-            near: d.in_range(0.05, 0.5),
-            far: 40.0,
-        };
-        let cull = d.in_range(0.0, 1.0) < 0.5;
-        Case {
-            vertices,
-            camera,
-            cull,
-        }
-    }
-}
 
 /// What `algorithm` at `sub_bits` gives on a soup against the reference: (real mismatches,
 /// depths beyond the bound), `Err` for a method's error, `None` for a scene the tools refuse.
@@ -97,7 +68,7 @@ fn judge(
 }
 
 /// The fewest triangles of `vertices` (dropping one at a time) that still fail.
-fn reduce(case: &Case, sub_bits: u32, algorithm: Algorithm) -> Vec<[f64; 3]> {
+fn reduce(case: &Soup, sub_bits: u32, algorithm: Algorithm) -> Vec<[f64; 3]> {
     let fails = |v: &[[f64; 3]]| {
         matches!(
             judge(v, case.camera, case.cull, sub_bits, algorithm, false),
@@ -125,11 +96,11 @@ fn main() {
     let cases = arg(1).unwrap_or(120) as usize;
     let seed = arg(2).unwrap_or(1);
     let only = arg(3).map(|c| c as usize);
-    let mut d = Draw::new(0x9e37_79b9_7f4a_7c15 ^ seed.wrapping_mul(0x2545_f491_4f6c_dd1d));
+    let mut d = Soup::draws(seed);
     let mut failures: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     let mut judged = 0;
     for k in 0..cases {
-        let case = Case::draw(&mut d, k);
+        let case = Soup::draw(&mut d, k);
         if only.is_some_and(|o| o != k) || case.camera.fixed().is_err() {
             continue;
         }

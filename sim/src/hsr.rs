@@ -49,19 +49,19 @@ pub const LEVELS: [Level; 3] = [
         polygons: 100,
         tris: 60,
         active: 34,
-        pieces: 109,
+        pieces: 108,
     },
     Level {
         polygons: 2500,
         tris: 1309,
         active: 121,
-        pieces: 1397,
+        pieces: 1413,
     },
     Level {
         polygons: 60_000,
         tris: 29_476,
         active: 500,
-        pieces: 29_889,
+        pieces: 30_074,
     },
 ];
 

@@ -98,7 +98,19 @@ pub fn accuracy_same_culling(
     h: usize,
     sub_bits: u32,
 ) -> Result<(Metrics, scene::FixedRender, reference::Image), String> {
-    let fixed = spec.render_fixed(w, h, sub_bits)?;
+    accuracy_same_culling_with(spec, w, h, sub_bits, scene::Algorithm::SpanZBuffer)
+}
+
+#[cfg(not(target_os = "none"))]
+/// [`accuracy_same_culling`] for any hidden-surface method.
+pub fn accuracy_same_culling_with(
+    spec: &SceneSpec,
+    w: usize,
+    h: usize,
+    sub_bits: u32,
+    algorithm: scene::Algorithm,
+) -> Result<(Metrics, scene::FixedRender, reference::Image), String> {
+    let fixed = spec.render_fixed_with(w, h, sub_bits, algorithm)?;
     let mut reference = spec.reference()?;
     reference.cull_back_faces = spec.cull_back_faces;
     compare_with(

@@ -4,9 +4,11 @@
 //!
 //! Every visible screen piece of the frame is kept (the [`store`] module: transform, clipping,
 //! projection and culling are the shared ones). The work is done in screen space: `x`, `y` in
-//! sub-pixels and `q = near/w` in I2F30 bits. Projection there is orthographic along `q` and
-//! the eye is at `q = +∞` (larger `q` is nearer), and a triangle's plane stays a plane, so
-//! every plane test below is exact integer arithmetic (`i128`) on the snapped vertices.
+//! sixteenths of a sub-pixel (the sort's grid, 4 bits below the sub-pixel grid; the snapped
+//! vertices lie on it exactly) and `q = near/w` in I2F30 bits. Projection there is
+//! orthographic along `q` and the eye is at `q = +∞` (larger `q` is nearer), and a
+//! triangle's plane stays a plane, so every plane test below is exact integer arithmetic
+//! (`i128`) on the snapped vertices.
 //!
 //! The pieces are sorted by their farthest depth (smallest `q`), far first. Then the head of
 //! the list, `P`, is compared with every other piece `Q` whose depth range reaches `P`'s
@@ -26,19 +28,26 @@
 //! marked. A marked piece that would be moved again closes a cycle: it is split by `P`'s
 //! plane (or `P` by its plane, whichever straddles the other), as is `Q` when neither order
 //! can be shown (interpenetration). The pieces of a split replace it in the list and the
-//! search goes on.
+//! search goes on. Pieces of one original never overlap (its split tree, below, gives each
+//! pixel centre to one of them) and are not compared.
+//!
+//! A piece's plane, in tests 3 and 4 and for splitting, is the plane of the original it is a
+//! part of, not the plane through its own rounded vertices: a frame then has only its
+//! originals' planes, and a part is never cut again by a plane a rounding away from the one
+//! that made it (on random soups such planes made pieces of slivers until the sort ran out
+//! of steps).
 //!
 //! # Splitting and tolerances
 //!
 //! A piece is cut where its edges cross the other's plane. The new vertices are rounded to
-//! the sub-pixel grid (and `q` to an I2F30 step) and shared by the pieces on both sides.
+//! the sort's grid (and `q` to an I2F30 step) and shared by the pieces on both sides.
 //! Rounded vertices are no longer exactly on the cutting plane, so tests 3 and 4 count
 //! a vertex as on a plane when the plane passes through its rounding cell (`±½` in `x`, `y`
 //! and `q`): `2·|n·(v − a)| ≤ |n_x| + |n_y| + |n_q|`. The pieces of a split then always pass
 //! against the plane that cut them, so no cut is repeated. The price is that a piece may stick
 //! out of another's plane by less than that cell and still be drawn behind it: the pixels
-//! affected lie within about half a sub-pixel of where the two planes meet, where the depth
-//! gap is below the renderer's error bound.
+//! affected lie within about a thirty-second of a sub-pixel of where the two planes meet,
+//! where the depth gap is below the renderer's error bound.
 //!
 //! A thin piece may be straddled by a plane and still have no part of any area once the cut
 //! points are rounded. Its region of the original can hold pixel centres all the same (a
@@ -48,8 +57,8 @@
 //!
 //! Likewise a cut whose two cut points round onto one line can leave one side of the plane
 //! without a part of any area while that side's exact region holds pixel centres (a sliver one
-//! sub-pixel wide, cut across). Its pixels would go to a part on the other side, ordered
-//! there. Then the cut points are rounded apart instead, each to a corner of its sub-pixel
+//! grid unit wide, cut across). Its pixels would go to a part on the other side, ordered
+//! there. Then the cut points are rounded apart instead, each to a corner of its grid
 //! cell: the nearest pair that keeps them on the plane within the tolerance (their depths are
 //! the piece's plane there), keeps every part's orientation and puts those centres in the
 //! side's part ([`SortStats::rounded_apart`]). A side whose region holds no centre is still
@@ -173,7 +182,7 @@ pub struct SortStats {
     /// Cycles that no plane of their pieces cuts beyond the rounding cell (pieces of
     /// interpenetrating triangles meeting within it), broken by drawing the head first.
     pub cycles_within_rounding: u32,
-    /// Cuts whose cut points were rounded apart (to other corners of their sub-pixel cells)
+    /// Cuts whose cut points were rounded apart (to other corners of their cells of the sort's grid)
     /// because, rounded to the nearest, they left one side of the plane without a part of any
     /// area while its region of the piece holds pixel centres.
     pub rounded_apart: u32,
@@ -344,7 +353,7 @@ impl<
             originals: n,
             n,
             grid: Grid {
-                sub: SUB_BITS,
+                sub: SUB_BITS + SORT,
                 width: vp.width as i64,
                 height: vp.height as i64,
             },
@@ -353,7 +362,19 @@ impl<
             stats: SortStats::default(),
         };
         sort.ranks::<SUB_BITS>(vp.width as i32, vp.height as i32);
+        // The sort works on a grid `SORT` bits finer than the sub-pixel one (the originals'
+        // vertices shifted, exactly), the painter on the originals as they were.
+        let to_sort = |t: &mut StoredTriangle| {
+            t.x = t.x.map(|x| x << SORT);
+            t.y = t.y.map(|y| y << SORT);
+        };
+        sort.store.iter_mut().take(collected).for_each(to_sort);
         let result = sort.run();
+        let from_sort = |t: &mut StoredTriangle| {
+            t.x = t.x.map(|x| x >> SORT);
+            t.y = t.y.map(|y| y >> SORT);
+        };
+        sort.store.iter_mut().take(collected).for_each(from_sort);
         let (n, len, cuts) = (sort.n, sort.len, sort.cuts);
         sort.stats.pieces_out = len as u32;
         sort.stats.entries = n as u32;
@@ -409,9 +430,9 @@ impl<
 /// `s` is in front, towards the eye). `tol` is `|n_x| + |n_y| + n_q`: a vertex is on the plane
 /// when `2·|s(v)| ≤ tol`, i.e. the plane passes through its rounding cell.
 ///
-/// Bit budget: coordinates are below 2^22 sub-pixels and `q` below 2^31, so edge differences
-/// are below 2^23 and 2^32, `n` below 2^56 and `s` below 2^90: `i128` holds all of it, and
-/// the split interpolation's products (below 2^115).
+/// Bit budget: coordinates are below 2^26 units of the sort's grid ([`SORT`]) and `q` below
+/// 2^31, so edge differences are below 2^27 and 2^32, `n` below 2^60 and `s` below 2^89:
+/// `i128` holds all of it, and the split interpolation's products (below 2^124).
 #[derive(Clone, Copy, Debug)]
 struct PlaneEq {
     n: [i128; 3],
@@ -629,6 +650,15 @@ impl Sort<'_> {
         internal(self.marked.get(i as usize).copied(), false)
     }
 
+    /// The plane of the original `i` is a part of. The plane tests and the cuts use it, not
+    /// the plane through a part's rounded vertices: then a frame has only its originals'
+    /// planes, a part lies on its original's plane within the rounding cell, and the parts of
+    /// a cut are never cut again by a plane a rounding away from the one that made them.
+    fn plane(&self, i: u16) -> Option<PlaneEq> {
+        let o = internal(self.origin.get(i as usize).copied(), i);
+        PlaneEq::of(self.piece(o))
+    }
+
     /// How head `p` and piece `q` (whose depth ranges overlap) must be ordered.
     fn order(&mut self, p: u16, q: u16) -> Order {
         self.stats.comparisons += 1;
@@ -636,8 +666,15 @@ impl Sort<'_> {
         if disjoint(&pt.x, &qt.x) || disjoint(&pt.y, &qt.y) {
             return Order::HeadFirst;
         }
-        let (Some(pp), Some(qp)) = (PlaneEq::of(pt), PlaneEq::of(qt)) else {
+        if PlaneEq::of(pt).is_none() || PlaneEq::of(qt).is_none() {
             return Order::HeadFirst; // a piece of no area covers nothing
+        }
+        if self.origin.get(p as usize) == self.origin.get(q as usize) {
+            // Parts of one original: its split tree gives every pixel centre to one of them.
+            return Order::HeadFirst;
+        }
+        let (Some(pp), Some(qp)) = (self.plane(p), self.plane(q)) else {
+            return Order::HeadFirst;
         };
         let head_first = qp.all_behind(pt) || pp.all_in_front(qt);
         let other_first = pp.all_behind(qt) || qp.all_in_front(pt);
@@ -735,7 +772,7 @@ impl Sort<'_> {
                 }
                 Some((j, q, order)) => {
                     let (pt, qt) = (*self.piece(p), *self.piece(q));
-                    let (pp, qp) = (PlaneEq::of(&pt), PlaneEq::of(&qt));
+                    let (pp, qp) = (self.plane(p), self.plane(q));
                     match (pp, qp) {
                         (Some(pp), _) if pp.straddled_by(&qt) => {
                             self.split(j, pp, &mut front)?;
@@ -1065,18 +1102,19 @@ impl Cut {
     };
 
     /// On row `y`, the side of column `x`'s centre (`true`: `pos`) and the first column after
-    /// `x` where the side changes, if any (sub-pixel bits `SUB`). Exact: the side is a linear
-    /// function `A·x + B` of the column, in `i128` (fine coordinates below 2^30: `|A| < 2^49`,
-    /// `|B| < 2^66`).
+    /// `x` where the side changes, if any (sub-pixel bits `SUB`, the line in fine units of the
+    /// sort's grid). Exact: the side is a linear function `A·x + B` of the column, in `i128`
+    /// (fine coordinates below 2^34, `SUB` at most 8: `|A| < 2^56`, `|B| < 2^72`).
     fn side_and_end<const SUB: u32>(&self, x: i32, y: i32) -> (bool, Option<i128>) {
         let (dx, dy) = (
             self.b[0] as i128 - self.a[0] as i128,
             self.b[1] as i128 - self.a[1] as i128,
         );
-        // Doubled fine coordinates: a centre is at (2c + 1) · 2^(SUB + FINE) halves.
-        let cx = |c: i128| ((2 * c + 1) << (SUB + FINE)) - 2 * self.a[0] as i128;
-        let cy = ((2 * y as i128 + 1) << (SUB + FINE)) - 2 * self.a[1] as i128;
-        let slope = -(dy << (SUB + FINE + 1));
+        // Doubled fine coordinates: a centre is at (2c + 1) · 2^(SUB + SORT + FINE) halves.
+        let bits = SUB + SORT + FINE;
+        let cx = |c: i128| ((2 * c + 1) << bits) - 2 * self.a[0] as i128;
+        let cy = ((2 * y as i128 + 1) << bits) - 2 * self.a[1] as i128;
+        let slope = -(dy << (bits + 1));
         let at0 = dx * cy - dy * cx(0);
         let here = slope * x as i128 + at0;
         // (Checked divisions: the divisor is positive, so `None` only stands for no change.)
@@ -1274,15 +1312,23 @@ fn assemble(
     }
 }
 
-/// Bits below the sub-pixel grid at which [`round_apart`] places the exact cut points: a
-/// [`FineXy`] is sub-pixels · 2^8. Coordinates below 2^22 sub-pixels stay below 2^30 (their
-/// cross products below 2^63, taken in `i128`), and the interpolation's products below 2^121.
+/// Bits below the sub-pixel grid of the sort's grid: pieces' vertices are in sub-pixels · 2^4
+/// while sorting, so rounding a cut point moves it by at most 1/32 of a sub-pixel per axis
+/// (and the plane tests' tolerance cell is as small). Coordinates below 2^22 sub-pixels are
+/// below 2^26 there.
+const SORT: u32 = 4;
+
+/// Bits below the sort's grid at which [`round_apart`] places the exact cut points and split
+/// trees keep their lines: a [`FineXy`] is sort units · 2^8. Coordinates below 2^26 sort
+/// units stay below 2^34 (their cross products below 2^71, taken in `i128`), and the
+/// interpolation's products below 2^123.
 const FINE: u32 = 8;
 
-/// A screen point in sub-pixels · 2^[`FINE`].
+/// A screen point in sort units · 2^[`FINE`].
 type FineXy = [i64; 2];
 
-/// The screen a frame is sorted for: its sub-pixel bits and size in pixels.
+/// The screen a frame is sorted for: its bits below the pixel (sub-pixel and [`SORT`] bits)
+/// and size in pixels.
 #[derive(Clone, Copy, Debug)]
 struct Grid {
     sub: u32,
@@ -1292,7 +1338,7 @@ struct Grid {
 
 /// When `parts` (the nearest rounding of a cut of `t` by `plane`) leaves one side of the plane
 /// without a part of any area while that side's exact region of `t` holds pixel centres, the
-/// same cut with its cut points rounded apart, each to a corner of the sub-pixel cell that
+/// same cut with its cut points rounded apart, each to a corner of the grid cell that
 /// holds it, so that the side keeps a part whose region in the split tree holds those centres.
 /// Of the corners, the nearest pair (summed squared distance) that keeps every cut point on
 /// the plane within its tolerance (its depth taken from `t`'s plane), every part's
@@ -1401,7 +1447,7 @@ fn round_apart(t: &StoredTriangle, plane: &PlaneEq, parts: &Parts, grid: Grid) -
     best.map(|(_, p)| p)
 }
 
-/// The four grid points around `e` (corners of its sub-pixel cell; repeated when `e` is on
+/// The four grid points around `e` (corners of its grid cell; repeated when `e` is on
 /// a grid line).
 fn corners(e: FineXy) -> [[i32; 2]; 4] {
     let down = |v: i64| (v >> FINE).clamp(i32::MIN as i64, i32::MAX as i64) as i32;
@@ -1648,18 +1694,25 @@ mod tests {
         // Lines at various slopes through points in fine units (4 sub-pixel bits), against
         // the sign of the cross product at each centre of a row.
         for (a, b) in [
-            ([3 << FINE, 5 << FINE], [200 << FINE, 90 << FINE]),
-            ([40 << FINE, 0], [41 << FINE, 300 << FINE]),
-            ([0, 17 << FINE], [150 << FINE, 17 << FINE]),
-            ([100 << FINE, 8 << FINE], [20 << FINE, 250 << FINE]),
-            ([64 << FINE, 0], [64 << FINE, 99 << FINE]),
-            ([1000, 1337], [51_000, 9_001]),
-            ([-77, 4_100], [3, 76_543]),
-        ] {
+            ([3, 5], [200, 90]),
+            ([40, 0], [41, 300]),
+            ([0, 17], [150, 17]),
+            ([100, 8], [20, 250]),
+            ([64, 0], [64, 99]),
+        ]
+        .map(|(a, b): ([i64; 2], [i64; 2])| {
+            (a.map(|v| v << (SORT + FINE)), b.map(|v| v << (SORT + FINE)))
+        })
+        .into_iter()
+        .chain([
+            ([1000, 1337], [851_000, 9_001]),
+            ([-77, 4_100], [3, 976_543]),
+        ]) {
             let cut = Cut { a, b, ..Cut::EMPTY };
             let side = |c: i32, y: i32| {
                 let line = Line { a, b, inside: a };
-                line.side([((c * 16 + 8) as i64) << FINE, ((y * 16 + 8) as i64) << FINE]) >= 0
+                let centre = |c: i32| ((c * 16 + 8) as i64) << (SORT + FINE);
+                line.side([centre(c), centre(y)]) >= 0
             };
             for y in 0..16 {
                 for x in 0..20 {

@@ -128,8 +128,8 @@ pub const HEIGHT: usize = 240;
 pub const MAX_TRIANGLES: usize = 7;
 /// Triangles crossing one row: 5 measured, plus the margin.
 pub const MAX_ACTIVE: usize = 5;
-/// Newell's depth sort (`PIECES`): 10 workspace entries and 11 sort steps measured, plus the margin.
-pub const NEWELL_PIECES: usize = 10;
+/// Newell's depth sort (`PIECES`): 12 workspace entries and 13 sort steps measured, plus the margin.
+pub const NEWELL_PIECES: usize = 12;
 /// Whether any analysed view needed clipping (if not, `NoClip` is safe for these views).
 pub const NEEDS_CLIPPING: bool = false;
 /// Back-face culling, as analysed.
