@@ -115,10 +115,10 @@
 //!
 //! A [`NewellWorkspace`] holds, in bytes:
 //!
-//! * `PIECES · 107`: the kept pieces ([`StoredTriangle`], 52), the list (2), a key per piece
+//! * `PIECES · 91`: the kept pieces ([`StoredTriangle`], 52), the list (2), a key per piece
 //!   (4: its activation rank while sorting, then its position), a mark (1), a bucket link (2),
-//!   a split-tree link (4), the piece's original (2) and a split-tree cut (40: two points in
-//!   fine units and two links);
+//!   a split-tree link (4), the piece's original (2) and a split-tree cut (24: two points and
+//!   two links);
 //! * `2·H` bucket heads, `size_of::<P>()·W + 4·W` for one row of pixels and their positions,
 //!   and `ACTIVE` active triangles (about 112 bytes each for flat shading, with the sort key).
 //!
@@ -969,9 +969,16 @@ impl Sort<'_> {
             debug_assert!(false, "internal error: no room for cut {k}");
             return Some(first);
         };
+        // The sort's fine units to the cut's: `SORT` bits fewer, to the nearest.
+        let point = |p: FineXy| {
+            p.map(|v| {
+                let v = (v + (1 << (SORT - 1))) >> SORT;
+                v.clamp(i32::MIN as i64, i32::MAX as i64) as i32
+            })
+        };
         *node = Cut {
-            a: line.a,
-            b: line.b,
+            a: point(line.a),
+            b: point(line.b),
             pos,
             neg,
         };
@@ -1081,14 +1088,15 @@ fn crossing_line(o: &StoredTriangle, plane: &PlaneEq, side: i128) -> Option<Line
 }
 
 /// A node of a split tree: the original piece's region is cut by the line through `a` and `b`
-/// (points in fine units); pixel centres `p` where `(b − a) × (p − a) ≥ 0` go to `pos`, the
-/// others to `neg` (each a [`LEAF`] piece, another cut or [`NOTHING`]). Every pixel centre of
-/// the original goes to exactly one leaf, whatever the rounding of the cut points, so the
-/// parts of a split tile the original without cracks or overlap.
+/// (points in sub-pixels · 2^[`FINE`], below 2^30 for coordinates below 2^22 sub-pixels);
+/// pixel centres `p` where `(b − a) × (p − a) ≥ 0` go to `pos`, the others to `neg` (each a
+/// [`LEAF`] piece, another cut or [`NOTHING`]). Every pixel centre of the original goes to
+/// exactly one leaf, whatever the rounding of the cut points, so the parts of a split tile the
+/// original without cracks or overlap.
 #[derive(Clone, Copy, Debug)]
 struct Cut {
-    a: FineXy,
-    b: FineXy,
+    a: [i32; 2],
+    b: [i32; 2],
     pos: u32,
     neg: u32,
 }
@@ -1102,16 +1110,15 @@ impl Cut {
     };
 
     /// On row `y`, the side of column `x`'s centre (`true`: `pos`) and the first column after
-    /// `x` where the side changes, if any (sub-pixel bits `SUB`, the line in fine units of the
-    /// sort's grid). Exact: the side is a linear function `A·x + B` of the column, in `i128`
-    /// (fine coordinates below 2^34, `SUB` at most 8: `|A| < 2^56`, `|B| < 2^72`).
+    /// `x` where the side changes, if any (sub-pixel bits `SUB`). Exact: the side is a linear
+    /// function `A·x + B` of the column, in `i128` (`|A| < 2^49`, `|B| < 2^66`).
     fn side_and_end<const SUB: u32>(&self, x: i32, y: i32) -> (bool, Option<i128>) {
         let (dx, dy) = (
             self.b[0] as i128 - self.a[0] as i128,
             self.b[1] as i128 - self.a[1] as i128,
         );
-        // Doubled fine coordinates: a centre is at (2c + 1) · 2^(SUB + SORT + FINE) halves.
-        let bits = SUB + SORT + FINE;
+        // Doubled coordinates: a centre is at (2c + 1) · 2^(SUB + FINE) halves.
+        let bits = SUB + FINE;
         let cx = |c: i128| ((2 * c + 1) << bits) - 2 * self.a[0] as i128;
         let cy = ((2 * y as i128 + 1) << bits) - 2 * self.a[1] as i128;
         let slope = -(dy << (bits + 1));
@@ -1700,9 +1707,7 @@ mod tests {
             ([100, 8], [20, 250]),
             ([64, 0], [64, 99]),
         ]
-        .map(|(a, b): ([i64; 2], [i64; 2])| {
-            (a.map(|v| v << (SORT + FINE)), b.map(|v| v << (SORT + FINE)))
-        })
+        .map(|(a, b): ([i32; 2], [i32; 2])| (a.map(|v| v << FINE), b.map(|v| v << FINE)))
         .into_iter()
         .chain([
             ([1000, 1337], [851_000, 9_001]),
@@ -1710,8 +1715,13 @@ mod tests {
         ]) {
             let cut = Cut { a, b, ..Cut::EMPTY };
             let side = |c: i32, y: i32| {
-                let line = Line { a, b, inside: a };
-                let centre = |c: i32| ((c * 16 + 8) as i64) << (SORT + FINE);
+                let fine = |p: [i32; 2]| p.map(i64::from);
+                let line = Line {
+                    a: fine(a),
+                    b: fine(b),
+                    inside: fine(a),
+                };
+                let centre = |c: i32| ((c * 16 + 8) as i64) << FINE;
                 line.side([centre(c), centre(y)]) >= 0
             };
             for y in 0..16 {

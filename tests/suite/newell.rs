@@ -174,7 +174,7 @@ fn no_room_for_split_pieces_is_reported() {
 #[test]
 fn workspace_memory_is_as_documented() {
     type Ws = NewellWorkspace<Rgb565, Flat, 240, 240, 1280, 64>;
-    let active = Ws::BYTES - (1280 * 107 + 240 * 2 + 240 * 2 + 240 * 4);
+    let active = Ws::BYTES - (1280 * 91 + 240 * 2 + 240 * 2 + 240 * 4);
     println!("{} bytes, {} for 64 active", Ws::BYTES, active);
     assert!(active > 64 * 90 && active < 64 * 120, "{}", Ws::BYTES);
 }
