@@ -182,9 +182,9 @@ pub struct SortStats {
     /// Cycles that no plane of their pieces cuts beyond the rounding cell (pieces of
     /// interpenetrating triangles meeting within it), broken by drawing the head first.
     pub cycles_within_rounding: u32,
-    /// Cuts whose cut points were rounded apart (to other corners of their cells of the sort's grid)
-    /// because, rounded to the nearest, they left one side of the plane without a part of any
-    /// area while its region of the piece holds pixel centres.
+    /// Cuts whose cut points were rounded apart (to other corners of their cells of the sort's
+    /// grid) because, rounded to the nearest, they left one side of the plane without a part
+    /// of any area while its region of the piece holds pixel centres.
     pub rounded_apart: u32,
 }
 
@@ -1055,7 +1055,7 @@ impl Line {
 ///
 /// A split tree cuts with this line, not with the line through the rounded cut points: two
 /// rounded points close together (a cut across a thin piece) give a line whose direction is
-/// off by up to a sub-pixel over their distance, which sends pixel centres far along it to
+/// off by up to a grid unit over their distance, which sends pixel centres far along it to
 /// the wrong part.
 fn crossing_line(o: &StoredTriangle, plane: &PlaneEq, side: i128) -> Option<Line> {
     let v = [0, 1, 2].map(|k| Vertex::of(o, k));
@@ -1325,10 +1325,11 @@ fn assemble(
 /// below 2^26 there.
 const SORT: u32 = 4;
 
-/// Bits below the sort's grid at which [`round_apart`] places the exact cut points and split
-/// trees keep their lines: a [`FineXy`] is sort units · 2^8. Coordinates below 2^26 sort
-/// units stay below 2^34 (their cross products below 2^71, taken in `i128`), and the
-/// interpolation's products below 2^123.
+/// Bits below the sort's grid at which [`round_apart`] places the exact cut points and
+/// [`crossing_line`] finds a split tree's line (a [`Cut`] keeps it [`SORT`] bits coarser, in
+/// sub-pixels · 2^8): a [`FineXy`] is sort units · 2^8. Coordinates below 2^26 sort units stay
+/// below 2^34 (their cross products below 2^71, taken in `i128`), and the interpolation's
+/// products below 2^123.
 const FINE: u32 = 8;
 
 /// A screen point in sort units · 2^[`FINE`].
