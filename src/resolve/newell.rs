@@ -666,7 +666,7 @@ impl Sort<'_> {
         if disjoint(&pt.x, &qt.x) || disjoint(&pt.y, &qt.y) {
             return Order::HeadFirst;
         }
-        if PlaneEq::of(pt).is_none() || PlaneEq::of(qt).is_none() {
+        if signed_area(pt) == 0 || signed_area(qt) == 0 {
             return Order::HeadFirst; // a piece of no area covers nothing
         }
         if self.origin.get(p as usize) == self.origin.get(q as usize) {
