@@ -79,6 +79,7 @@ mod firmware {
             back: 2,
             first: 0,
             count: 4,
+            facing_front: 2,
         },
         BspNode {
             plane: [0.0, 1.0, 0.0, 0.0],
@@ -86,6 +87,7 @@ mod firmware {
             back: NO_CHILD,
             first: 4,
             count: 4,
+            facing_front: 2,
         },
         BspNode {
             plane: [0.0, 0.0, 1.0, 0.0],
@@ -93,6 +95,7 @@ mod firmware {
             back: NO_CHILD,
             first: 8,
             count: 4,
+            facing_front: 2,
         },
     ];
 

@@ -193,7 +193,11 @@ fn close_t_junctions(out: Vec<Poly>, nodes: &mut [BspNode], mut created: Vec<V3>
     for node in nodes.iter_mut() {
         let range = node.first as usize..node.first as usize + node.count as usize;
         let first = fixed.len();
-        for p in &out[range] {
+        let mut facing_front = first;
+        for (k, p) in out[range].iter().enumerate() {
+            if k == node.facing_front as usize {
+                facing_front = fixed.len();
+            }
             let mut outline = Vec::new();
             for k in 0..3 {
                 let (a, b) = (p.v[k], p.v[(k + 1) % 3]);
@@ -223,8 +227,12 @@ fn close_t_junctions(out: Vec<Poly>, nodes: &mut [BspNode], mut created: Vec<V3>
                 });
             }
         }
+        if node.facing_front == node.count {
+            facing_front = fixed.len();
+        }
         node.first = first as u16;
         node.count = (fixed.len() - first) as u16;
+        node.facing_front = (facing_front - first) as u16;
     }
     fixed
 }
@@ -277,7 +285,7 @@ pub fn build(mesh: &MeshData) -> Result<Bsp, String> {
     let mut created: Vec<V3> = Vec::new();
     // Work items: (triangles, parent node and which side, depth). Popping the front list
     // before the back list keeps the nodes in pre-order.
-    let mut work: Vec<Work> = vec![(input, None, 1)];
+    let mut work: Vec<Work> = vec![(input.clone(), None, 1)];
     while let Some((list, parent, level)) = work.pop() {
         if list.is_empty() {
             continue;
@@ -304,6 +312,14 @@ pub fn build(mesh: &MeshData) -> Result<Bsp, String> {
             front.clear();
             back.clear();
         }
+        // The triangles facing the plane's front side first: with back-face culling the
+        // library draws only those facing the eye, by the side of the plane it is on. A
+        // piece faces as its original does (a split keeps the winding), decided here in f64
+        // from the original, which rounding cannot turn over.
+        let faces_front =
+            |p: &Poly| plane(&input[p.origin as usize]).is_some_and(|(m, _)| dot(m, n) > 0.0);
+        on.sort_by_key(|p| !faces_front(p));
+        let facing_front = on.iter().filter(|p| faces_front(p)).count();
         let index = nodes.len();
         let (first, count) = (out.len(), on.len());
         if out.len() + count >= u16::MAX as usize || index >= u16::MAX as usize {
@@ -319,6 +335,7 @@ pub fn build(mesh: &MeshData) -> Result<Bsp, String> {
             back: NO_CHILD,
             first: first as u16,
             count: count as u16,
+            facing_front: facing_front as u16,
         });
         if let Some((p, is_front)) = parent {
             if is_front {

@@ -162,12 +162,13 @@ fn bsp_source(b: &crate::bsp::Bsp) -> String {
         let plane = n.plane.map(|v| f32_literal(v as f64));
         let _ = writeln!(
             s,
-            "    BspNode {{ plane: [{}], front: {}, back: {}, first: {}, count: {} }},",
+            "    BspNode {{ plane: [{}], front: {}, back: {}, first: {}, count: {}, facing_front: {} }},",
             plane.join(", "),
             child(n.front),
             child(n.back),
             n.first,
-            n.count
+            n.count,
+            n.facing_front
         );
     }
     s += "];\n\n";

@@ -11,7 +11,9 @@
 //!
 //! Per frame the tree is traversed once (one plane test per node, with an explicit stack of
 //! `STACK` entries: no recursion), each triangle's place in the order becomes its sort key,
-//! and the rows are painted like the depth sort's, far to near.
+//! and the rows are painted like the depth sort's, far to near. With back-face culling the
+//! same plane test culls: a node's triangles facing away from the eye are left out (see
+//! [`BspNode::facing_front`]), not judged by their rounded orientation on screen.
 
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
@@ -47,6 +49,12 @@ pub struct BspNode {
     pub first: u16,
     /// How many.
     pub count: u16,
+    /// How many of them, the first ones of the range, face the plane's front side (the eye
+    /// sees them counter-clockwise from in front of it); the others face its back side. With
+    /// back-face culling a node's triangles facing away from the eye are not drawn, whatever
+    /// their orientation on screen: a thin piece left by a split can turn over when its
+    /// vertices are rounded, and would then show a surface that faces away.
+    pub facing_front: u16,
 }
 
 /// Why a BSP tree was rejected.
@@ -78,6 +86,11 @@ pub enum BspError {
     /// Node `node`'s triangle range is not the next one: ranges must follow each other in node
     /// order and end at the mesh's last triangle, so each triangle is drawn exactly once.
     BadRange {
+        /// The node.
+        node: usize,
+    },
+    /// Node `node` has more triangles facing its plane's front side than triangles.
+    BadFacing {
         /// The node.
         node: usize,
     },
@@ -201,13 +214,13 @@ impl<'a> BspTree<'a> {
     ///
     /// ```
     /// use scanline3d::resolve::bsp::{BspError, BspNode, BspTree, NO_CHILD};
-    /// let leaf = BspNode { plane: [0.0, 0.0, 1.0, 0.0], front: NO_CHILD, back: NO_CHILD, first: 0, count: 2 };
+    /// let leaf = BspNode { plane: [0.0, 0.0, 1.0, 0.0], front: NO_CHILD, back: NO_CHILD, first: 0, count: 2, facing_front: 2 };
     /// assert!(BspTree::new(&[leaf], 2).is_ok());
     /// assert_eq!(BspTree::new(&[leaf], 1).unwrap_err(), BspError::BadRange { node: 0 });
     /// let cycle = BspNode { front: 0, ..leaf };
     /// assert_eq!(BspTree::new(&[cycle], 2).unwrap_err(), BspError::BadChild { node: 0 });
     /// // A root with two leaves; then one leaf named by both sides of the root.
-    /// let one = BspNode { count: 1, ..leaf };
+    /// let one = BspNode { count: 1, facing_front: 1, ..leaf };
     /// let root = BspNode { front: 1, back: 2, ..one };
     /// let tree = [root, BspNode { first: 1, ..one }, BspNode { first: 2, ..one }];
     /// assert!(BspTree::new(&tree, 3).is_ok());
@@ -231,6 +244,9 @@ impl<'a> BspTree<'a> {
                 return Err(BspError::BadRange { node: i });
             }
             next_first += n.count as usize;
+            if n.facing_front > n.count {
+                return Err(BspError::BadFacing { node: i });
+            }
             let [a, b, c, d] = n.plane;
             if !(a.is_finite() && b.is_finite() && c.is_finite() && d.is_finite()) {
                 return Err(BspError::BadPlane { node: i });
@@ -266,16 +282,19 @@ impl<'a> BspTree<'a> {
         self.nodes
     }
 
-    /// Calls `f(first, count)` for each node's triangle range, far to near as seen from
-    /// `eye` (model coordinates). `Err(needed)` if `stack` is too small for this tree and eye.
+    /// Calls `f(node, eye_in_front)` for each node, far to near as seen from `eye` (model
+    /// coordinates), with the side of its plane the eye is on. `Err(needed)` if `stack` is too
+    /// small for this tree and eye.
     pub fn back_to_front(
         &self,
         eye: [f32; 3],
         stack: &mut [u32],
-        mut f: impl FnMut(u16, u16),
+        mut f: impl FnMut(&BspNode, bool),
     ) -> Result<(), usize> {
-        // Entries are node indices; the high bit marks "draw this node's triangles now".
+        // Entries are node indices; the high bit marks "draw this node's triangles now", the
+        // next one that the eye is in front of its plane.
         const DRAW: u32 = 1 << 31;
+        const IN_FRONT: u32 = 1 << 30;
         let mut top = 0usize;
         let push = |stack: &mut [u32], top: &mut usize, v: u32| match stack.get_mut(*top) {
             Some(slot) => {
@@ -290,12 +309,12 @@ impl<'a> BspTree<'a> {
             top -= 1;
             // `top` entries were pushed, and a checked tree names only its own nodes.
             let entry = internal(stack.get(top).copied(), 0);
-            let Some(node) = self.nodes.get((entry & !DRAW) as usize) else {
+            let Some(node) = self.nodes.get((entry & !(DRAW | IN_FRONT)) as usize) else {
                 debug_assert!(false, "internal error: node {entry:#x} not in the tree");
                 continue;
             };
             if entry & DRAW != 0 {
-                f(node.first, node.count);
+                f(node, entry & IN_FRONT != 0);
                 continue;
             }
             let [a, b, c, d] = node.plane;
@@ -309,7 +328,9 @@ impl<'a> BspTree<'a> {
             if near != NO_CHILD {
                 push(stack, &mut top, near as u32)?;
             }
-            push(stack, &mut top, entry | DRAW)?;
+            // Node indices are below 2^16, so the two flags are free.
+            let side = if in_front { IN_FRONT } else { 0 };
+            push(stack, &mut top, entry | DRAW | side)?;
             if far != NO_CHILD {
                 push(stack, &mut top, far as u32)?;
             }
@@ -347,6 +368,10 @@ fn to_model(t: &Transform, p: [f32; 3]) -> Option<[f32; 3]> {
 
 /// Pass 1's order for a BSP scene: the tree's back-to-front order over instance 0's mesh.
 struct BspOrder<'t, 'w> {
+    /// Back-face culling: a node's triangles facing away from the eye are left out.
+    cull: bool,
+    /// Triangles left out so.
+    culled: u32,
     tree: &'t BspTree<'t>,
     eye: [f32; 3],
     stack: &'w mut [u32],
@@ -368,9 +393,18 @@ impl TriangleOrder for BspOrder<'_, '_> {
         // exactly, and equal keys give the z-buffers' tie rule (first activated is drawn last).
         // Visiting them in reverse keeps each row's bucket in index order, as for the others.
         let mut rank = 0u32;
+        let (cull, culled) = (self.cull, &mut self.culled);
         self.tree
-            .back_to_front(self.eye, self.stack, |first, count| {
-                for tri in (first as usize..first as usize + count as usize).rev() {
+            .back_to_front(self.eye, self.stack, |node, eye_in_front| {
+                let (first, count) = (node.first as usize, node.count as usize);
+                let split = first + node.facing_front as usize;
+                let drawn = match (cull, eye_in_front) {
+                    (false, _) => first..first + count,
+                    (true, true) => first..split,
+                    (true, false) => split..first + count,
+                };
+                *culled += (count - drawn.len()) as u32;
+                for tri in drawn.rev() {
                     f(setup, tri, Some(rank));
                 }
                 rank += 1;
@@ -398,7 +432,7 @@ impl TriangleOrder for BspOrder<'_, '_> {
 /// let verts = [v(-1.0, -1.0), v(1.0, -1.0), v(-1.0, 1.0), v(1.0, 1.0)];
 /// let tris = [[0u16, 1, 2], [2, 1, 3]];
 /// let mesh = Mesh::new(&verts, &tris, MeshColors::Uniform(embedded_graphics::pixelcolor::Rgb888::new(200, 200, 200)), None)?;
-/// let nodes = [BspNode { plane: [0.0, 0.0, 1.0, 0.0], front: NO_CHILD, back: NO_CHILD, first: 0, count: 2 }];
+/// let nodes = [BspNode { plane: [0.0, 0.0, 1.0, 0.0], front: NO_CHILD, back: NO_CHILD, first: 0, count: 2, facing_front: 2 }];
 /// let tree = BspTree::new(&nodes, tris.len()).unwrap();
 /// let instances = [Instance { mesh: &mesh, transform: Transform::IDENTITY }];
 /// let camera = Camera::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0])?.perspective(60.0, 0.5, 10.0)?;
@@ -508,11 +542,13 @@ impl<
             spans: 0,
         };
         let mut order = BspOrder {
+            cull: options.cull_back_faces,
+            culled: 0,
             tree,
             eye,
             stack: &mut self.stack,
         };
-        drive::<P, S, SUB_BITS, C, A, K, 1, _, _, Unbounded>(
+        let mut stats = drive::<P, S, SUB_BITS, C, A, K, 1, _, _, Unbounded>(
             frame,
             &mut resolve,
             &mut order,
@@ -520,7 +556,9 @@ impl<
             options,
             &vp,
             sink,
-        )
+        )?;
+        stats.culled += order.culled;
+        Ok(stats)
     }
 }
 
@@ -540,6 +578,7 @@ mod tests {
             back,
             first: i as u16,
             count: 1,
+            facing_front: 1,
         };
         links.iter().enumerate().map(node).collect()
     }
@@ -549,8 +588,8 @@ mod tests {
         [1.0, -1.0].map(|z| {
             let mut seen = vec![0u32; tree.triangles()];
             let mut stack = vec![0u32; 64];
-            tree.back_to_front([0.0, 0.0, z], &mut stack, |first, count| {
-                for t in first..first + count {
+            tree.back_to_front([0.0, 0.0, z], &mut stack, |node, _| {
+                for t in node.first..node.first + node.count {
                     seen[t as usize] += 1;
                 }
             })
@@ -629,6 +668,72 @@ mod tests {
                 "{links:?}"
             );
         }
+    }
+
+    #[test]
+    fn more_triangles_facing_front_than_triangles_is_rejected() {
+        let nodes = [BspNode {
+            facing_front: 2,
+            ..tree(&[(N, N)])[0]
+        }];
+        assert_eq!(
+            BspTree::new(&nodes, 1).unwrap_err(),
+            BspError::BadFacing { node: 0 }
+        );
+    }
+
+    /// The stats of rendering one triangle, counter-clockwise on screen from the eye at
+    /// `z = 3`, as the only triangle of a node whose `facing_front` is given.
+    fn render_one(facing_front: u16, cull: bool) -> FrameStats {
+        use crate::scene::{Camera, Instance, Light, Mesh, MeshColors};
+        use crate::{sink::HashSink, Flat};
+        use embedded_graphics::pixelcolor::{Gray8, Rgb888};
+        use fixed::types::I16F16;
+        let v = |x: f32, y: f32| [I16F16::from_num(x), I16F16::from_num(y), I16F16::ZERO];
+        let verts = [v(-1.0, -1.0), v(1.0, -1.0), v(-1.0, 1.0)];
+        let tris = [[0u16, 1, 2]];
+        let colors = MeshColors::Uniform(Rgb888::new(200, 200, 200));
+        let mesh = Mesh::new(&verts, &tris, colors, None).unwrap();
+        let nodes = [BspNode {
+            plane: [0.0, 0.0, 1.0, 0.0],
+            front: NO_CHILD,
+            back: NO_CHILD,
+            first: 0,
+            count: 1,
+            facing_front,
+        }];
+        let tree = BspTree::new(&nodes, 1).unwrap();
+        let instances = [Instance {
+            mesh: &mesh,
+            transform: crate::scene::Transform::IDENTITY,
+        }];
+        let camera = Camera::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0])
+            .unwrap()
+            .perspective(60.0, 0.5, 10.0)
+            .unwrap();
+        let light = Light::new([0.0, 0.0, 1.0], 0.2, 0.8).unwrap();
+        let scene = Scene {
+            instances: &instances,
+            camera,
+            light,
+        };
+        let mut ws: std::boxed::Box<BspWorkspace<Gray8, Flat, 32, 32, 8, 8, 8>> =
+            std::boxed::Box::new(BspWorkspace::new(Gray8::new(0)));
+        let options = RenderOptions::default().with_back_face_culling(cull);
+        ws.render(&scene, &tree, &options, &mut HashSink::new())
+            .unwrap()
+    }
+
+    #[test]
+    fn culling_follows_the_nodes_facing_not_the_screen() {
+        // Facing the eye on screen and in the tree: drawn.
+        let shown = render_one(1, true);
+        assert_eq!((shown.activated, shown.culled), (1, 0));
+        // The tree says it faces away (a piece whose rounded vertices turned it over): culled,
+        // though counter-clockwise on screen; without culling drawn.
+        let turned = render_one(0, true);
+        assert_eq!((turned.activated, turned.culled), (0, 1));
+        assert_eq!(render_one(0, false).activated, 1);
     }
 
     /// A complete binary tree of `depth` levels in pre-order, appended to `nodes`.

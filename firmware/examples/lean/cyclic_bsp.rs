@@ -80,6 +80,7 @@ pub static BSP_NODES: [BspNode; 5] = [
         back: 3,
         first: 0,
         count: 1,
+        facing_front: 1,
     },
     BspNode {
         plane: [0.14367634, -0.2488485, 0.9578265, 1.3278179e-6],
@@ -87,6 +88,7 @@ pub static BSP_NODES: [BspNode; 5] = [
         back: NO_CHILD,
         first: 1,
         count: 2,
+        facing_front: 2,
     },
     BspNode {
         plane: [0.14367634, 0.2488485, 0.9578265, -2.1302178e-6],
@@ -94,6 +96,7 @@ pub static BSP_NODES: [BspNode; 5] = [
         back: NO_CHILD,
         first: 3,
         count: 2,
+        facing_front: 2,
     },
     BspNode {
         plane: [0.14367634, 0.2488485, 0.9578265, -2.1302178e-6],
@@ -101,6 +104,7 @@ pub static BSP_NODES: [BspNode; 5] = [
         back: 4,
         first: 5,
         count: 1,
+        facing_front: 1,
     },
     BspNode {
         plane: [0.14367634, -0.2488485, 0.9578265, 1.3278179e-6],
@@ -108,6 +112,7 @@ pub static BSP_NODES: [BspNode; 5] = [
         back: NO_CHILD,
         first: 6,
         count: 1,
+        facing_front: 1,
     },
 ];
 
