@@ -66,3 +66,85 @@ impl Soup {
         }
     }
 }
+
+/// Random traced scenes, as `trace_hybrid::every_search_gives_the_same_frame_on_random_scenes`
+/// and `trace_fixed::fixed_tracer_matches_the_reference_on_random_scenes` draw them
+/// (`sim/examples/trace_random.rs` for more): up to 7 objects of every primitive, sizes from a
+/// unit to the envelope's 2,000 (`case % 4` picks the scale), every material kind and IOR,
+/// point and directional lights.
+pub struct TracedDraw;
+
+impl TracedDraw {
+    /// The scene text of case `case` (some are refused by the format or the fixed-point
+    /// envelope: the draws do not check).
+    pub fn scene(d: &mut Draw, case: usize) -> String {
+        let scale = [1.0, 10.0, 100.0, 2000.0][case % 4];
+        let xyz = |p: [f64; 3]| format!("{} {} {}", p[0], p[1], p[2]);
+        let unit = |d: &mut Draw| d.in_range(0.0, 1.0);
+        let mut text = format!(
+            "background {} {} {}\nambient {}\n",
+            unit(d),
+            unit(d),
+            unit(d),
+            unit(d)
+        );
+        for k in 0..(case / 4) % 3 {
+            let intensity = d.in_range(0.0, 2.0);
+            text += &if k % 2 == 0 {
+                format!("light point {} {intensity}\n", xyz(d.point(scale)))
+            } else {
+                format!("light directional {} {intensity}\n", xyz(d.point(1.0)))
+            };
+        }
+        for (m, ior) in ["air", "water", "diamond"].iter().enumerate() {
+            let k: Vec<String> = (0..7).map(|_| unit(d).to_string()).collect();
+            text += &format!("material m{m} {} {ior}\n", k.join(" "));
+        }
+        for object in 0..1 + (case / 12) % 7 {
+            let m = format!("m{}", object % 3);
+            let (a, b) = (d.point(scale), d.point(scale));
+            let mut size = || d.in_range(0.001, scale);
+            text += &match (case + object) % 7 {
+                0 => format!("sphere {} {} {m}\n", xyz(a), size()),
+                1 => format!("plane {} {} {m}\n", xyz(b.map(|c| c / scale)), a[0]),
+                2 => {
+                    let far = [a[0] + size(), a[1] + size(), a[2] + size()];
+                    format!("box {} {} {m}\n", xyz(a), xyz(far))
+                }
+                3 => format!("cylinder {} {} {} {m}\n", xyz(a), xyz(b), size()),
+                4 => format!("cone {} {} {} {} {m}\n", xyz(a), size(), xyz(b), size()),
+                5 => format!(
+                    "ellipsoid {} {} {} {} {m}\n",
+                    xyz(a),
+                    size(),
+                    size(),
+                    size()
+                ),
+                _ => {
+                    let r = size();
+                    let corners: String = (0..5)
+                        .map(|k| {
+                            let t = k as f64 * std::f64::consts::TAU / 5.0;
+                            format!(" {}", xyz([a[0] + r * t.cos(), a[1], a[2] - r * t.sin()]))
+                        })
+                        .collect();
+                    format!("polygon {m}{corners}\n")
+                }
+            };
+        }
+        text
+    }
+
+    /// A random camera for case `case`, at its scale.
+    pub fn camera(d: &mut Draw, case: usize) -> CameraSpec {
+        let scale = [1.0, 10.0, 100.0, 2000.0][case % 4];
+        CameraSpec {
+            eye: d.point(scale),
+            target: d.point(scale),
+            up: [0.0, 1.0, 0.0],
+            fovy: d.in_range(5.0, 150.0),
+            near: d.in_range(0.01, 1.0),
+            far: d.in_range(2.0, 4.0 * scale),
+        }
+    }
+}

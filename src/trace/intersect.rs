@@ -112,6 +112,17 @@ fn plane(p: &Plane, ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
     plane_t_in(p.normal, p.offset, ray, t_min, t_max)
 }
 
+/// Whether the ray meets the plane `normal·p + offset = 0` at some `t ≥ t_min`, however far:
+/// `t·den = −num` compared exactly in 128 bits, no quotient. [`plane_t_in`] decides its
+/// window's lower end by the same comparison.
+fn plane_met_from(normal: Vec3, offset: I16F16, ray: &Ray, t_min: I16F16) -> bool {
+    let num = i128::from((normal.dot(ray.origin) + I32F32::from(offset)).to_bits());
+    let den = i128::from(normal.dot(ray.dir).to_bits());
+    // t = n / d with d > 0: the signs moved to the numerator.
+    let (n, d) = if den < 0 { (num, -den) } else { (-num, den) };
+    d != 0 && (n << 16) >= i128::from(t_min.to_bits()) * d
+}
+
 /// The two coordinates of `p` other than `axis`, raw I16F16 bits.
 #[inline]
 fn project(p: Vec3, axis: u8) -> (i64, i64) {
@@ -276,13 +287,37 @@ fn quadratic(a: I32F32, b: I32F32, c: I32F32) -> Roots {
     }
 }
 
+/// Where a ray starts, for the quadratic's value `c` at `t = 0`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Start {
+    /// Anywhere: `c` as computed.
+    Anywhere,
+    /// On the quadric surface itself (the ellipsoid, a frustum's side): `c` is 0. The origin
+    /// is a rounded hit point, so the computed `c` is a rounding away from 0, and for a ray
+    /// along the surface (an inward cosine of the size of that rounding) it moves the far
+    /// root by much more than the rounding, or, positive, takes the discriminant `B² − AC`
+    /// below 0 and loses the hit.
+    OnQuadric,
+    /// On a frustum's cap, inside the side's quadric: `c` at most 0.
+    OnCap,
+}
+
+fn at_origin(c: I32F32, start: Start) -> I32F32 {
+    match start {
+        Start::Anywhere => c,
+        Start::OnQuadric => I32F32::ZERO,
+        Start::OnCap => c.min(I32F32::ZERO),
+    }
+}
+
 /// The interval in which the ray is inside the ellipsoid: a sphere of radius `scale_radius`
 /// in coordinates scaled by `scale`.
-fn ellipsoid_span(e: &Ellipsoid, ray: &Ray) -> Option<(I16F16, I16F16)> {
+fn ellipsoid_span(e: &Ellipsoid, ray: &Ray, start: Start) -> Option<(I16F16, I16F16)> {
     let o = scale_axes(ray.origin.sub(e.centre), e.scale);
     let d = scale_axes(ray.dir, e.scale);
     let r = e.scale_radius;
-    match quadratic(d.dot(d), d.dot(o), o.dot(o) - r.wide_mul(r)) {
+    let c = at_origin(o.dot(o) - r.wide_mul(r), start);
+    match quadratic(d.dot(d), d.dot(o), c) {
         Roots::Two(t1, t2) => Some((t1, t2)),
         Roots::None | Roots::Unknown => None,
     }
@@ -290,7 +325,7 @@ fn ellipsoid_span(e: &Ellipsoid, ray: &Ray) -> Option<(I16F16, I16F16)> {
 
 /// The interval in which the ray is inside the capped frustum: the side's quadratic clipped
 /// to the slab between the caps.
-fn frustum_span(f: &Frustum, ray: &Ray) -> Option<(I16F16, I16F16)> {
+fn frustum_span(f: &Frustum, ray: &Ray, start: Start) -> Option<(I16F16, I16F16)> {
     let oc = ray.origin.sub(f.base);
     let so = narrow(oc.dot(f.axis))?; // along the axis
     let sd = narrow(ray.dir.dot(f.axis))?;
@@ -301,7 +336,7 @@ fn frustum_span(f: &Frustum, ray: &Ray) -> Option<(I16F16, I16F16)> {
     let ks = mul(f.slope, sd);
     let a = e.dot(e) - ks.wide_mul(ks);
     let b = q.dot(e) - m.wide_mul(ks);
-    let c = q.dot(q) - m.wide_mul(m);
+    let c = at_origin(q.dot(q) - m.wide_mul(m), start);
     // Slab between the caps: 0 ≤ so + t·sd ≤ height.
     let (mut t_in, mut t_out) = (I16F16::MIN, I16F16::MAX);
     if sd == I16F16::ZERO {
@@ -368,7 +403,7 @@ impl Shape<'_> {
             Shape::Polygon(p) => facet(&p.facet, p.vertices, ray, t_min, t_max),
             Shape::Triangle(t) => facet(&t.facet, &t.vertices, ray, t_min, t_max),
             Shape::Box(_) | Shape::Ellipsoid(_) | Shape::Frustum(_) => {
-                let (t_in, t_out) = self.span(ray)?;
+                let (t_in, t_out) = self.span(ray, Start::Anywhere)?;
                 first_root(t_in, t_out, t_min, t_max)
             }
         }
@@ -376,12 +411,27 @@ impl Shape<'_> {
 
     /// The interval of `t` in which the ray is inside a closed convex primitive (box,
     /// ellipsoid, frustum); `None` for the others.
-    fn span(&self, ray: &Ray) -> Option<(I16F16, I16F16)> {
+    fn span(&self, ray: &Ray, start: Start) -> Option<(I16F16, I16F16)> {
         match self {
             Shape::Box(b) => box_span(b, ray),
-            Shape::Ellipsoid(e) => ellipsoid_span(e, ray),
-            Shape::Frustum(f) => frustum_span(f, ray),
+            Shape::Ellipsoid(e) => ellipsoid_span(e, ray, start),
+            Shape::Frustum(f) => frustum_span(f, ray, start),
             _ => None,
+        }
+    }
+
+    /// Whether a shadow ray meets the primitive in `[t_min, t_max)`, where `t_max` =
+    /// `I16F16::MAX` stands for a ray without end (towards a directional light): an infinite
+    /// plane blocks such a ray wherever it meets it, also beyond the I16F16 range of `t`, as a
+    /// plane nearly parallel to the light does. A bounded primitive inside the envelope is
+    /// met, if at all, well inside that range.
+    #[inline]
+    pub fn blocks(&self, ray: &Ray, t_min: I16F16, t_max: I16F16) -> bool {
+        match self {
+            Shape::Plane(p) if t_max == I16F16::MAX => {
+                plane_met_from(p.normal, p.offset, ray, t_min)
+            }
+            _ => self.hit(ray, t_min, t_max).is_some(),
         }
     }
 
@@ -404,10 +454,16 @@ impl Shape<'_> {
             // Convex: a ray leaving the surface outwards never meets it again; one going
             // inwards meets it at the span's far end.
             Shape::Box(_) | Shape::Ellipsoid(_) | Shape::Frustum(_) => {
-                if self.normal(ray.origin).dot_bits(ray.dir) >= 0 {
+                let normal = self.normal(ray.origin);
+                if normal.dot_bits(ray.dir) >= 0 {
                     return None;
                 }
-                let (_, t_out) = self.span(ray)?;
+                // The origin lies on the feature whose normal it has.
+                let start = match self {
+                    Shape::Frustum(f) if normal == f.axis || normal == f.axis.neg() => Start::OnCap,
+                    _ => Start::OnQuadric,
+                };
+                let (_, t_out) = self.span(ray, start)?;
                 (t_out >= t_min && t_out < t_max).then_some(t_out)
             }
         }
@@ -418,18 +474,21 @@ impl Shape<'_> {
     #[inline]
     pub fn normal(&self, point: Vec3) -> Vec3 {
         match self {
-            Shape::Sphere(s) => point.sub(s.centre).normalized().unwrap_or(Vec3::ZERO),
+            Shape::Sphere(s) => {
+                // From a radius of 1/2 a surface point's longest offset is above 2^-2, where
+                // `unit` is `normalized`: the shorter test for most spheres.
+                let offset = point.sub(s.centre);
+                match s.radius >= I16F16::from_bits(1 << 15) {
+                    true => offset.normalized(),
+                    false => offset.unit(),
+                }
+                .unwrap_or(Vec3::ZERO)
+            }
             Shape::Plane(p) => p.normal,
             Shape::Polygon(p) => p.facet.normal,
             Shape::Triangle(t) => t.facet.normal,
             Shape::Box(b) => box_normal(b, point),
-            Shape::Ellipsoid(e) => {
-                // ∇ of Σ (p_i / r_i)², proportional to p_i · scale_i².
-                let s = e.scale;
-                scale_axes(scale_axes(point.sub(e.centre), s), s)
-                    .normalized()
-                    .unwrap_or(Vec3::ZERO)
-            }
+            Shape::Ellipsoid(e) => ellipsoid_normal(e, point),
             Shape::Frustum(f) => frustum_normal(f, point),
         }
     }
@@ -468,6 +527,11 @@ impl Shape<'_> {
 /// plane, polygon or triangle lying in it (same normal and offset, bit for bit).
 #[inline]
 pub(crate) fn meets_plane(plane: (Vec3, I16F16), ray: &Ray, t_min: I16F16, t_max: I16F16) -> bool {
+    if t_max == I16F16::MAX {
+        // A ray without end, as in `Shape::blocks`: an infinite plane among the group blocks
+        // it beyond the range of `t` too.
+        return plane_met_from(plane.0, plane.1, ray, t_min);
+    }
     plane_t_in(plane.0, plane.1, ray, t_min, t_max).is_some()
 }
 
@@ -524,6 +588,30 @@ fn box_normal(b: &AaBox, p: Vec3) -> Vec3 {
         .map_or(Vec3::ZERO, |(_, n)| n)
 }
 
+/// The outward unit normal of the ellipsoid at `p`: ∇ of Σ (d_i · scale_i)², `d = p − centre`,
+/// proportional to `d_i · scale_i²`. The products are exact (48 fraction bits; `|d_i| < 2^30`
+/// raw inside the envelope and `scale_i ≤ 1`, so below 2^62), then shifted alike to a longest
+/// component of 23 bits: `scale_i²` reaches 2^-16 on a thin ellipsoid, where products rounded
+/// to I16F16 left too few bits, or none, near the tips of its long axes.
+fn ellipsoid_normal(e: &Ellipsoid, p: Vec3) -> Vec3 {
+    let ([dx, dy, dz], [sx, sy, sz]) = (p.sub(e.centre).bits(), e.scale.bits());
+    let g = [(dx, sx), (dy, sy), (dz, sz)].map(|(d, s)| wide(d, s).wrapping_mul(i64::from(s)));
+    let [gx, gy, gz] = g.map(i64::unsigned_abs);
+    let longest = gx.max(gy).max(gz);
+    if longest == 0 {
+        return Vec3::ZERO;
+    }
+    let bits = 64 - longest.leading_zeros();
+    let [x, y, z] = g.map(|c| {
+        if bits > 23 {
+            (c >> (bits - 23)) as i32
+        } else {
+            (c << (23 - bits)) as i32
+        }
+    });
+    Vec3::from_bits(x, y, z).normalized().unwrap_or(Vec3::ZERO)
+}
+
 /// The outward normal of the frustum's cap or side nearest `p`.
 fn frustum_normal(f: &Frustum, p: Vec3) -> Vec3 {
     let oc = p.sub(f.base);
@@ -541,7 +629,7 @@ fn frustum_normal(f: &Frustum, p: Vec3) -> Vec3 {
     } else {
         // (radial unit − slope · axis), normalised.
         radial
-            .normalized()
+            .unit()
             .map(|u| u.sub(f.axis.scale(f.slope)))
             .and_then(Vec3::normalized)
             .unwrap_or(Vec3::ZERO)
@@ -721,5 +809,166 @@ mod tests {
     fn reflection_mirrors() {
         let r = reflect(v(0.6, -0.8, 0.0), v(0.0, 1.0, 0.0));
         assert_eq!(r, v(0.6, 0.8, 0.0));
+    }
+
+    /// A ray leaving a convex surface inwards meets it again at the chord's far end, however
+    /// close to the surface it runs. The origin is a rounded point of the side, so the side's
+    /// quadratic at `t = 0` comes out a rounding away from 0; positive, with an inward cosine
+    /// of 2^-13 its discriminant went below 0 and the hit was lost (a light inside a cylinder
+    /// or cone shone through its wall).
+    #[test]
+    fn grazing_rays_from_inside_meet_the_surface_again() {
+        let radius = 100.0f64;
+        let cylinder = Shape::Frustum(
+            Frustum::cylinder(v(0.0, -50.0, 0.0), v(0.0, 50.0, 0.0), f(radius as f32)).unwrap(),
+        );
+        let ellipsoid =
+            Shape::Ellipsoid(Ellipsoid::new(v(0.0, 0.0, 0.0), v(100.0, 60.0, 100.0)).unwrap());
+        let mut checked = 0;
+        for shape in [cylinder, ellipsoid] {
+            for k in 0..48 {
+                let phi = k as f64 * core::f64::consts::TAU / 48.0 + 0.1;
+                let (c, s) = (libm::cos(phi), libm::sin(phi));
+                for sin_in in [1.0 / 8192.0, 1.0 / 2048.0, 1.0 / 512.0] {
+                    let cos_t = libm::sqrt(1.0 - sin_in * sin_in);
+                    // In the plane y = 0, where both are circles of radius 100: along the
+                    // tangent, turned inwards by `sin_in`.
+                    let dir = [-s * cos_t - c * sin_in, 0.0, c * cos_t - s * sin_in];
+                    let ray = Ray {
+                        origin: v((radius * c) as f32, 0.0, (radius * s) as f32),
+                        dir: v(dir[0] as f32, 0.0, dir[2] as f32).normalized().unwrap(),
+                    };
+                    let chord = 2.0 * radius * sin_in;
+                    let t = shape
+                        .hit_from_surface(&ray, crate::trace::tracer::EPSILON, FAR)
+                        .unwrap_or_else(|| panic!("{shape:?} {phi} {sin_in}: no hit"));
+                    let t = t.to_num::<f64>();
+                    assert!(
+                        (t - chord).abs() <= 0.01 * chord + 0.01,
+                        "{shape:?} {phi} {sin_in}: t {t}, chord {chord}"
+                    );
+                    checked += 1;
+                }
+            }
+        }
+        assert_eq!(checked, 2 * 48 * 3);
+    }
+
+    /// Every normal of a thin ellipsoid (axes 0.037 to 0.763, and 0.02 to 5), of a sphere of
+    /// radius 2^-10 and of a cone near its apex is a unit vector along the exact gradient at the
+    /// (rounded) point. The ellipsoid's gradient, formed from I16F16 products, was shorter
+    /// than 2^-8 near the tips of its long axes and had no direction (a zero normal: unlit,
+    /// and mirrored as if by nothing); the sphere's offset and the cone's radial part too.
+    #[test]
+    fn normals_of_small_and_thin_shapes_are_unit_vectors_along_the_gradient() {
+        let ellipsoids = [
+            [0.037f64, 0.479, 0.763],
+            [0.02, 2.0, 5.0],
+            [2.0 / 1024.0; 3],
+        ];
+        let mut checked = 0;
+        for r in ellipsoids {
+            let e =
+                Ellipsoid::new(v(0.0, 0.0, 0.0), v(r[0] as f32, r[1] as f32, r[2] as f32)).unwrap();
+            let shapes = [
+                Shape::Ellipsoid(e),
+                Shape::Sphere(Sphere::new(v(0.0, 0.0, 0.0), f(r[0] as f32)).unwrap()),
+            ];
+            for (i, shape) in shapes.into_iter().enumerate() {
+                let radii = if i == 0 { r } else { [r[0]; 3] };
+                for a in 0..16 {
+                    for b in 1..16 {
+                        let (theta, phi) = (
+                            b as f64 * core::f64::consts::PI / 16.0,
+                            a as f64 * core::f64::consts::TAU / 16.0,
+                        );
+                        let p = [
+                            radii[0] * libm::sin(theta) * libm::cos(phi),
+                            radii[1] * libm::sin(theta) * libm::sin(phi),
+                            radii[2] * libm::cos(theta),
+                        ];
+                        let point = v(p[0] as f32, p[1] as f32, p[2] as f32);
+                        let q = [point.x, point.y, point.z].map(|c| c.to_num::<f64>());
+                        let g: [f64; 3] = core::array::from_fn(|k| q[k] / (radii[k] * radii[k]));
+                        let n = shape.normal(point);
+                        let n = [n.x, n.y, n.z].map(|c| c.to_num::<f64>());
+                        let len = libm::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+                        let cos = (n[0] * g[0] + n[1] * g[1] + n[2] * g[2]) / len;
+                        assert!(
+                            cos > 0.9999,
+                            "{shape:?} at {q:?}: normal {n:?}, gradient {g:?}"
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        // A cone of radius 1 narrowing to 0 over 2 units, at heights up to 2^-10 below the apex.
+        let cone = Shape::Frustum(
+            Frustum::new(v(0.0, 0.0, 0.0), f(1.0), v(0.0, 2.0, 0.0), f(0.0)).unwrap(),
+        );
+        for k in 0..16 {
+            let phi = k as f64 * core::f64::consts::TAU / 16.0;
+            for depth in [1.0 / 1024.0, 1.0 / 256.0, 1.0 / 64.0] {
+                let r = depth / 2.0;
+                let point = v(
+                    (r * libm::cos(phi)) as f32,
+                    (2.0 - depth) as f32,
+                    (r * libm::sin(phi)) as f32,
+                );
+                let n = cone.normal(point);
+                let n = [n.x, n.y, n.z].map(|c| c.to_num::<f64>());
+                // The side's outward normal: (2·radial unit, 1, …) / √5.
+                let exact =
+                    [2.0 * libm::cos(phi), 1.0, 2.0 * libm::sin(phi)].map(|c| c / libm::sqrt(5.0));
+                let cos = n[0] * exact[0] + n[1] * exact[1] + n[2] * exact[2];
+                assert!(
+                    cos > 0.999,
+                    "cone at {phi} {depth}: normal {n:?}, exact {exact:?}"
+                );
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 3 * 2 * 16 * 15 + 16 * 3);
+    }
+
+    /// A shadow ray towards a directional light has no end: an infinite plane it meets blocks
+    /// it, also where `t` is beyond the I16F16 range (a plane nearly parallel to the light),
+    /// which `hit` cannot report. The coplanar group test agrees.
+    #[test]
+    fn a_plane_blocks_a_ray_without_end_however_far() {
+        let plane = Shape::Plane(Plane::new(v(0.0, 1.0, 0.0), f(0.0)).unwrap());
+        let eps = crate::trace::tracer::EPSILON;
+        for (dy, meets) in [
+            (-1.0f32 / 65536.0, true),
+            (-1.0 / 8192.0, true),
+            (-0.5, true),
+            (1.0 / 65536.0, false),
+            (0.0, false),
+        ] {
+            let ray = Ray {
+                origin: v(0.0, 1.0, 0.0),
+                dir: Vec3 {
+                    x: I16F16::ONE,
+                    y: f(dy),
+                    z: I16F16::ZERO,
+                },
+            };
+            // Met at t = 1 / |dy|: up to 65,536, beyond the range from 2^-15 on.
+            assert_eq!(plane.blocks(&ray, eps, FAR), meets, "{dy}");
+            assert_eq!(
+                meets_plane(plane.plane().unwrap(), &ray, eps, FAR),
+                meets,
+                "{dy}"
+            );
+            let in_range = meets && dy < -1.0 / 32768.0;
+            assert_eq!(plane.hit(&ray, eps, FAR).is_some(), in_range, "{dy}");
+            // A ray with an end is blocked only before it.
+            assert_eq!(
+                plane.blocks(&ray, eps, f(100.0)),
+                meets && dy <= -0.01,
+                "{dy}"
+            );
+        }
     }
 }

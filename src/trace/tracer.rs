@@ -494,14 +494,18 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         search.finish(stats)
     }
 
-    /// `t` of object `id` along `ray` (which starts on object `from`) in `[t_min, t_max)`.
+    /// Whether object `id` blocks the shadow ray `ray` (which starts on object `from`) in
+    /// `[EPSILON, t_max)` ([`Shape::blocks`](crate::trace::Shape::blocks); `t_max` = `I16F16::MAX` for a directional
+    /// light).
     #[inline]
-    fn hit(&self, id: u32, ray: &Ray, from: u32, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
-        let object = self.scene.objects.get(id as usize)?;
+    fn blocks(&self, id: u32, ray: &Ray, from: u32, t_max: I16F16) -> bool {
+        let Some(object) = self.scene.objects.get(id as usize) else {
+            return false;
+        };
         if id == from {
-            object.shape.hit_from_surface(ray, t_min, t_max)
+            object.shape.hit_from_surface(ray, EPSILON, t_max).is_some()
         } else {
-            object.shape.hit(ray, t_min, t_max)
+            object.shape.blocks(ray, EPSILON, t_max)
         }
     }
 
@@ -523,7 +527,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         let cache_useful = *cached != u32::MAX
             && candidates.is_none_or(|list| list.iter().any(|c| c.object == *cached));
         let mut tests = u32::from(cache_useful);
-        if cache_useful && self.hit(*cached, ray, from, EPSILON, t_max).is_some() {
+        if cache_useful && self.blocks(*cached, ray, from, t_max) {
             stats.intersection_tests += tests;
             stats.shadow_cache_hits += 1;
             return true;
@@ -531,7 +535,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         let mut blocker = None;
         let mut blocks = |id: u32| {
             tests += 1;
-            let hit = self.hit(id, ray, from, EPSILON, t_max).is_some();
+            let hit = self.blocks(id, ray, from, t_max);
             if hit {
                 blocker = Some(id);
             }

@@ -132,6 +132,25 @@ impl Vec3 {
         self.normalized_with_length().map(|(unit, _)| unit)
     }
 
+    /// The unit vector along `self`, for any vector but zero: [`normalized`](Self::normalized)
+    /// after scaling a short vector by a power of two, which keeps its direction exactly,
+    /// until its longest component is at least 2^-2. `normalized` alone refuses a vector
+    /// shorter than 2^-8 and takes the direction of one not much longer from a few bits (the
+    /// normal of a primitive a few hundredths of a unit across, or near a cone's apex). Longer
+    /// vectors are normalised as `normalized` does, with the same result.
+    #[inline]
+    pub fn unit(self) -> Option<Vec3> {
+        let [x, y, z] = self.bits();
+        let longest = x.unsigned_abs().max(y.unsigned_abs()).max(z.unsigned_abs());
+        if longest == 0 {
+            return None;
+        }
+        // Below 2^14 raw (2^-2) the bit length is under 15: shifted to 15, every component
+        // stays below 2^15 raw in magnitude.
+        let shift = longest.leading_zeros().saturating_sub(17);
+        Vec3::from_bits(x << shift, y << shift, z << shift).normalized()
+    }
+
     /// Whether [`normalized`](Self::normalized) gives a unit vector: its length's [`sqrt`] is
     /// at least 2^-8 exactly when `self · self` is at least 2^-16 (2^16 raw I32F32 bits; below
     /// 2^32 raw the root is exact), without the root.

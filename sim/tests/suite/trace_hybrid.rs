@@ -6,8 +6,7 @@ use crate::run::{scratch, sim};
 use embedded_graphics::pixelcolor::Rgb565;
 use scanline3d::sink::HashSink;
 use scanline3d::trace::{ScreenBound, ShadowCandidate, TraceOptions, Tracer};
-use scanline3d_sim::draw::Draw;
-use scanline3d_sim::scene::CameraSpec;
+use scanline3d_sim::draw::{Draw, TracedDraw};
 use scanline3d_sim::trace::{corpus, fixed, scene::TracedScene};
 use std::path::Path;
 
@@ -100,60 +99,7 @@ fn every_search_gives_the_same_frame_on_random_scenes() {
     let mut d = Draw::new(0x2545_f491_4f6c_dd1d);
     let (mut frames, mut hit) = (0, 0);
     for case in 0..3_000usize {
-        let scale = [1.0, 10.0, 100.0, 2000.0][case % 4];
-        let xyz = |p: [f64; 3]| format!("{} {} {}", p[0], p[1], p[2]);
-        let unit = |d: &mut Draw| d.in_range(0.0, 1.0);
-        let mut text = format!(
-            "background {} {} {}\nambient {}\n",
-            unit(&mut d),
-            unit(&mut d),
-            unit(&mut d),
-            unit(&mut d)
-        );
-        for k in 0..(case / 4) % 3 {
-            let intensity = d.in_range(0.0, 2.0);
-            text += &if k % 2 == 0 {
-                format!("light point {} {intensity}\n", xyz(d.point(scale)))
-            } else {
-                format!("light directional {} {intensity}\n", xyz(d.point(1.0)))
-            };
-        }
-        for (m, ior) in ["air", "water", "diamond"].iter().enumerate() {
-            let k: Vec<String> = (0..7).map(|_| unit(&mut d).to_string()).collect();
-            text += &format!("material m{m} {} {ior}\n", k.join(" "));
-        }
-        for object in 0..1 + (case / 12) % 7 {
-            let m = format!("m{}", object % 3);
-            let (a, b) = (d.point(scale), d.point(scale));
-            let mut size = || d.in_range(0.001, scale);
-            text += &match (case + object) % 7 {
-                0 => format!("sphere {} {} {m}\n", xyz(a), size()),
-                1 => format!("plane {} {} {m}\n", xyz(b.map(|c| c / scale)), a[0]),
-                2 => {
-                    let far = [a[0] + size(), a[1] + size(), a[2] + size()];
-                    format!("box {} {} {m}\n", xyz(a), xyz(far))
-                }
-                3 => format!("cylinder {} {} {} {m}\n", xyz(a), xyz(b), size()),
-                4 => format!("cone {} {} {} {} {m}\n", xyz(a), size(), xyz(b), size()),
-                5 => format!(
-                    "ellipsoid {} {} {} {} {m}\n",
-                    xyz(a),
-                    size(),
-                    size(),
-                    size()
-                ),
-                _ => {
-                    let r = size();
-                    let corners: String = (0..5)
-                        .map(|k| {
-                            let t = k as f64 * std::f64::consts::TAU / 5.0;
-                            format!(" {}", xyz([a[0] + r * t.cos(), a[1], a[2] - r * t.sin()]))
-                        })
-                        .collect();
-                    format!("polygon {m}{corners}\n")
-                }
-            };
-        }
+        let text = TracedDraw::scene(&mut d, case);
         // Scenes the format or the fixed-point envelope refuses are skipped: `sim trace`'s own
         // tests cover those errors.
         let Ok(scene) = TracedScene::parse(&text, Path::new("."), "random") else {
@@ -162,14 +108,7 @@ fn every_search_gives_the_same_frame_on_random_scenes() {
         let Ok(scene) = fixed::FixedScene::new(&scene) else {
             continue;
         };
-        let cam = CameraSpec {
-            eye: d.point(scale),
-            target: d.point(scale),
-            up: [0.0, 1.0, 0.0],
-            fovy: d.in_range(5.0, 150.0),
-            near: d.in_range(0.01, 1.0),
-            far: d.in_range(2.0, 4.0 * scale),
-        };
+        let cam = TracedDraw::camera(&mut d, case);
         let options = fixed::options(1 + (case % 5) as u32, 1.0 / 256.0).unwrap();
         let (w, h) = (1 + case % 13, 1 + (case / 3) % 11);
         let render = |accel, hybrid| fixed::render(&scene, &cam, w, h, options, accel, hybrid);
