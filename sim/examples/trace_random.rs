@@ -11,8 +11,7 @@
 //! pixels.
 
 use scanline3d_sim::draw::{Draw, TracedDraw};
-use scanline3d_sim::trace::{compare, fixed, scene::TracedScene, whitted::Limits};
-use std::path::Path;
+use scanline3d_sim::trace::{compare, whitted::Limits};
 
 const SIDE: usize = 24;
 
@@ -24,15 +23,9 @@ fn main() {
     let mut d = Draw::new(0x2545_f491_4f6c_dd1d ^ seed.wrapping_mul(0x9e37_79b9_7f4a_7c15));
     let (mut frames, mut failing) = (0, Vec::new());
     for case in 0..cases {
-        // The draws of the tests: a camera only for a scene both tracers take.
-        let text = TracedDraw::scene(&mut d, case);
-        let refused = TracedScene::parse(&text, Path::new("."), "random")
-            .and_then(|traced| fixed::FixedScene::new(&traced))
-            .is_err();
-        if refused {
+        let Some((text, cam)) = TracedDraw::case(&mut d, case) else {
             continue;
-        }
-        let cam = TracedDraw::camera(&mut d, case);
+        };
         if only.is_some_and(|o| o != case) {
             continue;
         }

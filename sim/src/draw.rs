@@ -2,6 +2,9 @@
 //! seed names the cases a test or an example draws, with no dependency.
 
 use crate::scene::CameraSpec;
+use crate::trace::fixed::FixedScene;
+use crate::trace::scene::TracedScene;
+use std::path::Path;
 
 /// A generator of uniform draws.
 pub struct Draw(u64);
@@ -133,6 +136,15 @@ impl TracedDraw {
             };
         }
         text
+    }
+
+    /// Case `case`: its scene text and a camera, or `None` for a scene the format or the
+    /// fixed-point envelope refuses (for which no camera is drawn).
+    pub fn case(d: &mut Draw, case: usize) -> Option<(String, CameraSpec)> {
+        let text = Self::scene(d, case);
+        let traced = TracedScene::parse(&text, Path::new("."), "random").ok()?;
+        FixedScene::new(&traced).ok()?;
+        Some((text, Self::camera(d, case)))
     }
 
     /// A random camera for case `case`, at its scale.

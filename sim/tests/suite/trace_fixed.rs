@@ -15,10 +15,7 @@
 
 use scanline3d_sim::draw::{Draw, TracedDraw};
 use scanline3d_sim::trace::compare::{self, near_edge};
-use scanline3d_sim::trace::{
-    accel::Structure, corpus, fixed, render, scene::TracedScene, whitted::Limits,
-};
-use std::path::Path;
+use scanline3d_sim::trace::{accel::Structure, corpus, fixed, render, whitted::Limits};
 
 /// Image size of the comparison (small: the fixed tracer tests every object per ray).
 const SIZE: usize = 96;
@@ -117,15 +114,9 @@ fn fixed_tracer_matches_the_reference_on_random_scenes() {
     let mut d = Draw::new(0x2545_f491_4f6c_dd1d);
     let mut frames = 0;
     for case in 0..1_200 {
-        // The draws of trace_hybrid's test: a camera only for a scene both tracers take.
-        let text = TracedDraw::scene(&mut d, case);
-        let refused = TracedScene::parse(&text, Path::new("."), "random")
-            .and_then(|traced| fixed::FixedScene::new(&traced))
-            .is_err();
-        if refused {
+        let Some((text, cam)) = TracedDraw::case(&mut d, case) else {
             continue;
-        }
-        let cam = TracedDraw::camera(&mut d, case);
+        };
         let limits = Limits {
             max_depth: 1 + (case % 5) as u32,
             threshold: 1.0 / 256.0,

@@ -99,16 +99,13 @@ fn every_search_gives_the_same_frame_on_random_scenes() {
     let mut d = Draw::new(0x2545_f491_4f6c_dd1d);
     let (mut frames, mut hit) = (0, 0);
     for case in 0..3_000usize {
-        let text = TracedDraw::scene(&mut d, case);
         // Scenes the format or the fixed-point envelope refuses are skipped: `sim trace`'s own
         // tests cover those errors.
-        let Ok(scene) = TracedScene::parse(&text, Path::new("."), "random") else {
+        let Some((text, cam)) = TracedDraw::case(&mut d, case) else {
             continue;
         };
-        let Ok(scene) = fixed::FixedScene::new(&scene) else {
-            continue;
-        };
-        let cam = TracedDraw::camera(&mut d, case);
+        let parsed = TracedScene::parse(&text, Path::new("."), "random").unwrap();
+        let scene = fixed::FixedScene::new(&parsed).unwrap();
         let options = fixed::options(1 + (case % 5) as u32, 1.0 / 256.0).unwrap();
         let (w, h) = (1 + case % 13, 1 + (case / 3) % 11);
         let render = |accel, hybrid| fixed::render(&scene, &cam, w, h, options, accel, hybrid);
