@@ -408,6 +408,21 @@ mod tests {
             if scene.name == "interpenetrating" || scene.name == "cyclic" {
                 assert!(bsp.splits > 0, "{}: nothing split", scene.name);
             }
+            // Each node's first `facing_front` triangles are (pieces of) triangles facing
+            // its plane's front side, the others face its back (or have no plane).
+            let input_normal = |o: u32| {
+                let t = scene.mesh.triangles[o as usize];
+                let v = t.map(|i| scene.mesh.vertices[i as usize].map(|c| c.to_num::<f64>()));
+                cross(sub(v[1], v[0]), sub(v[2], v[0]))
+            };
+            for node in &bsp.nodes {
+                let n = node.plane.map(f64::from);
+                for k in 0..node.count {
+                    let m = input_normal(bsp.origin[(node.first + k) as usize]);
+                    let front = dot(m, [n[0], n[1], n[2]]) > 0.0;
+                    assert_eq!(front, k < node.facing_front, "{}: {node:?}", scene.name);
+                }
+            }
         }
     }
 

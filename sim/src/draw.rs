@@ -2,8 +2,9 @@
 //! seed names the cases a test or an example draws, with no dependency.
 
 use crate::scene::CameraSpec;
-use crate::trace::fixed::FixedScene;
-use crate::trace::scene::TracedScene;
+#[cfg(feature = "tools")]
+use crate::trace::{fixed::FixedScene, scene::TracedScene};
+#[cfg(feature = "tools")]
 use std::path::Path;
 
 /// A generator of uniform draws.
@@ -75,8 +76,10 @@ impl Soup {
 /// (`sim/examples/trace_random.rs` for more): up to 7 objects of every primitive, sizes from a
 /// unit to the envelope's 2,000 (`case % 4` picks the scale), every material kind and IOR,
 /// point and directional lights.
+#[cfg(feature = "tools")]
 pub struct TracedDraw;
 
+#[cfg(feature = "tools")]
 impl TracedDraw {
     /// The scene text of case `case` (some are refused by the format or the fixed-point
     /// envelope: the draws do not check).

@@ -478,11 +478,12 @@ impl Shape<'_> {
                 // From a radius of 1/2 a surface point's longest offset is above 2^-2, where
                 // `unit` is `normalized`: the shorter test for most spheres.
                 let offset = point.sub(s.centre);
-                match s.radius >= I16F16::from_bits(1 << 15) {
-                    true => offset.normalized(),
-                    false => offset.unit(),
-                }
-                .unwrap_or(Vec3::ZERO)
+                let unit = if s.radius >= I16F16::from_bits(1 << 15) {
+                    offset.normalized()
+                } else {
+                    offset.unit()
+                };
+                unit.unwrap_or(Vec3::ZERO)
             }
             Shape::Plane(p) => p.normal,
             Shape::Polygon(p) => p.facet.normal,
