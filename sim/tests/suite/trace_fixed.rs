@@ -105,10 +105,10 @@ fn compare(
 
 /// The fixed tracer against the f64 tracer on the first 1,200 random scenes of
 /// `trace_hybrid`'s test (`cargo run --release -p scanline3d-sim --example trace_random` draws
-/// more): every primary-id and shadow-mask mismatch is explained. It found three defects:
-/// a light inside a cylinder or cone shining through its wall (a grazing shadow ray's second
-/// root lost, case 306), thin ellipsoids without normals near their tips, and planes nearly
-/// parallel to a directional light not blocking it (`intersect::tests`).
+/// more): every primary-id and shadow-mask mismatch is explained. The comparison found three
+/// defects: a light inside a cylinder or cone shining through its wall (a grazing shadow
+/// ray's second root lost; case 306 here), thin ellipsoids without normals near their tips,
+/// and planes nearly parallel to a directional light not blocking it (`intersect::tests`).
 #[test]
 fn fixed_tracer_matches_the_reference_on_random_scenes() {
     let mut d = Draw::new(0x2545_f491_4f6c_dd1d);
