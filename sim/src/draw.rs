@@ -1,6 +1,8 @@
 //! Deterministic random draws for the randomized checks (Marsaglia's 64-bit xorshift), so a
 //! seed names the cases a test or an example draws, with no dependency.
 
+#[cfg(feature = "tools")]
+use crate::metaball::{BallSpec, MetaScene};
 use crate::scene::CameraSpec;
 #[cfg(feature = "tools")]
 use crate::trace::{fixed::FixedScene, scene::TracedScene};
@@ -161,5 +163,65 @@ impl TracedDraw {
             near: d.in_range(0.01, 1.0),
             far: d.in_range(2.0, 4.0 * scale),
         }
+    }
+}
+
+/// Random metaball scenes and cameras for the fixed caster against the f64 reference
+/// (`sim/examples/meta_random.rs`): 1 to 8 balls, about a fifth of negative density, at scale
+/// 1, 0.1, 10 or 100 (`case % 4`), random cameras. Cases with `(case / 4) % 2 == 1` are snapped
+/// to the library's 2^-16 grid ([`MetaScene::on_fixed_grid`]), so the comparison allows no
+/// input rounding there.
+#[cfg(feature = "tools")]
+pub struct MetaDraw;
+
+#[cfg(feature = "tools")]
+impl MetaDraw {
+    /// The generator whose draws are the cases `sim/examples/meta_random.rs` and the suite's
+    /// random test check.
+    pub fn draws() -> Draw {
+        Draw::new(0x1234_5678_9abc_def1)
+    }
+
+    /// Case `case`'s scene and camera (some lie outside the caster's envelope: the draws do not
+    /// check).
+    pub fn case(d: &mut Draw, case: usize) -> (MetaScene, CameraSpec) {
+        let scale = [1.0, 0.1, 10.0, 100.0][case % 4];
+        let n = 1 + (d.in_range(0.0, 1.0) * 8.0) as usize;
+        let balls = (0..n)
+            .map(|_| BallSpec {
+                centre: d.point(scale),
+                radius: d.in_range(0.3, 2.0) * scale,
+                density: if d.in_range(0.0, 1.0) < 0.2 {
+                    -d.in_range(0.3, 1.0)
+                } else {
+                    d.in_range(0.5, 1.5)
+                },
+                color: [0; 3].map(|_| d.in_range(0.0, 1.0)),
+                keys: vec![],
+            })
+            .collect();
+        let mut scene = MetaScene {
+            threshold: d.in_range(0.1, 0.9),
+            light: ([0.0, 0.0, 1.0], 0.2, 0.8),
+            balls,
+        };
+        let camera = CameraSpec {
+            eye: d.point(5.0 * scale),
+            target: d.point(scale),
+            up: [0.0, 1.0, 0.0],
+            fovy: d.in_range(20.0, 120.0),
+            near: d.in_range(0.01, 0.5) * scale,
+            far: 20.0 * scale,
+        };
+        if (case / 4) % 2 == 1 {
+            let snap = |v: f64| (v * 65536.0).round() / 65536.0;
+            scene.threshold = snap(scene.threshold);
+            for ball in &mut scene.balls {
+                ball.centre = ball.centre.map(snap);
+                ball.radius = snap(ball.radius);
+                ball.density = snap(ball.density);
+            }
+        }
+        (scene, camera)
     }
 }

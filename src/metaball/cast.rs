@@ -3,9 +3,10 @@
 //! Per ray and ball, `s(t) = A·(t − t_c)² + s_min` (closest approach `t_c`, `s_min` from the
 //! cross product, so no cancellation) gives the influence interval `|t − t_c| < √((1 − s_min)/A)`.
 //! The march starts at the near plane and steps `|g(t)| / L(t)`, where `g` is the summed field
-//! minus `T` and `L` the sum of `|q|·FIELD_LIPSCHITZ·|d|/R` over the balls active at `t`;
-//! steps stop at the next ball's entry, so `L` bounds `|g'|` over every step and a step never
-//! passes a root. The hit is where the step falls below [`EPSILON_T`]; a ray still marching after
+//! minus `T` and `L` the sum over the balls active at `t` of their slope bounds along the ray,
+//! `|q|·FIELD_LIPSCHITZ·|d|/R·(1 − s_min)^{3/2}` (a ray through the edge of a ball's influence
+//! sees only a little of its slope); steps stop at the next ball's entry, so `L` bounds `|g'|`
+//! over every step and a step never passes a root. The hit is where the step falls below [`EPSILON_T`]; a ray still marching after
 //! [`MAX_STEPS`] (a near-tangent graze) is counted as a miss and reported in [`CastStats::capped`].
 
 use super::{
@@ -140,6 +141,8 @@ pub struct CastStats {
     pub max_steps: u32,
     /// Rays stopped after [`MAX_STEPS`] and drawn as background.
     pub capped: u32,
+    /// The pixel `(column, row)` of the last of those, if any.
+    pub last_capped: Option<(u16, u16)>,
 }
 
 /// Why a frame stopped.
@@ -289,10 +292,12 @@ impl<P: RowPixel, const W: usize, const N: usize> Caster<P, W, N> {
         };
         let mut stats = CastStats::default();
         for row in 0..camera.height {
+            // Only the camera's columns: a caster may be wider than the frame.
             for (column, (pixel, depth)) in self
                 .pixels
                 .iter_mut()
                 .zip(self.depth.iter_mut())
+                .take(width)
                 .enumerate()
             {
                 let shade = frame.pixel::<N>(column as u16, row, &mut stats);
@@ -382,7 +387,7 @@ impl Frame<'_> {
         let d = self.camera.direction(column, row);
         let dd = dot(d, d);
         let length = sqrt_wide(dd);
-        let inv_dd = quotient(Wide::ONE, dd)?;
+        let inv_dd = reciprocal(dd)?;
         let mut rays = [RayBall::EMPTY; N];
         let mut count = 0usize;
         for (index, ball) in self.balls.iter().enumerate() {
@@ -430,6 +435,7 @@ impl Frame<'_> {
         if !found {
             if steps >= MAX_STEPS {
                 stats.capped += 1;
+                stats.last_capped = Some((column, row));
             }
             return None;
         }
@@ -499,7 +505,7 @@ impl Frame<'_> {
         }
         let (color, ball) =
             blend.finish(intensity.min(Wide::ONE), self.balls.iter().map(|b| b.color));
-        let depth = quotient(self.camera.near, t).map_or(Depth::ZERO, Depth::saturating_from_num);
+        let depth = depth_at(self.camera.near, t);
         Some(Hit { color, ball, depth })
     }
 }
@@ -529,6 +535,16 @@ fn ray_ball(
     // (1 − s_min)/A = (1 − s_min)·R²/|d|²; padded by 2^-16 so the rounding of the square root
     // never shortens the interval.
     let half = sqrt_wide(mul(mul(Wide::ONE - s_min, ball.r2), inv_dd)) + Wide::from_bits(1 << 16);
+    // Along the ray, s = s_min + A·u² (u = t − t_c) and |d(q·f)/dt| = |q|·|f'(s)|·2A|u|. With
+    // s = s_min + (1 − s_min)·z, z ∈ [0, 1), that is |q|·√A·(1 − s_min)^{3/2} times
+    // (1 − z)(22/9 − 12/9·s)·2√z, largest at s_min = 0, where it is |df/dr|·R: so the ray's own
+    // bound is the ball's times (1 − s_min)^{3/2}, here (1 − s_min)·A·half with the padded half
+    // (≥ √((1 − s_min)/A)). Far below the ball's bound for a ray through the edge of its
+    // influence.
+    let along = mul(
+        mul(ball.density.abs(), FIELD_LIPSCHITZ_WIDE),
+        mul(mul(Wide::ONE - s_min, a), half),
+    );
     Some(RayBall {
         ball: u8::try_from(index).ok()?,
         closest,
@@ -536,8 +552,34 @@ fn ray_ball(
         s_min,
         enter: closest - half,
         exit: closest + half,
-        lipschitz: ball.slope_bound * length,
+        lipschitz: (ball.slope_bound * length).min(along),
     })
+}
+
+/// `1/x` for `x > 2^-31` to within 2^-31 (one unsigned 64-bit division, rounding down): the
+/// ray's `1/|d|²`, which sets every ball's closest approach along the ray, so an error here
+/// moves the whole surface along the ray (with [`quotient`]'s 2^-16, up to 1.5·10⁻⁵ of the
+/// depth, much more where the ray grazes it).
+fn reciprocal(x: Wide) -> Option<Wide> {
+    let bits = u64::try_from(x.to_bits()).ok()?;
+    let q = (1u64 << 63).checked_div(bits)?;
+    i64::try_from(q).ok()?.checked_mul(2).map(Wide::from_bits)
+}
+
+/// The depth format's `near / t` (`t ≥ near`, both below 2^10) to within 2^-30 plus 2^-23 of
+/// `t`: one unsigned 64-bit division, `t` keeping 23 fractional bits ([`quotient`]'s 16 would
+/// report the hit up to 2^-16 deeper than it is).
+fn depth_at(near: Wide, t: Wide) -> Depth {
+    let numerator = u64::try_from(near.to_bits())
+        .ok()
+        .and_then(|n| n.checked_mul(1 << 21));
+    let denominator = u64::try_from(t.to_bits() >> 9).ok();
+    match (numerator, denominator) {
+        (Some(n), Some(d)) => n.checked_div(d).map_or(Depth::ZERO, |q| {
+            Depth::from_bits(i32::try_from(q).unwrap_or(i32::MAX))
+        }),
+        _ => Depth::ZERO,
+    }
 }
 
 /// `numerator / denominator` for a positive denominator in one `i64` division (I32F32's own
@@ -555,4 +597,145 @@ pub(super) fn quotient(numerator: Wide, denominator: Wide) -> Option<Wide> {
         .checked_mul(1 << 16)?
         .checked_div(den)
         .map(Wide::from_bits)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sink::HashSink;
+    use crate::test_rng::XorShift64;
+
+    fn unit(rng: &mut XorShift64) -> f64 {
+        (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn reciprocal_is_within_2_pow_minus_31() {
+        let mut rng = XorShift64::new(0x9e37_79b9_7f4a_7c15);
+        for _ in 0..10_000 {
+            let x = Wide::from_num(1.0 + 3.0 * unit(&mut rng));
+            let exact = 1.0 / x.to_num::<f64>();
+            let got = reciprocal(x).map(|r| r.to_num::<f64>());
+            assert!(
+                got.is_some_and(|r| (r - exact).abs() <= 2f64.powi(-31)),
+                "{x}"
+            );
+        }
+        assert_eq!(reciprocal(Wide::ZERO), None);
+        assert_eq!(reciprocal(Wide::from_num(-1)), None);
+    }
+
+    #[test]
+    fn depth_gives_back_the_ray_parameter_within_2_pow_minus_23() {
+        let mut rng = XorShift64::new(0x2545_f491_4f6c_dd1d);
+        for _ in 0..10_000 {
+            let near = 1.0 / 256.0 + unit(&mut rng) * 4.0;
+            let t = near * (1.0 + 15.0 * unit(&mut rng));
+            let (near_w, t_w) = (Wide::from_num(near), Wide::from_num(t));
+            let (near, t) = (near_w.to_num::<f64>(), t_w.to_num::<f64>());
+            let depth = depth_at(near_w, t_w).to_num::<f64>();
+            // The Q30 output's own step, 2^-30 of the depth, is t²/near·2^-30 in t.
+            let allowed = 2f64.powi(-23) + t * t / near * 2f64.powi(-30);
+            assert!((near / depth - t).abs() <= allowed, "near {near} t {t}");
+        }
+    }
+
+    /// The bound along the ray never falls below the slope it bounds, sampled on random rays
+    /// through random balls, the edge of their influence included.
+    #[test]
+    fn lipschitz_along_the_ray_bounds_its_slope() {
+        let mut rng = XorShift64::new(0x1234_5678_9abc_def1);
+        let camera = MetaCamera::new(
+            [0.0, 0.0, 6.0],
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            60.0,
+            0.1,
+            20.0,
+            64,
+            64,
+        );
+        let Ok(camera) = camera else {
+            panic!("camera");
+        };
+        let mut tested = 0;
+        for _ in 0..2_000 {
+            let mut r = || unit(&mut rng) as f32;
+            let centre = [4.0 * r() - 2.0, 4.0 * r() - 2.0, 4.0 * r() - 2.0];
+            let ball = Ball::new(centre, 0.2 + 2.0 * r(), 3.0 * r() - 1.5, Rgb888::BLACK);
+            let (column, row) = ((r() * 64.0) as u16, (r() * 64.0) as u16);
+            let frame = frame_ball(&ball, &camera);
+            let d = camera.direction(column, row);
+            let dd = dot(d, d);
+            let (Some(inv_dd), length) = (reciprocal(dd), sqrt_wide(dd)) else {
+                panic!("direction");
+            };
+            let Some(ray) = ray_ball(&frame, 0, d, dd, inv_dd, length) else {
+                continue;
+            };
+            tested += 1;
+            let (enter, exit) = (ray.enter.to_num::<f64>(), ray.exit.to_num::<f64>());
+            let q = frame.density.to_num::<f64>();
+            let h = |t: f64| {
+                let s = ray.a.to_num::<f64>() * (t - ray.closest.to_num::<f64>()).powi(2)
+                    + ray.s_min.to_num::<f64>();
+                if s >= 1.0 {
+                    0.0
+                } else {
+                    q * (1.0 - s) * (1.0 - s) * (1.0 - 4.0 / 9.0 * s)
+                }
+            };
+            let step = (exit - enter) / 512.0;
+            for k in 0..512 {
+                let t = enter + step * k as f64;
+                let slope = (h(t + step) - h(t)).abs() / step;
+                assert!(
+                    slope <= ray.lipschitz.to_num::<f64>() * 1.0001,
+                    "slope {slope} over {} ({ball:?}, pixel {column} {row})",
+                    ray.lipschitz
+                );
+            }
+        }
+        assert!(tested > 200, "{tested}");
+    }
+
+    /// A caster wider than the camera casts the camera's columns only.
+    #[test]
+    fn a_wider_caster_casts_the_same_frame() {
+        let balls = [
+            Ball::new([0.0, 0.0, 0.0], 1.5, 1.0, Rgb888::RED),
+            Ball::new([0.8, 0.3, 0.0], 1.0, 0.8, Rgb888::GREEN),
+        ];
+        let (Ok(scene), Ok(camera), Ok(light)) = (
+            Metaballs::new(&balls, crate::metaball::Coord::from_num(0.5)),
+            MetaCamera::new(
+                [0.0, 0.5, 5.0],
+                [0.0; 3],
+                [0.0, 1.0, 0.0],
+                45.0,
+                0.1,
+                20.0,
+                16,
+                16,
+            ),
+            Light::new([0.0, 0.0, 1.0], 0.2, 0.8),
+        ) else {
+            panic!("scene");
+        };
+        let render = |caster: &mut dyn FnMut(&mut HashSink) -> CastStats| {
+            let mut sink = HashSink::new();
+            let stats = caster(&mut sink);
+            (stats, sink.hash())
+        };
+        let mut narrow = Caster::<Rgb888, 16, 2>::new(Rgb888::BLACK);
+        let mut wide = Caster::<Rgb888, 64, 2>::new(Rgb888::BLACK);
+        let a = render(&mut |s| {
+            narrow
+                .render(&scene, &camera, &light, s)
+                .unwrap_or_default()
+        });
+        let b = render(&mut |s| wide.render(&scene, &camera, &light, s).unwrap_or_default());
+        assert!(a.0.hits > 20 && a.0.hits <= 256, "{:?}", a.0);
+        assert_eq!(a, b);
+    }
 }

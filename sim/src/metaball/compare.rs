@@ -2,7 +2,7 @@
 
 use super::reference::Reference;
 use super::MetaScene;
-use crate::reference::Image;
+use crate::reference::{dot, Image, V3};
 use crate::scene::CameraSpec;
 use embedded_graphics::pixelcolor::Rgb888;
 use embedded_graphics::prelude::RgbColor;
@@ -16,9 +16,10 @@ pub const MAX_WIDTH: usize = 640;
 /// Most balls the host renders with the library caster.
 pub const MAX_BALLS: usize = 64;
 
-/// Depth slack on top of the march's bound: the f32 camera set-up and I32F32 rounding
-/// (relative to the eye depth).
-pub const DEPTH_SLACK: f64 = 1e-4;
+/// Position error of the caster's ray points per unit of distance from the eye and of the eye
+/// from the origin: its camera is set up in f32 (relative errors of a few 2^-24); taken as
+/// 2^-20. Its depth output adds 2^-23 of the ray parameter.
+pub const CAMERA_ROUNDING: f64 = 1.0 / 1048576.0;
 
 /// The fixed-point caster's image (colour, ids, eye depth) and statistics.
 pub fn render_fixed(
@@ -104,6 +105,75 @@ fn render_rows<P: scanline3d::sink::RowPixel>(
         .map_err(|e| format!("caster: {e:?}"))
 }
 
+/// `scene` at frame 0 seen by `camera` at `side × side`, by the caster and by the reference,
+/// compared; `None` for a scene or camera outside the caster's or the reference's envelope.
+pub fn check(scene: MetaScene, camera: CameraSpec, side: usize) -> Option<Checked> {
+    let reference = camera
+        .reference()
+        .and_then(|c| Reference::new(&scene, 0, c))
+        .ok()?;
+    let (fixed, stats) = render_fixed(&scene, 0, &camera, side, side).ok()?;
+    let (expected, _) = reference.render(side, side);
+    let comparison = compare(&fixed, &expected, &reference);
+    Some(Checked {
+        scene,
+        camera,
+        fixed,
+        expected,
+        reference,
+        comparison,
+        stats,
+    })
+}
+
+/// A scene and camera checked against the reference ([`check`]).
+pub struct Checked {
+    /// The scene.
+    pub scene: MetaScene,
+    /// The camera.
+    pub camera: CameraSpec,
+    /// The caster's image.
+    pub fixed: Image,
+    /// The reference's image.
+    pub expected: Image,
+    /// The reference.
+    pub reference: Reference,
+    /// The comparison.
+    pub comparison: MetaComparison,
+    /// The caster's statistics.
+    pub stats: CastStats,
+}
+
+impl Checked {
+    /// Whether every mismatch is explained: no depth the stopping rule does not explain, and no
+    /// coverage mismatch off the silhouette but the one ray the caster reports capped (a near
+    /// tangent graze still marching after `MAX_STEPS`, drawn as background), if it capped one.
+    pub fn explained(&self) -> bool {
+        let capped_off_silhouette = match self.stats.last_capped {
+            Some((x, y)) if self.stats.capped == 1 => {
+                let (x, y) = (usize::from(x), usize::from(y));
+                let i = y * self.expected.width + x;
+                self.expected.ids[i] >= 0
+                    && self.fixed.ids[i] < 0
+                    && !near_silhouette(&self.expected, x, y)
+            }
+            _ => false,
+        };
+        let off_silhouette = self.comparison.off_silhouette - usize::from(capped_off_silhouette);
+        off_silhouette == 0 && self.comparison.depth_unexplained == 0
+    }
+}
+
+/// Whether the 3×3 neighbourhood of pixel `(x, y)` holds a silhouette of `image`: a pixel
+/// whose coverage differs from `(x, y)`'s.
+pub fn near_silhouette(image: &Image, x: usize, y: usize) -> bool {
+    let (w, h) = (image.width, image.height);
+    let covered = |x: usize, y: usize| image.ids[y * w + x] >= 0;
+    let here = covered(x, y);
+    (y.saturating_sub(1)..(y + 2).min(h))
+        .any(|yy| (x.saturating_sub(1)..(x + 2).min(w)).any(|xx| covered(xx, yy) != here))
+}
+
 /// The caster against the reference, per the measures.
 #[derive(Clone, Debug, Default)]
 pub struct MetaComparison {
@@ -119,8 +189,9 @@ pub struct MetaComparison {
     pub max_depth_error: f64,
     /// Mean eye-depth error over pixels covered by both.
     pub mean_depth_error: f64,
-    /// Pixels whose depth error exceeds the ray caster's documented bound (see [`compare`]).
-    pub depth_over_bound: usize,
+    /// Pixels covered by both whose depth the caster's stopping rule does not explain (see
+    /// [`compare`]).
+    pub depth_unexplained: usize,
     /// Colour PSNR over every pixel and channel (dB).
     pub psnr: f64,
     /// Ids that differ where both cover.
@@ -138,30 +209,27 @@ impl std::fmt::Display for MetaComparison {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "coverage mismatches {} ({:.3} %), off the silhouette {}; depth: max error {:.2e}, mean {:.2e}, over the caster's bound {}; PSNR {:.2} dB; id mismatches {}",
+            "coverage mismatches {} ({:.3} %), off the silhouette {}; depth: max error {:.2e}, mean {:.2e}, unexplained {}; PSNR {:.2} dB; id mismatches {}",
             self.coverage_mismatches,
             self.coverage_percent(),
             self.off_silhouette,
             self.max_depth_error,
             self.mean_depth_error,
-            self.depth_over_bound,
+            self.depth_unexplained,
             self.psnr,
             self.id_mismatches
         )
     }
 }
 
-/// Compares the caster's image with the reference's. The depth bound per pixel is the march's
-/// `EPSILON_T · max L / min |g'|` (Lipschitz bound over the field's slope along the ray, both
-/// taken between the two depths, sampled at 17 points) plus
-/// [`DEPTH_SLACK`] of the depth.
+/// Compares the caster's image with the reference's. A depth where both cover is explained
+/// when the caster's stopping rule allows it (see [`stop_explained`]).
 pub fn compare(fixed: &Image, reference: &Image, reference_scene: &Reference) -> MetaComparison {
     let (w, h) = (reference.width, reference.height);
     let mut m = MetaComparison {
         pixels: w * h,
         ..Default::default()
     };
-    let covered = |x: usize, y: usize| reference.ids[y * w + x] >= 0;
     let mut squared = 0.0;
     for y in 0..h {
         for x in 0..w {
@@ -173,9 +241,7 @@ pub fn compare(fixed: &Image, reference: &Image, reference_scene: &Reference) ->
             }
             if f != r {
                 m.coverage_mismatches += 1;
-                let near_silhouette = (y.saturating_sub(1)..(y + 2).min(h))
-                    .any(|yy| (x.saturating_sub(1)..(x + 2).min(w)).any(|xx| covered(xx, yy) != r));
-                if !near_silhouette {
+                if !near_silhouette(reference, x, y) {
                     m.off_silhouette += 1;
                 }
             } else if f {
@@ -191,18 +257,8 @@ pub fn compare(fixed: &Image, reference: &Image, reference_scene: &Reference) ->
                 let error = (tf - t).abs();
                 m.max_depth_error = m.max_depth_error.max(error);
                 m.mean_depth_error += error;
-                // Mean value theorem: |g(t_f)| = |g'(ξ)|·|t − t_f| for some ξ between the two,
-                // and the march stopped with |g(t_f)| < EPSILON_T·L.
-                let (mut slope, mut lipschitz) = (f64::INFINITY, 0.0f64);
-                for k in 0..=16 {
-                    let hit = reference_scene.hit(d, tf + (t - tf) * k as f64 / 16.0);
-                    slope = slope.min(hit.slope);
-                    lipschitz = lipschitz.max(hit.lipschitz);
-                }
-                let bound =
-                    EPSILON_T.to_num::<f64>() * lipschitz / slope.max(1e-300) + DEPTH_SLACK * t;
-                if error > bound {
-                    m.depth_over_bound += 1;
+                if !stop_explained(reference_scene, d, t, tf) {
+                    m.depth_unexplained += 1;
                 }
             }
         }
@@ -215,4 +271,50 @@ pub fn compare(fixed: &Image, reference: &Image, reference_scene: &Reference) ->
         10.0 * (255.0f64 * 255.0 / mse).log10()
     };
     m
+}
+
+/// Whether the caster's stopping rule explains a hit at `tf` on the ray of direction `d` whose
+/// reference surface is at `t`.
+///
+/// The caster stops where its step `|g| / (L + 2^-16)` falls below [`EPSILON_T`] (the quotient
+/// rounds its denominator up by at most 2^-16), so at `tf` the reference's `|g|` must be within
+/// `EPSILON_T·(L·(1 + 2^-10) + 2^-16)` (the `2^-10` covers the caster's rounded `L`), plus what
+/// rounding the scene into the library's formats ([`MarchPoint::rounding_gain`] times
+/// [`Reference::input_rounding`]) and the camera and depth output (`|∇g|` times the point's
+/// uncertainty, [`CAMERA_ROUNDING`] of its and the eye's distances plus 2^-23; `L` counts the
+/// balls within that of the point, as the caster's may) can move `g`.
+/// Where the caster stops beyond the reference's surface, `|g|` must stay in that band at 17
+/// points between the two, so no sliver of surface or gap was passed. A hit this explains can
+/// still be far in front of the surface where `g` runs almost level with it along the ray.
+///
+/// [`MarchPoint::rounding_gain`]: super::reference::MarchPoint::rounding_gain
+/// [`Reference::input_rounding`]: super::reference::Reference::input_rounding
+pub fn stop_explained(reference: &Reference, d: V3, t: f64, tf: f64) -> bool {
+    stop_ratio(reference, d, t, tf) <= 1.0
+}
+
+/// The largest `|g|` over its allowed band at the points [`stop_explained`] checks: at most 1
+/// where the rule explains the hit.
+pub fn stop_ratio(reference: &Reference, d: V3, t: f64, tf: f64) -> f64 {
+    let epsilon = EPSILON_T.to_num::<f64>();
+    let eye = reference.camera.eye;
+    let eye_distance = dot(eye, eye).sqrt();
+    let length = dot(d, d).sqrt();
+    let ratio = |at: f64| {
+        // Where the caster's point may be, around the reference's: |d| ≥ 1, so this bounds
+        // the uncertainty of the ray parameter too.
+        let uncertainty = CAMERA_ROUNDING * (at * length + eye_distance) + 1.0 / 8388608.0;
+        let point = reference.march_point(d, at, uncertainty);
+        let band = epsilon * (point.lipschitz * (1.0 + 1.0 / 1024.0) + 1.0 / 65536.0)
+            + point.rounding_gain * reference.input_rounding
+            + point.gradient * uncertainty;
+        point.g.abs() / band
+    };
+    if tf <= t {
+        ratio(tf)
+    } else {
+        (0..=16)
+            .map(|k| ratio(t + (tf - t) * f64::from(k) / 16.0))
+            .fold(0.0, f64::max)
+    }
 }

@@ -43,6 +43,17 @@ pub struct BallSpec {
 }
 
 impl BallSpec {
+    /// Whether the ball has no keys and its centre, radius and density lie on the 2^-16 grid
+    /// of the library's formats (so converting it moves nothing).
+    pub fn on_fixed_grid(&self) -> bool {
+        self.keys.is_empty()
+            && self
+                .centre
+                .iter()
+                .chain([&self.radius, &self.density])
+                .all(|&v| on_grid(v))
+    }
+
     /// The centre at `frame`.
     pub fn centre_at(&self, frame: u32) -> [f64; 3] {
         let mut keys = self.keys.clone();
@@ -84,7 +95,19 @@ fn numbers<const K: usize>(fields: &[&str], what: &str) -> Result<[f64; K], Stri
     Ok(out)
 }
 
+/// Whether `v` is a multiple of 2^-16 (a value I16F16 holds exactly, within its range).
+fn on_grid(v: f64) -> bool {
+    let scaled = v * 65536.0;
+    scaled == scaled.round() && v.abs() < 32768.0
+}
+
 impl MetaScene {
+    /// Whether the threshold and every ball lie on the library's 2^-16 grid
+    /// ([`BallSpec::on_fixed_grid`]).
+    pub fn on_fixed_grid(&self) -> bool {
+        on_grid(self.threshold) && self.balls.iter().all(BallSpec::on_fixed_grid)
+    }
+
     /// Parses a `.meta` file; errors are one line, `NAME:LINE: what`.
     pub fn parse(text: &str, name: &str) -> Result<MetaScene, String> {
         let mut threshold = None;

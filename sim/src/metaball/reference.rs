@@ -43,6 +43,28 @@ pub struct Reference {
     pub light: Light,
     /// The camera.
     pub camera: Camera,
+    /// How far the library's formats may move any input value: 0 when every radius, density,
+    /// centre and the threshold lie on their formats' 2^-16 grid and nothing moves, else 2^-16
+    /// (rounding to nearest, centres through I8F24 keys to I16F16).
+    pub input_rounding: f64,
+}
+
+/// What the fixed-point caster's stopping rule sees at one point of a ray.
+#[derive(Clone, Copy, Debug)]
+pub struct MarchPoint {
+    /// `g = Σ q f − T` there.
+    pub g: f64,
+    /// `|∇g|` there.
+    pub gradient: f64,
+    /// The caster's Lipschitz bound there: the sum of `|q|·FIELD_LIPSCHITZ/R·|d|` or, where
+    /// smaller, the ray's own `|q|·FIELD_LIPSCHITZ·(1 − s_min)·A·(half + 2^-16)` over the balls whose
+    /// influence interval along the ray may hold `t` in the caster: the sphere grown by what
+    /// input rounding can add, the interval widened at each end by the caster's 2^-16 and the
+    /// given uncertainty of `t`.
+    pub lipschitz: f64,
+    /// How far `g` may move per unit of input rounding ([`Reference::input_rounding`]): 1 for
+    /// `T`, and per ball `f + |q|·|df/dr|·(√3 + 1)` (its density, then its centre and radius).
+    pub rounding_gain: f64,
 }
 
 /// The nearest surface point along a ray.
@@ -54,11 +76,6 @@ pub struct MetaHit {
     pub ball: usize,
     /// Shaded colour.
     pub color: [u8; 3],
-    /// `|dg/dt|` at the hit.
-    pub slope: f64,
-    /// The Lipschitz bound the fixed-point caster uses there: `Σ |q|·L/R·|d|` over the balls
-    /// whose influence contains the hit.
-    pub lipschitz: f64,
 }
 
 /// The field `f(s)`, `s = r²/R²`, 0 for `s ≥ 1`.
@@ -198,6 +215,11 @@ impl Reference {
                 })
                 .collect(),
             threshold: scene.threshold,
+            input_rounding: if scene.on_fixed_grid() {
+                0.0
+            } else {
+                2f64.powi(-16)
+            },
             light: Light {
                 direction,
                 ambient,
@@ -217,6 +239,60 @@ impl Reference {
             })
             .sum::<f64>()
             - self.threshold
+    }
+
+    /// The caster's view of ray parameter `t` along direction `d`, known to within
+    /// `uncertainty` (see [`MarchPoint`]).
+    pub fn march_point(&self, d: V3, t: f64, uncertainty: f64) -> MarchPoint {
+        let pad = 1.0 / 65536.0 + uncertainty;
+        // The caster's ball may be this much larger once rounded (radius, and centre by √3).
+        let grow = self.input_rounding * (1.0 + 3f64.sqrt());
+        let dd = dot(d, d);
+        let length = dd.sqrt();
+        let p = at(self.camera.eye, d, t);
+        let mut gradient = [0.0; 3];
+        let mut point = MarchPoint {
+            g: self.g(p),
+            gradient: 0.0,
+            lipschitz: 0.0,
+            rounding_gain: 1.0,
+        };
+        for b in &self.balls {
+            let w = sub(b.centre, self.camera.eye);
+            let c = crate::reference::cross(w, d);
+            let distance2 = dot(c, c) / dd;
+            let grown = b.radius + grow;
+            let reach = grown * grown - distance2;
+            let half = (reach / dd).sqrt();
+            let closest = dot(w, d) / dd;
+            if reach <= 0.0 || t < closest - half - pad || t >= closest + half + pad {
+                continue;
+            }
+            // The caster's bound along the ray, |q|·FIELD_LIPSCHITZ·(1 − s_min)·A·(half +
+            // 2^-16), for the radius as given and as rounding may move it.
+            let along = [b.radius - grow, b.radius, grown]
+                .iter()
+                .map(|&r| {
+                    let rest = (1.0 - distance2 / (r * r)).max(0.0);
+                    let a = dd / (r * r);
+                    let lipschitz = b.density.abs() * scanline3d::metaball::FIELD_LIPSCHITZ;
+                    lipschitz * rest * a * ((rest / a).sqrt() + 1.0 / 65536.0)
+                })
+                .fold(0.0, f64::max);
+            let everywhere = b.density.abs() * scanline3d::metaball::FIELD_LIPSCHITZ / b.radius;
+            point.lipschitz += (everywhere * length).min(along);
+            let r = sub(p, b.centre);
+            let r2 = b.radius * b.radius;
+            let s = dot(r, r) / r2;
+            // ∇(q·f(s)) = q·f'(s)·2r/R²; |df/dr| = |f'(s)|·2|r|/R².
+            let k = b.density * field_slope(s) * 2.0 / r2;
+            for (g, ri) in gradient.iter_mut().zip(r) {
+                *g += k * ri;
+            }
+            point.rounding_gain += field(s) + k.abs() * dot(r, r).sqrt() * (3f64.sqrt() + 1.0);
+        }
+        point.gradient = dot(gradient, gradient).sqrt();
+        point
     }
 
     fn ray_balls(&self, d: V3) -> Vec<RayBall> {
@@ -302,8 +378,6 @@ impl Reference {
         let mut gradient = [0.0; 3];
         let (mut best, mut ball) = (f64::NEG_INFINITY, 0);
         let (mut weight, mut rgb) = (0.0, [0.0; 3]);
-        let mut lipschitz = 0.0;
-        let length = dot(d, d).sqrt();
         for (i, b) in self.balls.iter().enumerate() {
             let r = sub(p, b.centre);
             let r2 = b.radius * b.radius;
@@ -311,8 +385,6 @@ impl Reference {
             if s >= 1.0 {
                 continue;
             }
-            lipschitz +=
-                b.density.abs() * scanline3d::metaball::FIELD_LIPSCHITZ / b.radius * length;
             let contribution = b.density * field(s);
             if contribution > best {
                 (best, ball) = (contribution, i);
@@ -328,7 +400,6 @@ impl Reference {
                 *g += k * ri;
             }
         }
-        let slope = dot(gradient, d).abs();
         let mut intensity = self.light.ambient;
         if let Some(n) = normalize(gradient) {
             // Outward normal −∇g; from inside the surface +∇g faces the eye.
@@ -345,8 +416,6 @@ impl Reference {
             t,
             ball,
             color: base.map(|c| (c * intensity).round().clamp(0.0, 255.0) as u8),
-            slope,
-            lipschitz,
         }
     }
 
