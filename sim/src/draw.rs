@@ -3,6 +3,8 @@
 
 #[cfg(feature = "tools")]
 use crate::metaball::{BallSpec, MetaScene};
+#[cfg(feature = "tools")]
+use crate::patch::{Patch, PatchModel, TrimLoop};
 use crate::scene::CameraSpec;
 #[cfg(feature = "tools")]
 use crate::trace::{fixed::FixedScene, scene::TracedScene};
@@ -223,5 +225,71 @@ impl MetaDraw {
             }
         }
         (scene, camera)
+    }
+}
+
+/// Random single bicubic patches for the fixed patch renderer against the Bezier-clipping
+/// reference (`sim/examples/patch_random.rs`): a 4×4 net over a square, its points jittered
+/// in the plane by up to 0.6 of the spacing and lifted by up to 2, at scale 1, 0.05 or 20
+/// (`case % 3`); rational with weights 0.2–5 when `(case / 3) % 3 == 1`, with a trim hole
+/// (a regular polygon of 3 to 8 sides) when `(case / 3) % 4 == 2`; random cameras; tolerance
+/// 0.5, 1 or 2 px (`(case / 2) % 3`).
+#[cfg(feature = "tools")]
+pub struct PatchDraw;
+
+#[cfg(feature = "tools")]
+impl PatchDraw {
+    /// The generator whose draws are the cases of `sim/examples/patch_random.rs`.
+    pub fn draws() -> Draw {
+        Draw::new(0x0005_eed0_f9a7_c4e5)
+    }
+
+    /// Case `case`: the model, a camera and the tolerance in pixels.
+    pub fn case(d: &mut Draw, case: usize) -> (PatchModel, CameraSpec, f64) {
+        let scale = [1.0, 0.05, 20.0][case % 3];
+        let (bump, jitter) = (d.in_range(0.0, 2.0), d.in_range(0.0, 0.6));
+        let mut points = [[0.0; 3]; 16];
+        for (k, p) in points.iter_mut().enumerate() {
+            let (i, j) = ((k / 4) as f64, (k % 4) as f64);
+            *p = [
+                (i / 1.5 - 1.0 + d.in_range(-jitter, jitter)) * scale,
+                (j / 1.5 - 1.0 + d.in_range(-jitter, jitter)) * scale,
+                d.in_range(-bump, bump) * scale,
+            ];
+        }
+        let rational = (case / 3) % 3 == 1;
+        let weights = [0; 16].map(|_| if rational { d.in_range(0.2, 5.0) } else { 1.0 });
+        let mut trims = vec![];
+        if (case / 3) % 4 == 2 {
+            let (cu, cv, r) = (
+                d.in_range(0.3, 0.7),
+                d.in_range(0.3, 0.7),
+                d.in_range(0.1, 0.25),
+            );
+            let n = 3 + d.in_range(0.0, 6.0) as usize;
+            let points = (0..n)
+                .map(|k| {
+                    let a = k as f64 * std::f64::consts::TAU / n as f64;
+                    [cu + r * a.cos(), cv + r * a.sin()]
+                })
+                .collect();
+            trims.push(TrimLoop { points });
+        }
+        let model = PatchModel {
+            patches: vec![Patch {
+                points,
+                weights,
+                trims,
+            }],
+        };
+        let camera = CameraSpec {
+            eye: d.point(4.0 * scale),
+            target: d.point(0.5 * scale),
+            up: [0.0, 1.0, 0.0],
+            fovy: d.in_range(20.0, 100.0),
+            near: d.in_range(0.01, 0.5) * scale,
+            far: 100.0 * scale,
+        };
+        (model, camera, [0.5, 1.0, 2.0][(case / 2) % 3])
     }
 }
