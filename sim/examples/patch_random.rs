@@ -8,14 +8,15 @@
 //!
 //! A pixel covered by one renderer and not the other should lie within the tolerance plus
 //! 1/16 px (the snapped vertices) of a place where the reference's coverage changes (the rule
-//! of `patch_compare::trimmed_holes_appear_where_the_trim_says`). Prints the cases where one
+//! of `patch_compare::trimmed_holes_appear_where_the_trim_says`; a distance over that is
+//! searched again finely, for slivers of surface the coarse search steps over). Prints the cases where one
 //! does not, or the renderer reports a capped patch, with the largest distance (the search
 //! reaches 4 px: 4.000 means "4 px or more"); with a CASE, its model, camera and every
 //! mismatched pixel.
 
 use scanline3d_sim::draw::PatchDraw;
 use scanline3d_sim::patch::fixed::{render_fixed, PatchShading};
-use scanline3d_sim::patch::render::{distance_to_change, Reference};
+use scanline3d_sim::patch::render::{distance_to_change, distance_to_change_finely, Reference};
 use scanline3d_sim::scene::LightSpec;
 
 const SIDE: usize = 48;
@@ -65,7 +66,11 @@ fn main() {
             if (fixed.image.ids[i] >= 0) != (want.ids[i] >= 0) {
                 mismatches += 1;
                 let centre = (x as f64 + 0.5, y as f64 + 0.5);
-                let distance = distance_to_change(&covered, centre, 4.0);
+                let mut distance = distance_to_change(&covered, centre, 4.0);
+                if distance > tolerance + 1.0 / 16.0 {
+                    // Look again for a sliver the coarse search stepped over.
+                    distance = distance_to_change_finely(&covered, centre, 4.0);
+                }
                 far = far.max(distance);
                 if only.is_some() {
                     println!(

@@ -217,16 +217,36 @@ impl Reference {
 /// function of the reference's hit at a screen point) changes, searched in 16 directions out
 /// to `reach` pixels in steps of 1/4 px and refined by bisection to 1/1000 px; `reach` if none
 /// is found. An upper bound up to the angular resolution (about 2 %), and a change thinner
-/// than a step can be stepped over, which also errs long.
-pub fn distance_to_change(class: &dyn Fn(f64, f64) -> i64, (x, y): (f64, f64), reach: f64) -> f64 {
+/// than a step can be stepped over, which also errs long ([`distance_to_change_finely`]).
+pub fn distance_to_change(class: &dyn Fn(f64, f64) -> i64, centre: (f64, f64), reach: f64) -> f64 {
+    search_change(class, centre, reach, 16, 0.25)
+}
+
+/// [`distance_to_change`] in 64 directions and steps of 1/32 px: finds slivers of surface
+/// (a fold seen edge on) down to about 1/32 px wide, at 16 to 32 times the cost.
+pub fn distance_to_change_finely(
+    class: &dyn Fn(f64, f64) -> i64,
+    centre: (f64, f64),
+    reach: f64,
+) -> f64 {
+    search_change(class, centre, reach, 64, 1.0 / 32.0)
+}
+
+fn search_change(
+    class: &dyn Fn(f64, f64) -> i64,
+    (x, y): (f64, f64),
+    reach: f64,
+    directions: u32,
+    step_length: f64,
+) -> f64 {
     let here = class(x, y);
     let mut best = reach;
-    for k in 0..16 {
-        let a = k as f64 * std::f64::consts::TAU / 16.0;
+    for k in 0..directions {
+        let a = f64::from(k) * std::f64::consts::TAU / f64::from(directions);
         let (dx, dy) = (a.cos(), a.sin());
         // March outwards to the first change, then bisect.
         let mut inside = 0.0;
-        let mut step = 0.25;
+        let mut step = step_length;
         while step <= best {
             if class(x + dx * step, y + dy * step) != here {
                 let mut outside = step;
@@ -242,7 +262,7 @@ pub fn distance_to_change(class: &dyn Fn(f64, f64) -> i64, (x, y): (f64, f64), r
                 break;
             }
             inside = step;
-            step += 0.25;
+            step += step_length;
         }
     }
     best
