@@ -4,6 +4,7 @@
 //! [`render`]); the trade of tolerance against cost and against meshes ([`trade`]). `docs/patches.md` describes the format and the algorithm.
 
 pub mod clip;
+pub mod compare;
 pub mod fixed;
 pub mod model;
 pub mod parse;

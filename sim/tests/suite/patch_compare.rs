@@ -266,3 +266,34 @@ fn trimmed_holes_appear_where_the_trim_says() {
     }
     println!("farthest of all: {worst:.3} px");
 }
+
+/// Random single polynomial patches (the first cases of `sim/examples/patch_random.rs`, which
+/// also draws rational ones, and more): a pixel covered by one renderer and not the other lies
+/// within the tolerance plus 1/16 px of a change of the reference's coverage, unless the
+/// renderer reports a capped patch.
+#[test]
+fn random_polynomial_patches_follow_the_tolerance() {
+    use scanline3d_sim::draw::PatchDraw;
+    use scanline3d_sim::patch::compare::coverage;
+    let mut d = PatchDraw::draws();
+    let mut frames = 0;
+    for case in 0..240 {
+        let (model, camera, tolerance) = PatchDraw::case(&mut d, case);
+        if model
+            .patches
+            .iter()
+            .any(|p| p.weights.iter().any(|&w| w != 1.0))
+        {
+            continue;
+        }
+        let Some(c) = coverage(&model, &camera, tolerance, 48) else {
+            continue;
+        };
+        if !c.capped {
+            let far = c.farthest();
+            assert!(far <= tolerance + 1.0 / 16.0, "case {case}: {far} px");
+            frames += 1;
+        }
+    }
+    assert!(frames > 100, "{frames} frames");
+}
