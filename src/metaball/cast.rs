@@ -6,8 +6,9 @@
 //! minus `T` and `L` the sum over the balls active at `t` of their slope bounds along the ray,
 //! `|q|·FIELD_LIPSCHITZ·|d|/R·(1 − s_min)^{3/2}` (a ray through the edge of a ball's influence
 //! sees only a little of its slope); steps stop at the next ball's entry, so `L` bounds `|g'|`
-//! over every step and a step never passes a root. The hit is where the step falls below [`EPSILON_T`]; a ray still marching after
-//! [`MAX_STEPS`] (a near-tangent graze) is counted as a miss and reported in [`CastStats::capped`].
+//! over every step and a step never passes a root. The hit is where the step falls below
+//! [`EPSILON_T`]; a ray still marching after [`MAX_STEPS`] (a near-tangent graze) is counted as
+//! a miss and reported in [`CastStats::capped`].
 
 use super::{
     field, field_slope, mul, wide_from_f32, Ball, Blend, MetaballError, Metaballs, Wide,

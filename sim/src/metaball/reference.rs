@@ -57,10 +57,10 @@ pub struct MarchPoint {
     /// `|∇g|` there.
     pub gradient: f64,
     /// The caster's Lipschitz bound there: the sum of `|q|·FIELD_LIPSCHITZ/R·|d|` or, where
-    /// smaller, the ray's own `|q|·FIELD_LIPSCHITZ·(1 − s_min)·A·(half + 2^-16)` over the balls whose
-    /// influence interval along the ray may hold `t` in the caster: the sphere grown by what
-    /// input rounding can add, the interval widened at each end by the caster's 2^-16 and the
-    /// given uncertainty of `t`.
+    /// smaller, the ray's own `|q|·FIELD_LIPSCHITZ·(1 − s_min)·A·(half + 2^-16)`, over the
+    /// balls whose influence interval along the ray may hold `t` in the caster: the sphere
+    /// grown by what input rounding can add, the interval widened at each end by the caster's
+    /// 2^-16 and the given uncertainty of `t`.
     pub lipschitz: f64,
     /// How far `g` may move per unit of input rounding ([`Reference::input_rounding`]): 1 for
     /// `T`, and per ball `f + |q|·|df/dr|·(√3 + 1)` (its density, then its centre and radius).
