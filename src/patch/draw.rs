@@ -16,7 +16,7 @@ use crate::arithmetic::Arithmetic;
 use crate::cache::CachedVertex;
 use crate::clip::{ClipVertex, Clipped, Clipping};
 use crate::depth::Depth;
-use crate::math::{floor_div_i64, mul_i64, mul_i64_i32, mul_wide};
+use crate::math::{floor_div_i64, mul_i64};
 use crate::options::RenderOptions;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{color_channels, first_row, signed_area, xy, TriangleWalk};
@@ -726,15 +726,10 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
         row: usize,
         f: &mut impl FnMut(&[ScreenVertex<SUB>; 3], Rgb888, u32, u32),
     ) {
-        let back = shows_back(t);
-        let face = if back { face.back } else { face.front };
-        let color = |v: &Vertex| if back { v.color.back } else { v.color.front };
         // Borrowed field by field, not copied: this runs once per triangle.
         let (vp, cull, stats) = (&self.vp, self.cull, &mut self.stats);
         stats.frame.triangles_in += 1;
-        let project = |c: &ClipVertex| vp.project_as::<A::Projection>(&c.p, c.color, true);
-        let mut emit = |s: [ScreenVertex<SUB>; 3], stats: &mut PatchStats| {
-            let area = signed_area(&s);
+        let mut emit = |s: [ScreenVertex<SUB>; 3], area: i64, face, stats: &mut PatchStats| {
             // Front faces have negative area in y-down screen coordinates.
             if area == 0 {
                 return;
@@ -756,30 +751,57 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
             stats.frame.bucketed += 1;
             f(&s, face, patch as u32, 0);
         };
+        // The side shown is the one the snapped triangle turns to the camera, as the
+        // rasterizer and culling see it: at a silhouette the triangles are edge-on, and a side
+        // found in eye space can disagree there (test
+        // `fixed_renderer_against_the_reference_at_half_a_pixel`, the sphere's rim).
+        let shown = |mut s: [ScreenVertex<SUB>; 3]| {
+            let area = signed_area(&s);
+            if area <= 0 {
+                return (s, area, face.front);
+            }
+            for (s, v) in s.iter_mut().zip(t) {
+                s.color = v.color.back;
+            }
+            (s, area, face.back)
+        };
         // Inside every clip plane: the screen positions projected once per vertex, as the
         // clipper's path below would project them.
-        if let [Some(a), Some(b), Some(c)] = t.map(|v| v.screen.screen::<SUB>(color(v))) {
-            emit([a, b, c], stats);
+        if let [Some(a), Some(b), Some(c)] = t.map(|v| v.screen.screen::<SUB>(v.color.front)) {
+            let (s, area, face) = shown([a, b, c]);
+            emit(s, area, face, stats);
             return;
         }
-        let cv = t.map(|v| ClipVertex {
-            p: v.p,
-            color: color(v),
-        });
-        match C::clip(vp, &cv, &mut self.polygon) {
+        let project = |c: &ClipVertex| vp.project_as::<A::Projection>(&c.p, c.color, true);
+        let clip_vertices = |back: bool| {
+            t.map(|v| ClipVertex {
+                p: v.p,
+                color: if back { v.color.back } else { v.color.front },
+            })
+        };
+        match C::clip(vp, &clip_vertices(false), &mut self.polygon) {
             Clipped::Outside => stats.frame.rejected += 1,
             Clipped::Skipped => stats.frame.unclipped += 1,
             Clipped::Inside => {
-                if let [Some(a), Some(b), Some(c)] = cv.each_ref().map(project) {
-                    emit([a, b, c], stats);
+                if let [Some(a), Some(b), Some(c)] = clip_vertices(false).each_ref().map(project) {
+                    let (s, area, face) = shown([a, b, c]);
+                    emit(s, area, face, stats);
                 }
             }
             Clipped::Polygon => {
                 stats.frame.clipped += 1;
+                // A planar polygon in front of the eye: its fan turns one way, the first
+                // triangle with area says which (the clipper interpolates the colours, so the
+                // back's are clipped again).
+                let back = fan_turns_back(self.polygon.as_ref(), project);
+                if back && !cull {
+                    C::clip(vp, &clip_vertices(true), &mut self.polygon);
+                }
+                let face = if back { face.back } else { face.front };
                 let mut fan = self.polygon.as_ref().iter().filter_map(project);
                 if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
                     for c in fan {
-                        emit([a, b, c], stats);
+                        emit([a, b, c], signed_area(&[a, b, c]), face, stats);
                         b = c;
                     }
                 }
@@ -922,70 +944,22 @@ struct Vertex {
     color: Sides<[I16F16; 3]>,
 }
 
-/// Whether the camera (at the eye-space origin) sees the back of triangle `t`: its normal
-/// `(b − a) × (c − a)` (in `(x, y, −w)`, counter-clockwise = front) points away from the eye.
-/// Coordinates are cut to 24 bits first (`>> 8` of I16F16 bits), so edges fit 25 bits, the
-/// cross product 50 bits and its dot product with a point 75 bits: [`dot_is_positive`] takes
-/// its sign exactly in 64-bit arithmetic.
-fn shows_back(t: [&Vertex; 3]) -> bool {
-    let v = t.map(|v| [v.p.x, v.p.y, v.p.w].map(|c| c.to_bits() >> 8));
-    let v = v.map(|p| [p[0], p[1], -p[2]]);
-    let d = |a: [i32; 3], b: [i32; 3]| [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let (e1, e2) = (d(v[0], v[1]), d(v[0], v[2]));
-    let n = [
-        mul_wide(e1[1], e2[2]) - mul_wide(e1[2], e2[1]),
-        mul_wide(e1[2], e2[0]) - mul_wide(e1[0], e2[2]),
-        mul_wide(e1[0], e2[1]) - mul_wide(e1[1], e2[0]),
-    ];
-    dot_is_positive(n, v[0])
-}
-
-/// Whether `n · p > 0` for `|n_k| < 2^54` and `|p_k| < 2^31`, exactly, without 128-bit
-/// products (a library call on 32-bit cores): with `n_k = h_k·2^24 + l_k`, `l_k` in
-/// [0, 2^24), the dot product is `H·2^24 + L` (`H = Σ h_k·p_k`, `L = Σ l_k·p_k`, both far
-/// inside `i64`), and with `L = q·2^24 + r`, `r` in [0, 2^24), it is `s·2^24 + r` for
-/// `s = H + q`: positive exactly when `s > 0`, or `s = 0` and `r > 0`. Test
-/// `dot_sign_is_the_wide_sign`.
-fn dot_is_positive(n: [i64; 3], p: [i32; 3]) -> bool {
-    let (mut high, mut low) = (0i64, 0i64);
-    for (n, p) in n.iter().zip(p) {
-        high += mul_wide((n >> 24) as i32, p);
-        low += mul_i64_i32(n & 0xFF_FFFF, p);
-    }
-    let s = high + (low >> 24);
-    s > 0 || (s == 0 && low & 0xFF_FFFF > 0)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn dot_sign_is_the_wide_sign() {
-        let mut rng = crate::test_rng::XorShift64::new(0x51ce_5eed_0bad_cafe);
-        let wide = |n: [i64; 3], p: [i32; 3]| {
-            (0..3).map(|k| n[k] as i128 * p[k] as i128).sum::<i128>() > 0
-        };
-        let check = |n: [i64; 3], p: [i32; 3]| {
-            assert_eq!(dot_is_positive(n, p), wide(n, p), "{n:?} {p:?}");
-        };
-        // Exact zeros, and sums one unit either side of zero through the low part.
-        check([0; 3], [5, -7, 9]);
-        check([1 << 24, -(1 << 24), 0], [3, 3, 1]);
-        check([(1 << 24) + 1, -(1 << 24), 0], [3, 3, 1]);
-        check([(1 << 24) - 1, -(1 << 24), 0], [3, 3, 1]);
-        check([-1, 1, 0], [1, 1, 0]);
-        check([(1 << 54) - 1; 3], [i32::MAX, i32::MIN, 1]);
-        check([-(1 << 54) + 1; 3], [i32::MAX, i32::MIN, i32::MAX]);
-        for case in 0..200_000u32 {
-            let bits = 1 + case % 54;
-            let mut n = || (rng.next_u64() as i64) >> (64 - bits);
-            let n = [n(), n(), n()];
-            let mut p = || (rng.next_u64() >> 32) as i32 >> (case % 31);
-            let p = [p(), p(), p()];
-            check(n, p);
-            // A near-cancelling pair: the same terms with one sign flipped.
-            check([n[0], -n[0], n[2] & 0xFF], [p[0], p[0], p[2]]);
+/// Whether the first triangle with area of the fan of `polygon`, projected by `project`,
+/// turns its back to the camera (positive area in y-down screen coordinates).
+fn fan_turns_back<const SUB: u32>(
+    polygon: &[ClipVertex],
+    project: impl Fn(&ClipVertex) -> Option<ScreenVertex<SUB>>,
+) -> bool {
+    let mut fan = polygon.iter().filter_map(project);
+    let (Some(a), Some(mut b)) = (fan.next(), fan.next()) else {
+        return false;
+    };
+    for c in fan {
+        let area = signed_area(&[a, b, c]);
+        if area != 0 {
+            return area > 0;
         }
+        b = c;
     }
+    false
 }

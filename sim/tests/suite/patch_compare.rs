@@ -142,17 +142,19 @@ fn reference_and_fixed_renderer_share_the_base_colour() {
 #[test]
 fn fixed_renderer_against_the_reference_at_half_a_pixel() {
     // Least colour PSNR (dB) where ids agree, Gouraud and flat: the measured figures (sphere
-    // 38.5 and 37.6 dB, teapot 42.9 and 42.0 dB) rounded down to whole dB, less 1 dB.
+    // 51.7 and 44.1 dB, teapot 47.6 and 45.3 dB) rounded down to whole dB, less 1 dB. The
+    // sphere's rim, where edge-on triangles must show the side they turn to the camera,
+    // fails this (38.5 dB) when the side comes from a coarser test than the rasterizer's.
     let cases = [
         (
             "sphere.bpt",
             camera([2.0, 1.5, 2.5], [0.0; 3], [0.0, 1.0, 0.0]),
-            (37.0, 36.0),
+            (50.0, 43.0),
         ),
         (
             "teapot.bpt",
             camera([4.0, -7.0, 3.0], [0.2, 0.0, 1.3], [0.0, 0.0, 1.0]),
-            (41.0, 41.0),
+            (46.0, 44.0),
         ),
     ];
     for (name, cam, (gouraud_min, flat_min)) in cases {
