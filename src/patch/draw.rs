@@ -420,7 +420,10 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
 
     /// The projected control points of `net`.
     fn screen_net(&self, net: &Net) -> ScreenNet {
-        net.h.map(|h| self.screen(&self.eye(h)))
+        ScreenNet {
+            points: net.h.map(|h| self.screen(&self.eye(h))),
+            weights: net.h.map(|h| h[3]),
+        }
     }
 
     /// Where the control hull of `net` lies (the surface is inside it: positive weights).

@@ -16,12 +16,13 @@
 //! bilinear interpolation of a cell errs by at most `⅛·(h_u²·|S_uu| + h_v²·|S_vv|)` and
 //! cutting the cell along a diagonal adds `¼·h_u·h_v·|S_uv|`; with `|S_uu| ≤ 6·max|Δ_uu P|`
 //! and `|S_uv| ≤ 9·max|Δ_uv P|` the three terms are `¾·max|Δ_uu P|/n_u²`, the same in `v`,
-//! and `9/4·max|Δ_uv P|/(n_u·n_v)`, each given a third of the tolerance. The bound holds for
-//! polynomial patches under an affine map;
-//! it is applied to the projected control points, so under perspective and for rational
-//! patches it is an estimate (the measured error against the exact reference is in the
-//! repository's `docs/patches.md`). Lengths are in sub-pixels, bounded above by
-//! `max + min/2` of `|dx|, |dy|`.
+//! and `9/4·max|Δ_uv P|/(n_u·n_v)`, each given a third of the tolerance. For rational patches
+//! the same bounds hold for the homogeneous form of [`Homogeneous`], which adds a term for
+//! the weights' own second differences. The bounds hold under an affine map; they are
+//! applied to the projected control points, so under perspective they are an estimate (the
+//! measured error against the exact reference is in the repository's
+//! `docs/patch-scanline.md`). Lengths are in sub-pixels, bounded above by `max + min/2` of
+//! `|dx|, |dy|`.
 
 use super::{MAX_LEVEL, PARAM_ONE};
 use crate::math::mul_i64;
@@ -29,8 +30,110 @@ use crate::math::mul_i64;
 /// A parameter pair `(u, v)`, I16F16 bits.
 pub(crate) type Uv = [u32; 2];
 
-/// Projected control points in sub-pixels, `None` for points not in front of the near plane.
-pub(crate) type ScreenNet = [Option<[i64; 2]>; 16];
+/// A patch's control points projected to the screen, with their weights.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct ScreenNet {
+    /// Positions in sub-pixels, `None` for points not in front of the near plane.
+    pub(crate) points: [Option<[i64; 2]>; 16],
+    /// Weights, I16F16 bits (positive).
+    pub(crate) weights: [i64; 16],
+}
+
+/// What [`levels`] measures second differences of for the control points `indices` of a
+/// net: the points themselves if their weights are equal (a polynomial curve or patch),
+/// else the homogeneous form below.
+///
+/// For weights `ω_i`, the curve (or patch) is `P = Y/W + r` with `Y` the polynomial of
+/// control points `ω_i·(p_i − r)` and `W` that of the weights. A chord (a flat triangle) is
+/// the dehomogenised linear interpolant `L_Y/L_W + r` of the same vertices, so
+/// `P − chord = ((Y − L_Y) − (L_Y/L_W)·(W − L_W))/W`: with `W ≥ ω_min` and `|L_Y/L_W| ≤ D`,
+/// the largest distance of a control point from `r` (the chord is inside the control hull),
+/// the distance is at most `(|Y − L_Y| + D·|W − L_W|)/ω_min`, and each part follows the
+/// polynomial bounds of the module docs. So the second difference that stands for `Δ²p` is
+/// `|Δ²(ω·(p − r))|/ω_min + D·|Δ²ω|/ω_min`, the largest of each over the triples added.
+/// `r` is the centre of the points' bounding box (smallest `D` of the box's points, about).
+/// Test `rational_levels_bound_the_chord_distance`.
+struct Homogeneous {
+    /// `ω_i·(p_i − r)` in sub-pixel × I16F16 bits, or `p_i` when the weights are equal.
+    points: [[i64; 2]; 16],
+    /// The weights, I16F16 bits (0 when equal: no weight term).
+    weights: [i64; 16],
+    /// `ω_min` (1 when the weights are equal).
+    divisor: i64,
+    /// `D`, sub-pixels (rounded up).
+    reach: i64,
+}
+
+impl Homogeneous {
+    /// The control points `indices` of `s`; `None` if one is not projected.
+    fn new(s: &ScreenNet, indices: impl Iterator<Item = usize> + Clone) -> Option<Self> {
+        let mut h = Homogeneous {
+            points: [[0; 2]; 16],
+            weights: [0; 16],
+            divisor: 1,
+            reach: 0,
+        };
+        let (mut lo, mut hi) = ([i64::MAX; 2], [i64::MIN; 2]);
+        let (mut w_min, mut w_max) = (i64::MAX, i64::MIN);
+        for k in indices.clone() {
+            let p = s.points.get(k).copied().flatten()?;
+            let w = s.weights.get(k).copied().unwrap_or(0);
+            for c in 0..2 {
+                lo[c] = lo[c].min(p[c]);
+                hi[c] = hi[c].max(p[c]);
+            }
+            (w_min, w_max) = (w_min.min(w), w_max.max(w));
+            if let Some(out) = h.points.get_mut(k) {
+                *out = p;
+            }
+        }
+        if w_min >= w_max || w_min <= 0 {
+            return Some(h);
+        }
+        let r = [0, 1].map(|c| lo[c] + (hi[c] - lo[c]) / 2);
+        for k in indices {
+            let (Some(p), Some(&w)) = (h.points.get_mut(k), s.weights.get(k)) else {
+                continue;
+            };
+            let d = [p[0] - r[0], p[1] - r[1]];
+            h.reach = h.reach.max(length(d));
+            *p = d.map(|d| d.saturating_mul(w));
+            if let Some(out) = h.weights.get_mut(k) {
+                *out = w;
+            }
+        }
+        h.divisor = w_min;
+        Some(h)
+    }
+
+    /// The bound standing for `|Δ²p|` over the triples `(a, b, c)` (`b` doubled) or, with
+    /// `d`, the twists `a − b − c + d`: see [`Homogeneous`].
+    fn largest(&self, triples: impl Iterator<Item = [usize; 4]>) -> i64 {
+        let (mut points, mut weights) = (0i64, 0i64);
+        for [a, b, c, d] in triples {
+            let at = |k: usize| self.points.get(k).copied().unwrap_or([0; 2]);
+            let w = |k: usize| self.weights.get(k).copied().unwrap_or(0);
+            let (pa, pb, pc) = (at(a), at(b), at(c));
+            let (delta, dw) = match d {
+                usize::MAX => (
+                    [0, 1].map(|k| pa[k] - 2 * pb[k] + pc[k]),
+                    w(a) - 2 * w(b) + w(c),
+                ),
+                d => {
+                    let pd = at(d);
+                    (
+                        [0, 1].map(|k| pd[k] - pb[k] - pc[k] + pa[k]),
+                        w(d) - w(b) - w(c) + w(a),
+                    )
+                }
+            };
+            points = points.max(length(delta));
+            weights = weights.max(dw.abs());
+        }
+        let up = |n: i64| n.saturating_add(self.divisor - 1) / self.divisor;
+        up(points).saturating_add(up(weights.saturating_mul(self.reach)))
+    }
+}
 
 /// Subdivision levels (log2 of segment counts) of one patch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,14 +162,6 @@ fn length(d: [i64; 2]) -> i64 {
     x.max(y).saturating_add(x.min(y) / 2 + 1)
 }
 
-/// `|a − 2b + c|` (bounded above by [`length`]); `None` if a point is not projected. Out of
-/// line: [`levels`] (once per patch) takes 33 of these in loops the compiler unrolls.
-#[inline(never)]
-fn second_difference(a: Option<[i64; 2]>, b: Option<[i64; 2]>, c: Option<[i64; 2]>) -> Option<i64> {
-    let (a, b, c) = (a?, b?, c?);
-    Some(length([0, 1].map(|k| a[k] - 2 * b[k] + c[k])))
-}
-
 /// The smallest level `k` with `scale·m ≤ 4·tol·4^k`, and whether it had to stop at
 /// [`MAX_LEVEL`] (or `m` is unknown).
 fn level(m: Option<i64>, scale: i64, tol: i64) -> (u8, bool) {
@@ -82,50 +177,51 @@ fn level(m: Option<i64>, scale: i64, tol: i64) -> (u8, bool) {
     (MAX_LEVEL as u8, true)
 }
 
-/// The largest of some second differences (`None` if any is unknown).
-fn largest(mut values: impl Iterator<Item = Option<i64>>) -> Option<i64> {
-    values.try_fold(0i64, |m, v| Some(m.max(v?)))
-}
-
 /// Levels for a patch with projected control points `s`, tolerance `tol` sub-pixels (≥ 1).
 pub(crate) fn levels(s: &ScreenNet, tol: i64) -> Levels {
-    let at = |k: usize| s.get(k).copied().flatten();
+    // The triples `(a, b, c)` of second differences; no fourth point.
+    const NONE: usize = usize::MAX;
     let mut capped = false;
     let edges = EDGES.map(|e| {
-        let m = largest(
-            [(0, 1, 2), (1, 2, 3)]
-                .into_iter()
-                .map(|(a, b, c)| second_difference(at(e[a]), at(e[b]), at(e[c]))),
-        );
+        let m = Homogeneous::new(s, e.into_iter()).map(|h| {
+            h.largest([(0, 1, 2), (1, 2, 3)].into_iter().map(|(a, b, c)| {
+                let at = |k: usize| e.get(k).copied().unwrap_or(0);
+                [at(a), at(b), at(c), NONE]
+            }))
+        });
         let (k, c) = level(m, 3, tol);
         capped |= c;
         k
     });
-    let along_u = largest(
-        (0..4)
-            .flat_map(|j| (0..2).map(move |i| (i, j)))
-            .map(|(i, j)| {
-                second_difference(at(4 * i + j), at(4 * (i + 1) + j), at(4 * (i + 2) + j))
-            }),
-    );
-    let along_v = largest(
-        (0..4)
-            .flat_map(|i| (0..2).map(move |j| (i, j)))
-            .map(|(i, j)| second_difference(at(4 * i + j), at(4 * i + j + 1), at(4 * i + j + 2))),
-    );
-    let twist = largest(
-        (0..3)
-            .flat_map(|i| (0..3).map(move |j| (i, j)))
-            .map(|(i, j)| {
-                let (a, b, c, d) = (
-                    at(4 * i + j)?,
-                    at(4 * i + j + 1)?,
-                    at(4 * (i + 1) + j)?,
-                    at(4 * (i + 1) + j + 1)?,
-                );
-                Some(length([0, 1].map(|k| d[k] - b[k] - c[k] + a[k])))
-            }),
-    );
+    let whole = Homogeneous::new(s, 0..16);
+    let along_u = whole.as_ref().map(|h| {
+        h.largest(
+            (0..4)
+                .flat_map(|j| (0..2).map(move |i| (i, j)))
+                .map(|(i, j)| [4 * i + j, 4 * (i + 1) + j, 4 * (i + 2) + j, NONE]),
+        )
+    });
+    let along_v = whole.as_ref().map(|h| {
+        h.largest(
+            (0..4)
+                .flat_map(|i| (0..2).map(move |j| (i, j)))
+                .map(|(i, j)| [4 * i + j, 4 * i + j + 1, 4 * i + j + 2, NONE]),
+        )
+    });
+    let twist = whole.as_ref().map(|h| {
+        h.largest(
+            (0..3)
+                .flat_map(|i| (0..3).map(move |j| (i, j)))
+                .map(|(i, j)| {
+                    [
+                        4 * i + j,
+                        4 * i + j + 1,
+                        4 * (i + 1) + j,
+                        4 * (i + 1) + j + 1,
+                    ]
+                }),
+        )
+    });
     // Each of the three interior terms gets a third of the tolerance: ¾·m/n² ≤ tol/3.
     let (mut u, cu) = level(along_u, 9, tol);
     let (mut v, cv) = level(along_v, 9, tol);
@@ -333,21 +429,152 @@ mod tests {
     #[test]
     fn levels_follow_the_flatness_bound() {
         // A straight, evenly spaced net: one segment per edge, the minimum inside.
-        let mut s: ScreenNet = [None; 16];
+        let mut s = ScreenNet {
+            points: [None; 16],
+            weights: [1 << 16; 16],
+        };
         for i in 0..4 {
             for j in 0..4 {
-                s[4 * i + j] = Some([100 * i as i64, 100 * j as i64]);
+                s.points[4 * i + j] = Some([100 * i as i64, 100 * j as i64]);
             }
         }
         let l = levels(&s, 8);
         assert_eq!((l.u, l.v, l.edges, l.capped), (1, 1, [0; 4], false));
         // Bend edge v = 0: P_10 moved by 64 sub-pixels: |Δ²| = 128 (bounded by 129),
         // ¾·129/n² ≤ 8 needs n = 4.
-        s[4] = Some([100, -64]);
+        s.points[4] = Some([100, -64]);
         let l = levels(&s, 8);
         assert_eq!(l.edges, [2, 0, 0, 0]);
         // A point behind the near plane: everything at the cap.
-        s[5] = None;
+        s.points[5] = None;
         assert!(levels(&s, 8).capped);
+    }
+
+    /// Cubic Bernstein weights at `t`.
+    fn bernstein(t: f64) -> [f64; 4] {
+        let m = 1.0 - t;
+        [m * m * m, 3.0 * t * m * m, 3.0 * t * t * m, t * t * t]
+    }
+
+    /// The homogeneous point `(ω·x, ω·y, ω)` of the screen net `s` at `(u, v)`.
+    fn hom(s: &ScreenNet, u: f64, v: f64) -> [f64; 3] {
+        let (bu, bv) = (bernstein(u), bernstein(v));
+        let mut h = [0.0; 3];
+        for (i, bu) in bu.iter().enumerate() {
+            for (j, bv) in bv.iter().enumerate() {
+                let (p, w) = (s.points[4 * i + j].unwrap(), s.weights[4 * i + j] as f64);
+                let b = bu * bv * w;
+                h[0] += b * p[0] as f64;
+                h[1] += b * p[1] as f64;
+                h[2] += b;
+            }
+        }
+        h
+    }
+
+    /// The largest distance (sub-pixels) between the surface of `s` and its chords at levels
+    /// `l`: along each edge between the curve and its segments, and over every grid cell's
+    /// two triangles between the surface and the dehomogenised linear interpolant of the
+    /// corners (the flat triangle, as the renderer draws it), sampled.
+    fn chord_distance(s: &ScreenNet, l: &Levels) -> f64 {
+        let point = |h: [f64; 3]| [h[0] / h[2], h[1] / h[2]];
+        let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+        let mix = |hs: &[([f64; 3], f64)]| {
+            let mut h = [0.0; 3];
+            for (p, b) in hs {
+                for k in 0..3 {
+                    h[k] += b * p[k];
+                }
+            }
+            h
+        };
+        let mut worst = 0.0f64;
+        // Edges in the order of `EDGES`: v = 0, u = 1, v = 1, u = 0.
+        let on_edge = |side: usize, t: f64| match side {
+            0 => hom(s, t, 0.0),
+            1 => hom(s, 1.0, t),
+            2 => hom(s, t, 1.0),
+            _ => hom(s, 0.0, t),
+        };
+        for (side, &k) in l.edges.iter().enumerate() {
+            let n = 1usize << k;
+            for seg in 0..n {
+                let (t0, t1) = (seg as f64 / n as f64, (seg + 1) as f64 / n as f64);
+                let (h0, h1) = (on_edge(side, t0), on_edge(side, t1));
+                for q in 1..16 {
+                    let f = q as f64 / 16.0;
+                    let chord = point(mix(&[(h0, 1.0 - f), (h1, f)]));
+                    let curve = point(on_edge(side, t0 + f * (t1 - t0)));
+                    worst = worst.max(dist(chord, curve));
+                }
+            }
+        }
+        let (nu, nv) = (1usize << l.u, 1usize << l.v);
+        for i in 0..nu {
+            for j in 0..nv {
+                let uv = |di: usize, dj: usize| {
+                    ((i + di) as f64 / nu as f64, (j + dj) as f64 / nv as f64)
+                };
+                let corners = [uv(0, 0), uv(1, 0), uv(1, 1), uv(0, 1)];
+                for t in CELL_TRIANGLES {
+                    let c = t.map(|k| corners[k]);
+                    let h = c.map(|(u, v)| hom(s, u, v));
+                    for a in 0..=6 {
+                        for b in 0..=6 - a {
+                            let (ba, bb) = (a as f64 / 6.0, b as f64 / 6.0);
+                            let bc = 1.0 - ba - bb;
+                            let u = ba * c[0].0 + bb * c[1].0 + bc * c[2].0;
+                            let v = ba * c[0].1 + bb * c[1].1 + bc * c[2].1;
+                            let flat = point(mix(&[(h[0], ba), (h[1], bb), (h[2], bc)]));
+                            worst = worst.max(dist(flat, point(hom(s, u, v))));
+                        }
+                    }
+                }
+            }
+        }
+        worst
+    }
+
+    /// Random rational nets (weights 1/4 to 4 times each other's, 30 to 60 pixels across):
+    /// wherever the levels are not capped, every chord is within the tolerance of the
+    /// surface. The same points taken as polynomial (the weights ignored, as the estimate was
+    /// before) give levels whose chords are farther in some of them.
+    #[test]
+    fn rational_levels_bound_the_chord_distance() {
+        let mut rng = crate::test_rng::XorShift64::new(0x7a7e_11a7_5eed_0001);
+        let mut unit = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let (mut checked, mut too_coarse) = (0, 0);
+        for case in 0..300 {
+            let tol = 4 + (unit() * 28.0) as i64;
+            let size = 480.0 + unit() * 480.0;
+            let mut s = ScreenNet {
+                points: [None; 16],
+                weights: [0; 16],
+            };
+            for i in 0..4 {
+                for j in 0..4 {
+                    let jitter = |r: f64| (r - 0.5) * size / 3.0;
+                    let x = i as f64 * size / 3.0 + jitter(unit());
+                    let y = j as f64 * size / 3.0 + jitter(unit());
+                    s.points[4 * i + j] = Some([x as i64, y as i64]);
+                    s.weights[4 * i + j] = (65536.0 * (unit() * 2.0 - 1.0).exp2()) as i64;
+                }
+            }
+            let l = levels(&s, tol);
+            if l.capped {
+                continue;
+            }
+            checked += 1;
+            let d = chord_distance(&s, &l);
+            assert!(d <= tol as f64, "case {case}: {d} > {tol} at {l:?}");
+            let polynomial = ScreenNet {
+                weights: [1 << 16; 16],
+                ..s
+            };
+            too_coarse += (chord_distance(&s, &levels(&polynomial, tol)) > tol as f64) as u32;
+        }
+        assert!(checked >= 150, "{checked}");
+        assert!(too_coarse > 0);
+        std::println!("{checked} nets checked; the weights ignored, {too_coarse} too coarse");
     }
 }

@@ -142,14 +142,14 @@ fn reference_and_fixed_renderer_share_the_base_colour() {
 #[test]
 fn fixed_renderer_against_the_reference_at_half_a_pixel() {
     // Least colour PSNR (dB) where ids agree, Gouraud and flat: the measured figures (sphere
-    // 51.7 and 44.1 dB, teapot 47.6 and 45.3 dB) rounded down to whole dB, less 1 dB. The
+    // 51.9 and 45.0 dB, teapot 47.6 and 45.3 dB) rounded down to whole dB, less 1 dB. The
     // sphere's rim, where edge-on triangles must show the side they turn to the camera,
     // fails this (38.5 dB) when the side comes from a coarser test than the rasterizer's.
     let cases = [
         (
             "sphere.bpt",
             camera([2.0, 1.5, 2.5], [0.0; 3], [0.0, 1.0, 0.0]),
-            (50.0, 43.0),
+            (50.0, 44.0),
         ),
         (
             "teapot.bpt",
@@ -269,25 +269,19 @@ fn trimmed_holes_appear_where_the_trim_says() {
     println!("farthest of all: {worst:.3} px");
 }
 
-/// Random single polynomial patches (the first cases of `sim/examples/patch_random.rs`, which
-/// also draws rational ones, and more): a pixel covered by one renderer and not the other lies
+/// Random single patches, polynomial and rational (the first cases of
+/// `sim/examples/patch_random.rs`): a pixel covered by one renderer and not the other lies
 /// within the tolerance plus 1/16 px of a change of the reference's coverage, unless the
-/// renderer reports a capped patch.
+/// renderer reports a capped patch. Cases 12, 48, 67 and 166 fail (up to 0.68 px beyond) when
+/// the levels ignore the weights.
 #[test]
-fn random_polynomial_patches_follow_the_tolerance() {
+fn random_patches_follow_the_tolerance() {
     use scanline3d_sim::draw::PatchDraw;
     use scanline3d_sim::patch::compare::coverage;
     let mut d = PatchDraw::draws();
-    let mut frames = 0;
+    let (mut frames, mut rational) = (0, 0);
     for case in 0..240 {
         let (model, camera, tolerance) = PatchDraw::case(&mut d, case);
-        if model
-            .patches
-            .iter()
-            .any(|p| p.weights.iter().any(|&w| w != 1.0))
-        {
-            continue;
-        }
         let Some(c) = coverage(&model, &camera, tolerance, 48) else {
             continue;
         };
@@ -295,7 +289,13 @@ fn random_polynomial_patches_follow_the_tolerance() {
             let far = c.farthest();
             assert!(far <= tolerance + 1.0 / 16.0, "case {case}: {far} px");
             frames += 1;
+            rational += model
+                .patches
+                .iter()
+                .any(|p| p.weights.iter().any(|&w| w != 1.0)) as u32;
         }
     }
+    assert!(rational > 30, "{rational} rational frames");
+    println!("{frames} frames checked, {rational} of them rational");
     assert!(frames > 100, "{frames} frames");
 }
