@@ -782,33 +782,40 @@ impl<'m, const SUB: u32, C: Clipping, A: Arithmetic, const TRIM: usize>
                 color: if back { v.color.back } else { v.color.front },
             })
         };
-        match C::clip(vp, &clip_vertices(false), &mut self.polygon) {
-            Clipped::Outside => stats.frame.rejected += 1,
-            Clipped::Skipped => stats.frame.unclipped += 1,
-            Clipped::Inside => {
-                if let [Some(a), Some(b), Some(c)] = clip_vertices(false).each_ref().map(project) {
-                    let (s, area, face) = shown([a, b, c]);
-                    emit(s, area, face, stats);
+        // A cut triangle is clipped with its front colours first; if the polygon turns its
+        // back to the camera (a planar polygon in front of the eye: its fan turns one way,
+        // the first triangle with area says which), once more with the back's (the clipper
+        // interpolates them). One call site, so the clipper is not inlined twice.
+        let mut colors_of_back = false;
+        loop {
+            match C::clip(vp, &clip_vertices(colors_of_back), &mut self.polygon) {
+                Clipped::Outside => stats.frame.rejected += 1,
+                Clipped::Skipped => stats.frame.unclipped += 1,
+                Clipped::Inside => {
+                    let projected = clip_vertices(false).each_ref().map(project);
+                    if let [Some(a), Some(b), Some(c)] = projected {
+                        let (s, area, face) = shown([a, b, c]);
+                        emit(s, area, face, stats);
+                    }
                 }
-            }
-            Clipped::Polygon => {
-                stats.frame.clipped += 1;
-                // A planar polygon in front of the eye: its fan turns one way, the first
-                // triangle with area says which (the clipper interpolates the colours, so the
-                // back's are clipped again).
-                let back = fan_turns_back(self.polygon.as_ref(), project);
-                if back && !cull {
-                    C::clip(vp, &clip_vertices(true), &mut self.polygon);
-                }
-                let face = if back { face.back } else { face.front };
-                let mut fan = self.polygon.as_ref().iter().filter_map(project);
-                if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
-                    for c in fan {
-                        emit([a, b, c], signed_area(&[a, b, c]), face, stats);
-                        b = c;
+                Clipped::Polygon => {
+                    let back = fan_turns_back(self.polygon.as_ref(), project);
+                    if back && !cull && !colors_of_back {
+                        colors_of_back = true;
+                        continue;
+                    }
+                    stats.frame.clipped += 1;
+                    let face = if back { face.back } else { face.front };
+                    let mut fan = self.polygon.as_ref().iter().filter_map(project);
+                    if let (Some(a), Some(mut b)) = (fan.next(), fan.next()) {
+                        for c in fan {
+                            emit([a, b, c], signed_area(&[a, b, c]), face, stats);
+                            b = c;
+                        }
                     }
                 }
             }
+            return;
         }
     }
 

@@ -66,7 +66,8 @@ struct Homogeneous {
 
 impl Homogeneous {
     /// The control points `indices` of `s`; `None` if one is not projected.
-    fn new(s: &ScreenNet, indices: impl Iterator<Item = usize> + Clone) -> Option<Self> {
+    #[inline(never)]
+    fn new(s: &ScreenNet, indices: &[usize]) -> Option<Self> {
         let mut h = Homogeneous {
             points: [[0; 2]; 16],
             weights: [0; 16],
@@ -75,7 +76,7 @@ impl Homogeneous {
         };
         let (mut lo, mut hi) = ([i64::MAX; 2], [i64::MIN; 2]);
         let (mut w_min, mut w_max) = (i64::MAX, i64::MIN);
-        for k in indices.clone() {
+        for &k in indices {
             let p = s.points.get(k).copied().flatten()?;
             let w = s.weights.get(k).copied().unwrap_or(0);
             for c in 0..2 {
@@ -91,7 +92,7 @@ impl Homogeneous {
             return Some(h);
         }
         let r = [0, 1].map(|c| lo[c] + (hi[c] - lo[c]) / 2);
-        for k in indices {
+        for &k in indices {
             let (Some(p), Some(&w)) = (h.points.get_mut(k), s.weights.get(k)) else {
                 continue;
             };
@@ -106,29 +107,20 @@ impl Homogeneous {
         Some(h)
     }
 
-    /// The bound standing for `|Δ²p|` over the triples `(a, b, c)` (`b` doubled) or, with
-    /// `d`, the twists `a − b − c + d`: see [`Homogeneous`].
-    fn largest(&self, triples: impl Iterator<Item = [usize; 4]>) -> i64 {
+    /// The bound standing for `|Δ²p|` over the triples `(a, b, c)` (`b` doubled) or the
+    /// twists `a − b − c + d` ([`NONE`] for no `d`): see [`Homogeneous`].
+    #[inline(never)]
+    fn largest(&self, quads: &[[u8; 4]]) -> i64 {
         let (mut points, mut weights) = (0i64, 0i64);
-        for [a, b, c, d] in triples {
-            let at = |k: usize| self.points.get(k).copied().unwrap_or([0; 2]);
-            let w = |k: usize| self.weights.get(k).copied().unwrap_or(0);
-            let (pa, pb, pc) = (at(a), at(b), at(c));
-            let (delta, dw) = match d {
-                usize::MAX => (
-                    [0, 1].map(|k| pa[k] - 2 * pb[k] + pc[k]),
-                    w(a) - 2 * w(b) + w(c),
-                ),
-                d => {
-                    let pd = at(d);
-                    (
-                        [0, 1].map(|k| pd[k] - pb[k] - pc[k] + pa[k]),
-                        w(d) - w(b) - w(c) + w(a),
-                    )
-                }
-            };
+        let at = |k: u8| self.points.get(k as usize).copied().unwrap_or([0; 2]);
+        let w = |k: u8| self.weights.get(k as usize).copied().unwrap_or(0);
+        for &[a, b, c, d] in quads {
+            // `a − 2b + c` is the twist with `c` for `b` and `d` for `c`.
+            let (c, d) = if d == NONE { (b, c) } else { (c, d) };
+            let (pa, pb, pc, pd) = (at(a), at(b), at(c), at(d));
+            let delta = [0, 1].map(|k| pd[k] - pb[k] - pc[k] + pa[k]);
             points = points.max(length(delta));
-            weights = weights.max(dw.abs());
+            weights = weights.max((w(d) - w(b) - w(c) + w(a)).abs());
         }
         let up = |n: i64| n.saturating_add(self.divisor - 1) / self.divisor;
         up(points).saturating_add(up(weights.saturating_mul(self.reach)))
@@ -156,6 +148,44 @@ const EDGES: [[usize; 4]; 4] = [
     [0, 1, 2, 3],
 ];
 
+/// No fourth point: a second difference `a − 2b + c`, not a twist.
+const NONE: u8 = u8::MAX;
+
+/// Every control point.
+const ALL: [usize; 16] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15];
+
+/// The second differences along `u` (`P_ij`, `P_i+1,j`, `P_i+2,j`; `u` along `i`, index
+/// `4·i + j`).
+const ALONG_U: [[u8; 4]; 8] = second_differences(4, 1);
+
+/// The second differences along `v`.
+const ALONG_V: [[u8; 4]; 8] = second_differences(1, 4);
+
+/// The twists `P_ij − P_i,j+1 − P_i+1,j + P_i+1,j+1`.
+const TWISTS: [[u8; 4]; 9] = {
+    let mut out = [[0; 4]; 9];
+    let mut k = 0;
+    while k < 9 {
+        let p = (4 * (k / 3) + k % 3) as u8;
+        out[k] = [p, p + 1, p + 4, p + 5];
+        k += 1;
+    }
+    out
+};
+
+/// The 8 triples of points `step` apart in the direction of `step`, starting a step of
+/// `across` apart across it.
+const fn second_differences(step: u8, across: u8) -> [[u8; 4]; 8] {
+    let mut out = [[0; 4]; 8];
+    let mut k = 0;
+    while k < 8 {
+        let p = (k / 2) as u8 * across + (k % 2) as u8 * step;
+        out[k] = [p, p + step, p + 2 * step, NONE];
+        k += 1;
+    }
+    out
+}
+
 /// An upper bound of the length of `d`: `max + min/2` of `|dx|, |dy|` (at most 12 % over).
 fn length(d: [i64; 2]) -> i64 {
     let (x, y) = (d[0].saturating_abs(), d[1].saturating_abs());
@@ -179,49 +209,20 @@ fn level(m: Option<i64>, scale: i64, tol: i64) -> (u8, bool) {
 
 /// Levels for a patch with projected control points `s`, tolerance `tol` sub-pixels (≥ 1).
 pub(crate) fn levels(s: &ScreenNet, tol: i64) -> Levels {
-    // The triples `(a, b, c)` of second differences; no fourth point.
-    const NONE: usize = usize::MAX;
     let mut capped = false;
     let edges = EDGES.map(|e| {
-        let m = Homogeneous::new(s, e.into_iter()).map(|h| {
-            h.largest([(0, 1, 2), (1, 2, 3)].into_iter().map(|(a, b, c)| {
-                let at = |k: usize| e.get(k).copied().unwrap_or(0);
-                [at(a), at(b), at(c), NONE]
-            }))
+        let m = Homogeneous::new(s, &e).map(|h| {
+            let [a, b, c, d] = e.map(|k| k as u8);
+            h.largest(&[[a, b, c, NONE], [b, c, d, NONE]])
         });
         let (k, c) = level(m, 3, tol);
         capped |= c;
         k
     });
-    let whole = Homogeneous::new(s, 0..16);
-    let along_u = whole.as_ref().map(|h| {
-        h.largest(
-            (0..4)
-                .flat_map(|j| (0..2).map(move |i| (i, j)))
-                .map(|(i, j)| [4 * i + j, 4 * (i + 1) + j, 4 * (i + 2) + j, NONE]),
-        )
-    });
-    let along_v = whole.as_ref().map(|h| {
-        h.largest(
-            (0..4)
-                .flat_map(|i| (0..2).map(move |j| (i, j)))
-                .map(|(i, j)| [4 * i + j, 4 * i + j + 1, 4 * i + j + 2, NONE]),
-        )
-    });
-    let twist = whole.as_ref().map(|h| {
-        h.largest(
-            (0..3)
-                .flat_map(|i| (0..3).map(move |j| (i, j)))
-                .map(|(i, j)| {
-                    [
-                        4 * i + j,
-                        4 * i + j + 1,
-                        4 * (i + 1) + j,
-                        4 * (i + 1) + j + 1,
-                    ]
-                }),
-        )
-    });
+    let whole = Homogeneous::new(s, &ALL);
+    let along_u = whole.as_ref().map(|h| h.largest(&ALONG_U));
+    let along_v = whole.as_ref().map(|h| h.largest(&ALONG_V));
+    let twist = whole.as_ref().map(|h| h.largest(&TWISTS));
     // Each of the three interior terms gets a third of the tolerance: ¾·m/n² ≤ tol/3.
     let (mut u, cu) = level(along_u, 9, tol);
     let (mut v, cv) = level(along_v, 9, tol);
