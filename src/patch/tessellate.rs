@@ -122,7 +122,12 @@ impl Homogeneous {
             points = points.max(length(delta));
             weights = weights.max((w(d) - w(b) - w(c) + w(a)).abs());
         }
-        let up = |n: i64| n.saturating_add(self.divisor - 1) / self.divisor;
+        // `divisor` is positive; `checked_div` keeps the division's panic off the render path.
+        let up = |n: i64| {
+            n.saturating_add(self.divisor.saturating_sub(1))
+                .checked_div(self.divisor)
+                .unwrap_or(i64::MAX)
+        };
         up(points).saturating_add(up(weights.saturating_mul(self.reach)))
     }
 }
