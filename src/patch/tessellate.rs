@@ -51,7 +51,7 @@ pub(crate) struct ScreenNet {
 /// the distance is at most `(|Y − L_Y| + D·|W − L_W|)/ω_min`, and each part follows the
 /// polynomial bounds of the module docs. So the second difference that stands for `Δ²p` is
 /// `|Δ²(ω·(p − r))|/ω_min + D·|Δ²ω|/ω_min`, the largest of each over the triples added.
-/// `r` is the centre of the points' bounding box (smallest `D` of the box's points, about).
+/// `r` is the centre of the points' bounding box, which keeps `D` small.
 /// Test `rational_levels_bound_the_chord_distance`.
 struct Homogeneous {
     /// `ω_i·(p_i − r)` in sub-pixel × I16F16 bits, or `p_i` when the weights are equal.
