@@ -57,7 +57,7 @@ fn main() {
         }
         let over = far > tolerance + 1.0 / 16.0;
         if c.capped {
-            capped.push(case);
+            capped.push((case, over));
         } else if over {
             beyond.push((case, rational, far - tolerance));
         }
@@ -79,8 +79,9 @@ fn main() {
     };
     let ((polynomial, p_far), (rational, r_far)) = (over(false), over(true));
     println!(
-        "{frames} frames; {} with a capped patch (reported); beyond the tolerance plus 1/16 px, not capped: {polynomial} polynomial (up to {p_far:.2} px over), {rational} rational (up to {r_far:.2} px over): {:?}",
+        "{frames} frames; {} with a capped patch (reported; {} of them beyond the tolerance plus 1/16 px); beyond the tolerance plus 1/16 px, not capped: {polynomial} polynomial (up to {p_far:.2} px over), {rational} rational (up to {r_far:.2} px over): {:?}",
         capped.len(),
+        capped.iter().filter(|c| c.1).count(),
         beyond.iter().map(|b| b.0).collect::<Vec<_>>()
     );
 }
