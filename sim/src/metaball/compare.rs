@@ -145,22 +145,10 @@ pub struct Checked {
 }
 
 impl Checked {
-    /// Whether every mismatch is explained: no depth the stopping rule does not explain, and no
-    /// coverage mismatch off the silhouette but the one ray the caster reports capped (a near
-    /// tangent graze still marching after `MAX_STEPS`, drawn as background), if it capped one.
+    /// Whether every mismatch is explained: no coverage mismatch off the silhouette and no depth
+    /// the stopping rule does not explain.
     pub fn explained(&self) -> bool {
-        let capped_off_silhouette = match self.stats.last_capped {
-            Some((x, y)) if self.stats.capped == 1 => {
-                let (x, y) = (usize::from(x), usize::from(y));
-                let i = y * self.expected.width + x;
-                self.expected.ids[i] >= 0
-                    && self.fixed.ids[i] < 0
-                    && !near_silhouette(&self.expected, x, y)
-            }
-            _ => false,
-        };
-        let off_silhouette = self.comparison.off_silhouette - usize::from(capped_off_silhouette);
-        off_silhouette == 0 && self.comparison.depth_unexplained == 0
+        self.comparison.off_silhouette == 0 && self.comparison.depth_unexplained == 0
     }
 }
 
