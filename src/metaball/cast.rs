@@ -512,8 +512,12 @@ impl Frame<'_> {
             if density >= CURVED_LIMIT || ray.a >= CURVED_LIMIT {
                 return Wide::ZERO;
             }
-            // Rounded up by one step of the product's truncation.
+            // Rounded up by one step of the product's truncation. Each term is below 2^27, so
+            // stopping once the sum reaches 2^12 keeps it from wrapping.
             curvature += mul(mul(density, ray.a), FIELD_CURVATURE_WIDE) + Wide::DELTA;
+            if curvature >= CURVED_LIMIT {
+                return Wide::ZERO;
+            }
             if let Some(s) = ray.s(t) {
                 // d(q·f(s))/dt = q·f'(s)·2A·u.
                 let au = mul(ray.a, t - ray.closest);
@@ -527,11 +531,7 @@ impl Frame<'_> {
         );
         let magnitude = g.abs() - g_slack;
         let sigma_slope = if g > Wide::ZERO { slope } else { -slope };
-        if magnitude <= Wide::ZERO
-            || curvature >= CURVED_LIMIT
-            || magnitude >= CURVED_LIMIT
-            || slope.abs() >= CURVED_LIMIT
-        {
+        if magnitude <= Wide::ZERO || magnitude >= CURVED_LIMIT || slope.abs() >= CURVED_LIMIT {
             return Wide::ZERO;
         }
         let two_m_g = mul(curvature, magnitude) * 2;
