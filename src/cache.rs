@@ -22,6 +22,7 @@
 //! is not kept: the rare triangles that need clipping transform their vertices again, with the
 //! same result.
 
+use crate::math::zip3;
 use crate::project::{ProjectionPrecision, ScreenVertex, SubPx, Viewport};
 use crate::vertex::EyePoint;
 use crate::Depth;
@@ -123,7 +124,7 @@ impl CachedVertex {
         v: [&Self; 3],
         colors: [[I16F16; 3]; 3],
     ) -> Option<[ScreenVertex<S>; 3]> {
-        let [Some(a), Some(b), Some(c)] = [0, 1, 2].map(|k| v[k].screen::<S>(colors[k])) else {
+        let [Some(a), Some(b), Some(c)] = zip3(v, colors, |v, c| v.screen::<S>(c)) else {
             return None;
         };
         Some([a, b, c])

@@ -527,7 +527,13 @@ fn div_rem_below_with<const SOFT: bool>(u1: u32, u0: u32, v: u32) -> (u32, u32) 
     // One 16-bit digit of the quotient of `top·2^16 + next` (`top < v`): the estimate from
     // `vn1 >= 2^15` is at most two too large.
     let digit = |top: u32, next: u32| {
-        let mut q = if SOFT { by.div_rem(top).0 } else { top / vn1 };
+        // (`checked_div`: where this closure is left out of line, as with `opt-level = "z"`,
+        // the compiler no longer sees `vn1 >= 2^15`.)
+        let mut q = if SOFT {
+            by.div_rem(top).0
+        } else {
+            top.checked_div(vn1).unwrap_or(0)
+        };
         let mut rhat = top - q * vn1;
         while q >= B || q * vn0 > (rhat << 16 | next) {
             q -= 1;
@@ -1003,6 +1009,28 @@ pub(crate) fn cosine_i32(v: [i64; 3], unit: [i32; 3]) -> Option<i32> {
         dot.unsigned_abs() / len
     } as i32;
     Some((if dot < 0 { -q } else { q }) << 15)
+}
+
+/// `n.checked_div_euclid(d)` for `i128` from `checked_div` and `checked_rem` (the same values):
+/// the standard method calls `div_euclid`, whose own panic path stays wherever that call is
+/// not inlined, as with `opt-level = "z"`.
+pub(crate) fn checked_div_euclid_i128(n: i128, d: i128) -> Option<i128> {
+    let (q, r) = (n.checked_div(d)?, n.checked_rem(d)?);
+    Some(match (r < 0, d > 0) {
+        (true, true) => q - 1,
+        (true, false) => q + 1,
+        (false, _) => q,
+    })
+}
+
+/// `[f(a₀, b₀), f(a₁, b₁), f(a₂, b₂)]`. The same as `[0, 1, 2].map(|k| f(a[k], b[k]))` without
+/// indexing: where the optimiser keeps such a closure out of line (`opt-level = "z"` does), the
+/// index is a run-time value and each `a[k]` keeps a bounds check, a panic path the render path
+/// must not have (the panic-never link check builds with both optimisation levels).
+#[inline(always)]
+pub(crate) fn zip3<A, B, C>(a: [A; 3], b: [B; 3], mut f: impl FnMut(A, B) -> C) -> [C; 3] {
+    let ([a0, a1, a2], [b0, b1, b2]) = (a, b);
+    [f(a0, b0), f(a1, b1), f(a2, b2)]
 }
 
 #[cfg(test)]

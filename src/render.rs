@@ -17,7 +17,7 @@ use crate::arithmetic::Arithmetic;
 use crate::cache::CachedVertex;
 use crate::clip::{ClipVertex, Clipped, Clipping};
 use crate::depth::{DepthFormat, DepthRow};
-use crate::math::NormalPrecision;
+use crate::math::{zip3, NormalPrecision};
 use crate::options::RenderOptions;
 use crate::project::ProjectionPrecision;
 use crate::project::{ScreenVertex, Viewport};
@@ -517,7 +517,7 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                 [self.lighting.face::<A::Normals>(v); 3]
             }
         };
-        [0, 1, 2].map(|k| color_channels(shade(base[k], intensity[k])))
+        zip3(base, intensity, |b, i| color_channels(shade(b, i)))
     }
 
     /// Transforms the three vertices `idx` to eye space, with colour attributes `colors`.
@@ -529,9 +529,9 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         let verts = self.instance.mesh.vertices();
         let zero = [I16F16::ZERO; 3];
         let v = idx.map(|i| internal(verts.get(i as usize), &zero));
-        [0, 1, 2].map(|k| ClipVertex {
-            p: A::Transform::apply(&self.mv, v[k]),
-            color: colors[k],
+        zip3(v, colors, |p, color| ClipVertex {
+            p: A::Transform::apply(&self.mv, p),
+            color,
         })
     }
 

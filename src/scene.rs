@@ -370,18 +370,19 @@ impl Transform {
 
     /// `self ∘ inner`: applies `inner` first, then `self`.
     pub fn then_after(&self, inner: &Transform) -> Transform {
-        let a = &self.m;
-        let b = &inner.m;
-        let mut m = [[0.0f32; 4]; 3];
-        for (r, row) in m.iter_mut().enumerate() {
-            for (c, out) in row.iter_mut().enumerate() {
-                let mut v = a[r][0] * b[0][c] + a[r][1] * b[1][c] + a[r][2] * b[2][c];
-                if c == 3 {
-                    v += a[r][3];
-                }
-                *out = v;
+        // Row by row and column by column without indexing (no bounds checks to survive
+        // `opt-level = "z"`): m[r][c] = Σ_k a[r][k]·b[k][c], plus a[r][3] in the last column.
+        let [b0, b1, b2] = &inner.m;
+        let m = self.m.map(|[a0, a1, a2, a3]| {
+            let mut row = [0.0f32; 4];
+            for (((out, x), y), z) in row.iter_mut().zip(b0).zip(b1).zip(b2) {
+                *out = a0 * x + a1 * y + a2 * z;
             }
-        }
+            if let Some(last) = row.last_mut() {
+                *last += a3;
+            }
+            row
+        });
         Transform { m }
     }
 

@@ -14,9 +14,9 @@
 //! [`MAX_MODEL_COORD`]: crate::scene::MAX_MODEL_COORD
 
 use crate::math::{
-    fit_bits, fixed_from_f32, i16f16_from_f32, mul_wide, NormalPrecision, NO_WIDE_MULTIPLY,
+    fit_bits, fixed_from_f32, i16f16_from_f32, mul_wide, zip3, NormalPrecision, NO_WIDE_MULTIPLY,
 };
-use crate::scene::{Light, Transform, Vertex};
+use crate::scene::{Coord, Light, Transform, Vertex};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
 use fixed::types::{I16F16, I2F30};
 
@@ -393,9 +393,9 @@ impl Lighting {
 /// [`MAX_MODEL_COORD`]: crate::scene::MAX_MODEL_COORD
 #[inline]
 fn face_normal(v: [&Vertex; 3]) -> [i64; 3] {
-    let d = |a: &Vertex, b: &Vertex, k: usize| b[k].to_bits().wrapping_sub(a[k].to_bits());
-    let e1 = [0, 1, 2].map(|k| d(v[0], v[1], k));
-    let e2 = [0, 1, 2].map(|k| d(v[0], v[2], k));
+    let [a, b, c] = v;
+    let d = |p: Coord, q: Coord| q.to_bits().wrapping_sub(p.to_bits());
+    let (e1, e2) = (zip3(*a, *b, d), zip3(*a, *c, d));
     if NO_WIDE_MULTIPLY {
         if let Some(n) = short_edge_normal(e1, e2) {
             return n;

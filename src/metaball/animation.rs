@@ -13,6 +13,7 @@
 //! 2^63: the interpolation is exact `i64` arithmetic.
 
 use super::{ball_in_envelope, Ball, Coord, MetaballError, Metaballs, DENSITY_LIMIT, MAX_BALLS};
+use crate::math::zip3;
 use embedded_graphics::pixelcolor::Rgb888;
 use fixed::types::I8F24;
 
@@ -85,11 +86,8 @@ impl AnimatedBall<'_> {
 /// `a + (b − a)·offset/span` rounded to I16F16 (to nearest, halves up), in exact integers.
 fn interpolate(a: &BallKey, b: &BallKey, offset: u32, span: u32) -> [Coord; 3] {
     let span = i64::from(span);
-    [0, 1, 2].map(|i| {
-        let (start, end) = (
-            i64::from(a.centre[i].to_bits()),
-            i64::from(b.centre[i].to_bits()),
-        );
+    zip3(a.centre, b.centre, |a, b| {
+        let (start, end) = (i64::from(a.to_bits()), i64::from(b.to_bits()));
         let product = (end - start).wrapping_mul(i64::from(offset));
         // product / span = whole + rest / span with 0 ≤ rest < span (span > 0).
         let (whole, rest) = product

@@ -18,6 +18,7 @@ use super::{
 };
 use super::{MAX_COORD, MAX_FAR, MIN_NEAR};
 use crate::depth::{Depth, DepthRow};
+use crate::math::zip3;
 use crate::scene::Light;
 use crate::sink::{Row, RowPixel, RowSink};
 use embedded_graphics::pixelcolor::{Rgb888, RgbColor};
@@ -108,7 +109,9 @@ impl MetaCamera {
         let sy = 2.0 * tan_half / h;
         let x0 = (0.5 / w * 2.0 - 1.0) * tan_half * w / h;
         let y0 = (1.0 - 0.5 / h * 2.0) * tan_half;
-        let corner = [0, 1, 2].map(|i| forward[i] + side[i] * x0 + up[i] * y0);
+        let corner = zip3(zip3(forward, side, |f, s| f + s * x0), up, |fs, u| {
+            fs + u * y0
+        });
         Ok(MetaCamera {
             eye: wide3(eye),
             corner: wide3(corner),
@@ -133,11 +136,11 @@ impl MetaCamera {
 
     /// The ray direction through the centre of pixel `(column, row)`.
     fn direction(&self, column: u16, row: u16) -> [Wide; 3] {
-        [0, 1, 2].map(|i| {
-            self.corner[i]
-                + self.per_column[i].saturating_mul_int(i64::from(column))
-                + self.per_row[i].saturating_mul_int(i64::from(row))
-        })
+        let (column, row) = (i64::from(column), i64::from(row));
+        let across = zip3(self.corner, self.per_column, |c, s| {
+            c + s.saturating_mul_int(column)
+        });
+        zip3(across, self.per_row, |a, s| a + s.saturating_mul_int(row))
     }
 }
 
@@ -346,7 +349,7 @@ fn frame_ball(ball: &Ball, camera: &MetaCamera) -> FrameBall {
     let density = Wide::from(ball.density);
     let centre = ball.centre.map(Wide::from);
     FrameBall {
-        offset: [0, 1, 2].map(|i| centre[i] - camera.eye[i]),
+        offset: zip3(centre, camera.eye, |c, e| c - e),
         r2: radius * radius,
         inv_r2: Wide::ONE.checked_div(radius * radius).unwrap_or(Wide::ZERO),
         density,

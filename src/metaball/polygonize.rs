@@ -25,6 +25,7 @@
 
 use super::cast::quotient;
 use super::{field, field_slope, mul, Ball, Blend, Coord, Metaballs, Wide};
+use crate::math::zip3;
 use crate::scene::{Mesh, MeshColors, SceneError, Vertex};
 use embedded_graphics::pixelcolor::Rgb888;
 
@@ -231,7 +232,7 @@ impl GridBall {
     /// `s = |p − c|²/R²` and `p − c` where `p` is inside the influence sphere.
     #[inline]
     fn at(&self, p: [Wide; 3]) -> Option<(Wide, [Wide; 3])> {
-        let offset = [0, 1, 2].map(|i| p[i] - self.centre[i]);
+        let offset = zip3(p, self.centre, |p, c| p - c);
         if offset.iter().any(|o| o.abs() >= self.radius) {
             return None;
         }
@@ -250,7 +251,8 @@ struct Lattice {
 
 impl Lattice {
     fn point(&self, index: [usize; 3]) -> [Wide; 3] {
-        [0, 1, 2].map(|i| self.origin[i] + self.step[i].saturating_mul_int(index[i] as i64))
+        let steps = zip3(self.step, index, |s, i| s.saturating_mul_int(i as i64));
+        zip3(self.origin, steps, |o, s| o + s)
     }
 }
 
@@ -365,7 +367,9 @@ fn lattice<const S: usize>(balls: &[GridBall]) -> Option<Lattice> {
         return None;
     }
     let cells = Wide::from_num(S.saturating_sub(1).max(1) as i32);
-    let step = [0, 1, 2].map(|i| quotient(high[i] - low[i], cells).unwrap_or(Wide::ZERO));
+    let step = zip3(high, low, |h, l| {
+        quotient(h - l, cells).unwrap_or(Wide::ZERO)
+    });
     Some(Lattice { origin: low, step })
 }
 
@@ -461,13 +465,17 @@ impl Work<'_> {
         let (a64, b64) = (i64::from(a.to_bits()), i64::from(b.to_bits()));
         let t = Wide::from_bits((a64 << 32).checked_div(a64 - b64).unwrap_or(0));
         let start = self.lattice.point(base);
-        let p = [0, 1, 2].map(|i| {
-            if d >> i & 1 == 1 {
-                start[i] + mul(t, self.lattice.step[i])
-            } else {
-                start[i]
-            }
-        });
+        let p = zip3(
+            zip3(start, self.lattice.step, |s, st| (s, st)),
+            [1, 2, 4],
+            |(s, st), bit| {
+                if d & bit != 0 {
+                    s + mul(t, st)
+                } else {
+                    s
+                }
+            },
+        );
         // Outward: from the inside end towards the outside end, the fallback normal.
         let sign = if a > Coord::ZERO {
             Wide::ONE
@@ -591,15 +599,16 @@ impl<const S: usize> Cells<'_, S> {
             let (p, q) = (corner(p), corner(q));
             [p[0] + q[0], p[1] + q[1], p[2] + q[2]]
         });
-        let e1 = [0, 1, 2].map(|i| mid[1][i] - mid[0][i]);
-        let e2 = [0, 1, 2].map(|i| mid[2][i] - mid[0][i]);
+        let [m0, m1, m2] = mid;
+        let (e1, e2) = (zip3(m1, m0, |a, b| a - b), zip3(m2, m0, |a, b| a - b));
         let n = [
             e1[1] * e2[2] - e1[2] * e2[1],
             e1[2] * e2[0] - e1[0] * e2[2],
             e1[0] * e2[1] - e1[1] * e2[0],
         ];
-        let c = corner(inner);
-        let towards_inner: i32 = (0..3).map(|i| n[i] * (2 * c[i] - mid[0][i])).sum();
+        let to_inner = zip3(corner(inner), m0, |c, m| 2 * c - m);
+        let [t0, t1, t2] = zip3(n, to_inner, |n, d| n * d);
+        let towards_inner = t0 + t1 + t2;
         let mut ids = [NONE; 3];
         for (id, [p, q]) in ids.iter_mut().zip(edges) {
             *id = self.edge(x, y, p, q);

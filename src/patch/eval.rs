@@ -12,7 +12,7 @@
 //! of the projected surface `H_u·ω − H·ω_u` multiplies them by a weight (2^20): below 2^56.
 
 use super::{PatchModel, Weight, PARAM_ONE};
-use crate::math::{fit_bits, mul_i64, NO_WIDE_MULTIPLY};
+use crate::math::{fit_bits, mul_i64, zip3, NO_WIDE_MULTIPLY};
 use crate::scene::Vertex;
 use fixed::types::I16F16;
 
@@ -80,7 +80,13 @@ impl Lerp for Hom {
     }
     #[inline(always)]
     fn slope(self, b: Hom) -> Hom {
-        [0, 1, 2, 3].map(|k| triple(b[k] - self[k]))
+        let ([a0, a1, a2, a3], [b0, b1, b2, b3]) = (self, b);
+        [
+            triple(b0 - a0),
+            triple(b1 - a1),
+            triple(b2 - a2),
+            triple(b3 - a3),
+        ]
     }
 }
 
@@ -363,7 +369,10 @@ impl TangentColumn {
         let tangent = |d: Hom| -> Option<[i64; 3]> {
             let w = h[3] >> 4;
             let dw = d[3] >> 4;
-            let t = [0, 1, 2].map(|k| mul_i64(d[k] >> 4, w) - mul_i64(h[k] >> 4, dw));
+            let ([d0, d1, d2, _], [h0, h1, h2, _]) = (d, h);
+            let t = zip3([d0, d1, d2], [h0, h1, h2], |d, h| {
+                mul_i64(d >> 4, w) - mul_i64(h >> 4, dw)
+            });
             // Below this a tangent is rounding noise (a few units of its last bits), and
             // scaling it up would invent a direction.
             let largest = t.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
@@ -388,16 +397,16 @@ impl TangentColumn {
 /// positive (a convex combination of weights of at least 1/16).
 #[inline]
 pub(crate) fn dehomogenize(h: Hom) -> Vertex {
-    let w = h[3];
+    let [x, y, z, w] = h;
     if w == 1 << 16 {
         // A polynomial patch: nothing to divide.
-        return [0, 1, 2].map(|k| I16F16::from_bits(h[k] as i32));
+        return [x, y, z].map(|c| I16F16::from_bits(c as i32));
     }
     // Weights are below 2^21 bits and `h` below 2^32, so nothing here overflows; `checked_`
     // keeps the render path free of panics.
     let w = w.max(1);
-    [0, 1, 2].map(|k| {
-        let q = ((h[k] << 17) + w).checked_div_euclid(2 * w).unwrap_or(0);
+    [x, y, z].map(|c| {
+        let q = ((c << 17) + w).checked_div_euclid(2 * w).unwrap_or(0);
         I16F16::from_bits(q as i32)
     })
 }

@@ -91,7 +91,8 @@ impl Homogeneous {
         if w_min >= w_max || w_min <= 0 {
             return Some(h);
         }
-        let r = [0, 1].map(|c| lo[c] + (hi[c] - lo[c]) / 2);
+        let ([lo_u, lo_v], [hi_u, hi_v]) = (lo, hi);
+        let r = [lo_u + (hi_u - lo_u) / 2, lo_v + (hi_v - lo_v) / 2];
         for &k in indices {
             let (Some(p), Some(&w)) = (h.points.get_mut(k), s.weights.get(k)) else {
                 continue;
@@ -118,7 +119,11 @@ impl Homogeneous {
             // `a − 2b + c` is the twist with `c` for `b` and `d` for `c`.
             let (c, d) = if d == NONE { (b, c) } else { (c, d) };
             let (pa, pb, pc, pd) = (at(a), at(b), at(c), at(d));
-            let delta = [0, 1].map(|k| pd[k] - pb[k] - pc[k] + pa[k]);
+            let twist = |[a, b, c, d]: [i64; 4]| d - b - c + a;
+            let delta = [
+                twist([pa[0], pb[0], pc[0], pd[0]]),
+                twist([pa[1], pb[1], pc[1], pd[1]]),
+            ];
             points = points.max(length(delta));
             weights = weights.max((w(d) - w(b) - w(c) + w(a)).abs());
         }

@@ -250,17 +250,39 @@ pub(crate) enum Cut {
     Pieces,
 }
 
+/// The sides of `t` in order, `(t₀, t₁)`, `(t₁, t₂)`, `(t₂, t₀)`.
+fn sides(t: &[P; 3]) -> [(P, P); 3] {
+    let [a, b, c] = *t;
+    [(a, b), (b, c), (c, a)]
+}
+
+/// The corners' bounding box `(lo, hi)`.
+fn bounds(t: &[P; 3]) -> (P, P) {
+    let [[u0, v0], [u1, v1], [u2, v2]] = *t;
+    (
+        [u0.min(u1).min(u2), v0.min(v1).min(v2)],
+        [u0.max(u1).max(u2), v0.max(v1).max(v2)],
+    )
+}
+
+/// Whether segment `a b` lies wholly outside the box `lo..=hi` on one axis.
+fn apart(a: P, b: P, lo: P, hi: P) -> bool {
+    let ([au, av], [bu, bv]) = (a, b);
+    au.max(bu) < lo[0] || au.min(bu) > hi[0] || av.max(bv) < lo[1] || av.min(bv) > hi[1]
+}
+
 fn uv(p: Uv) -> P {
     [p[0] as i64, p[1] as i64]
 }
 
 fn to_uv(p: P) -> Uv {
-    [0, 1].map(|k| p[k].clamp(0, PARAM_ONE as i64) as u32)
+    p.map(|c| c.clamp(0, PARAM_ONE as i64) as u32)
 }
 
 /// Sum of the corners (the centroid times 3).
 fn corner_sum(t: &[P; 3]) -> P {
-    [0, 1].map(|k| t[0][k] + t[1][k] + t[2][k])
+    let [[u0, v0], [u1, v1], [u2, v2]] = *t;
+    [u0 + u1 + u2, v0 + v1 + v2]
 }
 
 /// How trimming treats triangle `t` (counter-clockwise in `(u, v)`).
@@ -269,13 +291,12 @@ pub(crate) fn classify(trims: &Trims<'_>, t: [Uv; 3]) -> Cut {
         return Cut::Keep;
     }
     let t = t.map(uv);
-    let lo = [0, 1].map(|k| t[0][k].min(t[1][k]).min(t[2][k]));
-    let hi = [0, 1].map(|k| t[0][k].max(t[1][k]).max(t[2][k]));
-    let inside = |p: P| (0..3).all(|k| orient(t[k], t[(k + 1) % 3], p) >= 0);
+    let (lo, hi) = bounds(&t);
+    let sides = sides(&t);
+    let inside = |p: P| sides.iter().all(|&(c, d)| orient(c, d, p) >= 0);
     let touched = trims.edges().any(|(a, b)| {
-        let apart = (0..2).any(|k| a[k].max(b[k]) < lo[k] || a[k].min(b[k]) > hi[k]);
-        !apart
-            && (inside(a) || inside(b) || (0..3).any(|k| segments_meet(a, b, t[k], t[(k + 1) % 3])))
+        !apart(a, b, lo, hi)
+            && (inside(a) || inside(b) || sides.iter().any(|&(c, d)| segments_meet(a, b, c, d)))
     });
     if touched {
         Cut::Pieces
@@ -302,7 +323,8 @@ fn crossing(e: (P, P), s: (P, P)) -> P {
     let den = d[0] * f[1] - d[1] * f[0];
     let num = (q0[0] - p0[0]) * f[1] - (q0[1] - p0[1]) * f[0];
     let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
-    [0, 1].map(|k| p0[k] + div_round(d[k] * num, den).unwrap_or(0))
+    let along = |p: i64, d: i64| p + div_round(d * num, den).unwrap_or(0);
+    [along(p0[0], d[0]), along(p0[1], d[1])]
 }
 
 /// A point on a triangle's boundary: on side `side` (from corner `side` to the next), at
@@ -380,7 +402,7 @@ pub(crate) fn clip<const TRIM: usize>(
 /// The first trim vertex strictly inside `t`, or inside one of its sides (with that side).
 fn inner_vertex(trims: &Trims<'_>, t: &[P; 3]) -> Option<(P, Option<usize>)> {
     trims.vertices().find_map(|p| {
-        let o = [0, 1, 2].map(|k| orient(t[k], t[(k + 1) % 3], p));
+        let o = sides(t).map(|(a, b)| orient(a, b, p));
         match o {
             [a, b, c] if a > 0 && b > 0 && c > 0 => Some((p, None)),
             _ => {
@@ -548,9 +570,8 @@ fn sort_by_key<T: Copy, K: Ord>(s: &mut [T], key: impl Fn(&T) -> K) {
 /// its sides): its two boundary points, or `None` if it only touches `t` or runs along a side.
 fn chord(t: &[P; 3], s: (P, P)) -> Option<(Boundary, Boundary)> {
     let (a, b) = s;
-    let lo = [0, 1].map(|k| t[0][k].min(t[1][k]).min(t[2][k]));
-    let hi = [0, 1].map(|k| t[0][k].max(t[1][k]).max(t[2][k]));
-    if (0..2).any(|k| a[k].max(b[k]) < lo[k] || a[k].min(b[k]) > hi[k]) {
+    let (lo, hi) = bounds(t);
+    if apart(a, b, lo, hi) {
         return None;
     }
     let mut hits = [None; 2];
@@ -564,8 +585,7 @@ fn chord(t: &[P; 3], s: (P, P)) -> Option<(Boundary, Boundary)> {
         }
         count += 1;
     };
-    for side in 0..3 {
-        let (c, d) = (t[side], t[(side + 1) % 3]);
+    for (side, (c, d)) in sides(t).into_iter().enumerate() {
         if orient(a, b, c) == 0 && within(a, b, c) {
             hit(Boundary {
                 side: side as u8,

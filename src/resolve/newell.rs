@@ -127,6 +127,7 @@
 use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::depth::DepthRow;
+use crate::math::checked_div_euclid_i128;
 use crate::options::{RenderOptions, MAX_INSTANCES};
 use crate::render::{
     internal, viewport, walk_rows, ActiveTri, Buckets, FinishedRow, Resolve, NO_ENTRY,
@@ -515,15 +516,30 @@ fn disjoint(a: &[i32; 3], b: &[i32; 3]) -> bool {
     a1 <= b0 || b1 <= a0
 }
 
+/// `run.rotate_right(1)` without its assertion (`1 <= len`), which stays where the call is
+/// not inlined (`opt-level = "z"`): the last entry first, the others one place on.
+fn rotate_right_by_one(run: &mut [u16]) {
+    if let Some(&last) = run.last() {
+        let mut carry = last;
+        for entry in run.iter_mut() {
+            core::mem::swap(entry, &mut carry);
+        }
+    }
+}
+
 /// Whether an edge line of `a` has all of `b` on its outside (or on it).
 fn separates(a: &StoredTriangle, b: &StoredTriangle) -> bool {
-    (0..3).any(|k| {
-        let (i, j, o) = (k, (k + 1) % 3, (k + 2) % 3);
-        let (ex, ey) = (a.x[j] as i64 - a.x[i] as i64, a.y[j] as i64 - a.y[i] as i64);
-        let f = |x: i32, y: i32| ex * (y as i64 - a.y[i] as i64) - ey * (x as i64 - a.x[i] as i64);
-        let inside = f(a.x[o], a.y[o]).signum();
-        inside != 0 && (0..3).all(|m| f(b.x[m], b.y[m]) * inside <= 0)
-    })
+    let ([x0, x1, x2], [y0, y1, y2]) = (a.x, a.y);
+    let (p0, p1, p2) = ((x0, y0), (x1, y1), (x2, y2));
+    // Each edge (i, j) with the opposite vertex o.
+    [(p0, p1, p2), (p1, p2, p0), (p2, p0, p1)]
+        .into_iter()
+        .any(|((xi, yi), (xj, yj), (xo, yo))| {
+            let (ex, ey) = (xj as i64 - xi as i64, yj as i64 - yi as i64);
+            let f = |x: i32, y: i32| ex * (y as i64 - yi as i64) - ey * (x as i64 - xi as i64);
+            let inside = f(xo, yo).signum();
+            inside != 0 && b.x.iter().zip(&b.y).all(|(&x, &y)| f(x, y) * inside <= 0)
+        })
 }
 
 /// Whether the projections of `a` and `b` may share a pixel centre (exact: a separating line
@@ -547,7 +563,7 @@ enum Order {
 fn div_round(num: i128, den: i128) -> i128 {
     // Callers divide by the gap between two plane distances of opposite sign, never 0 and far
     // below 2^126; 0 is the release fallback for that internal error (no panic path).
-    match (2 * num + den).checked_div_euclid(2 * den) {
+    match checked_div_euclid_i128(2 * num + den, 2 * den) {
         Some(q) => q,
         None => {
             debug_assert!(false, "internal error: {num} / {den}");
@@ -699,7 +715,7 @@ impl Sort<'_> {
         // `done <= j < len`, and list entries index the marks.
         // (Rotating only a non-empty run: no panic path.)
         if let Some(run @ [_, ..]) = self.list.get_mut(done..=j) {
-            run.rotate_right(1);
+            rotate_right_by_one(run);
         } else {
             debug_assert!(
                 false,
@@ -931,7 +947,7 @@ impl Sort<'_> {
             self.len += 1;
             // The list has room for every piece in the store, and the run is not empty.
             if let Some(run @ [_, ..]) = self.list.get_mut(pos..self.len) {
-                run.rotate_right(1);
+                rotate_right_by_one(run);
                 if let Some(first) = run.first_mut() {
                     *first = i as u16;
                 }
@@ -1127,11 +1143,11 @@ impl Cut {
         // (Checked divisions: the divisor is positive, so `None` only stands for no change.)
         if here >= 0 {
             // First column with slope·c + at0 < 0.
-            let first = at0.checked_div_euclid(-slope).map(|c| c + 1);
+            let first = checked_div_euclid_i128(at0, -slope).map(|c| c + 1);
             (true, first.filter(|_| slope < 0))
         } else {
             // First column with slope·c + at0 ≥ 0.
-            let first = at0.checked_div_euclid(slope).map(|c| -c);
+            let first = checked_div_euclid_i128(at0, slope).map(|c| -c);
             (false, first.filter(|_| slope > 0))
         }
     }
@@ -1443,7 +1459,11 @@ fn round_apart(t: &StoredTriangle, plane: &PlaneEq, parts: &Parts, grid: Grid) -
                 continue;
             }
             let d = |p: &[i32; 2], e: FineXy| {
-                let [dx, dy] = [0, 1].map(|k| (((p[k] as i64) << FINE) - e[k]) as i128);
+                let ([px, py], [ex, ey]) = (*p, e);
+                let (dx, dy) = (
+                    (((px as i64) << FINE) - ex) as i128,
+                    (((py as i64) << FINE) - ey) as i128,
+                );
                 dx * dx + dy * dy
             };
             let distance = d(p1, e1) + d(p2, e2);
@@ -1520,7 +1540,7 @@ fn for_each_centre(region: &[FineXy], grid: Grid, mut f: impl FnMut(FineXy) -> b
                     (q[1] - p[1]) as i128,
                 );
                 let (num, den) = if den < 0 { (-num, -den) } else { (num, den) };
-                let floor = num.checked_div_euclid(den).unwrap_or(0) as i64;
+                let floor = checked_div_euclid_i128(num, den).unwrap_or(0) as i64;
                 (p[0] + floor, p[0] + floor + 1)
             };
             x0 = x0.min(lo);
@@ -1573,12 +1593,13 @@ impl Vertex {
     }
 
     fn of(t: &StoredTriangle, k: usize) -> Vertex {
+        // Checked lookups: `k` is below 3 at every call, which `opt-level = "z"` cannot see.
         Vertex {
             k,
-            x: t.x[k],
-            y: t.y[k],
-            q: t.q[k],
-            color: t.colors[k],
+            x: t.x.get(k).copied().unwrap_or(0),
+            y: t.y.get(k).copied().unwrap_or(0),
+            q: t.q.get(k).copied().unwrap_or(0),
+            color: t.colors.get(k).copied().unwrap_or(Rgb888::BLACK),
         }
     }
 

@@ -731,7 +731,8 @@ impl<P: RowPixel, S: Shading, const SUB: u32> Subdivision<'_, P, S, SUB> {
 /// Sub-pixel `(x, y)` of a kept piece's vertices.
 #[inline]
 fn xy(t: &StoredTriangle) -> [(i32, i32); 3] {
-    [0, 1, 2].map(|k| (t.x[k], t.y[k]))
+    let ([x0, x1, x2], [y0, y1, y2]) = (t.x, t.y);
+    [(x0, y0), (x1, y1), (x2, y2)]
 }
 
 /// How piece `t` meets window `win`, by the exact coverage of the window's centres.

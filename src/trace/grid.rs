@@ -65,7 +65,7 @@ impl GridShape {
         }
         let span = hi.sub(lo);
         let count = |extent: I16F16| -> Result<u16, GridError> {
-            let n = extent.to_bits() / cell.to_bits() + 1;
+            let n = extent.to_bits().checked_div(cell.to_bits()).unwrap_or(-1) + 1;
             u16::try_from(n)
                 .ok()
                 .filter(|n| *n >= 1 && *n <= MAX_CELLS_PER_AXIS)
@@ -90,8 +90,14 @@ impl GridShape {
             usize::from(self.dims.get(axis).copied().unwrap_or(1)),
         );
         let cell = self.cell.to_bits().max(1);
-        let at = |v: i32| ((v.saturating_sub(min)).max(0) / cell) as usize;
-        (at(lo).min(dim - 1), at(hi).min(dim - 1))
+        let at = |v: i32| {
+            (v.saturating_sub(min))
+                .max(0)
+                .checked_div(cell)
+                .unwrap_or(0) as usize
+        };
+        let last = dim.saturating_sub(1);
+        (at(lo).min(last), at(hi).min(last))
     }
 
     fn index(&self, c: [usize; 3]) -> usize {

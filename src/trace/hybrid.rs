@@ -22,6 +22,7 @@
 //! them; nothing is dropped silently.
 
 use crate::depth::DepthRow;
+use crate::math::zip3;
 use crate::sink::{Row, RowPixel, RowSink};
 use crate::trace::bvh::{self, heap_sort_by_key, PAD};
 use crate::trace::row_shadow::{padded_box, row_region, row_shadows, RowShadows, ShadowCandidate};
@@ -165,13 +166,18 @@ fn tangent_slopes(
 ) -> Option<(f32, f32)> {
     let length = libm::sqrtf(axis.iter().map(|a| a * a).sum());
     let a = axis.map(|v| v / length);
-    let sum = |f: &dyn Fn(usize) -> f32| (0..3).map(f).sum::<f32>();
-    let (cx, cz) = (sum(&|i| a[i] * c[i]), sum(&|i| forward[i] * c[i]));
+    // Σ_i p_i·q_i·w_i, summed in index order (no indexing: no bounds checks at any opt-level).
+    let sum = |p: [f32; 3], q: [f32; 3], w: [f32; 3]| {
+        let [t0, t1, t2] = zip3(zip3(p, q, |p, q| p * q), w, |pq, w| pq * w);
+        t0 + t1 + t2
+    };
+    let one = [1.0; 3];
+    let (cx, cz) = (sum(a, c, one), sum(forward, c, one));
     let r2 = radii.map(|r| r * r);
     let (saa, sff, saf) = (
-        sum(&|i| a[i] * a[i] * r2[i]),
-        sum(&|i| forward[i] * forward[i] * r2[i]),
-        sum(&|i| a[i] * forward[i] * r2[i]),
+        sum(a, a, r2),
+        sum(forward, forward, r2),
+        sum(a, forward, r2),
     );
     // m²·(cz² − Sff) − 2m·(cx·cz − Saf) + (cx² − Saa) = 0.
     let q = cz * cz - sff;

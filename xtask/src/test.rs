@@ -113,6 +113,11 @@ pub(crate) fn test() -> Result<(), String> {
         .chain(lean)
         .collect();
     build_firmware_examples("firmware", &examples)?;
+    // The same proof for size-optimised builds (`opt-level = "z"`, the lean profile), which
+    // leave closures out of line where the firmware profile inlines them and with them
+    // bounds checks the firmware profile proves away.
+    step("the panic-never link check again, size-optimised (the lean profile)");
+    build_firmware_examples("lean", &["panic_never"])?;
     package()?;
     finish_fuzz_build(fuzz_build)?;
     step("second stage: the firmware on QEMU against the host's renders, the examples, fuzzing");
