@@ -1038,6 +1038,48 @@ mod tests {
     use super::*;
 
     #[test]
+    fn checked_div_euclid_i128_is_the_standard_one() {
+        let mut rng = crate::test_rng::XorShift64::new(0x5bd1_e995_1234_5678);
+        let edges = [
+            i128::MIN,
+            i128::MIN + 1,
+            -7,
+            -2,
+            -1,
+            0,
+            1,
+            2,
+            7,
+            i128::MAX - 1,
+            i128::MAX,
+        ];
+        let mut values: std::vec::Vec<i128> = edges.to_vec();
+        for _ in 0..2_000 {
+            let wide = i128::from(rng.next_u64()) << 64 | i128::from(rng.next_u64());
+            values.push(wide >> (rng.next_u64() % 127));
+        }
+        for &n in &values {
+            for &d in values.iter().step_by(7).chain(&edges) {
+                assert_eq!(
+                    checked_div_euclid_i128(n, d),
+                    n.checked_div_euclid(d),
+                    "{n} / {d}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn zip3_pairs_in_order() {
+        let mut calls = std::vec::Vec::new();
+        let out = zip3([1, 2, 3], [10, 20, 30], |a, b| {
+            calls.push(a);
+            a * b
+        });
+        assert_eq!((out, calls.as_slice()), ([10, 40, 90], &[1, 2, 3][..]));
+    }
+
+    #[test]
     fn isqrt32_is_floor_sqrt() {
         // Every v below 2^20, every square and its neighbours, and a stride through the rest.
         let squares = (0u64..=65535).flat_map(|r| [r * r, (r * r).saturating_sub(1), r * r + 1]);

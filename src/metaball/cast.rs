@@ -863,7 +863,7 @@ mod tests {
                 }
                 steps += 1;
                 let linear = quotient(sample.g.abs(), sample.lipschitz).unwrap_or(Wide::MAX);
-                if h > linear * 4 {
+                if h > linear.saturating_mul(Wide::from_num(4)) {
                     longer += 1;
                 }
                 for k in 1..=256 {
