@@ -719,11 +719,8 @@ mod tests {
         }
     }
 
-    /// The bound along the ray never falls below the slope it bounds, sampled on random rays
-    /// through random balls, the edge of their influence included.
-    #[test]
-    fn lipschitz_along_the_ray_bounds_its_slope() {
-        let mut rng = XorShift64::new(0x1234_5678_9abc_def1);
+    /// A 64×64 camera 6 units from the origin, looking at it.
+    fn test_camera() -> MetaCamera {
         let camera = MetaCamera::new(
             [0.0, 0.0, 6.0],
             [0.0; 3],
@@ -737,6 +734,23 @@ mod tests {
         let Ok(camera) = camera else {
             panic!("camera");
         };
+        camera
+    }
+
+    /// A light from the eye's side.
+    fn test_light() -> Light {
+        let Ok(light) = Light::new([0.0, 0.0, 1.0], 0.2, 0.8) else {
+            panic!("light");
+        };
+        light
+    }
+
+    /// The bound along the ray never falls below the slope it bounds, sampled on random rays
+    /// through random balls, the edge of their influence included.
+    #[test]
+    fn lipschitz_along_the_ray_bounds_its_slope() {
+        let mut rng = XorShift64::new(0x1234_5678_9abc_def1);
+        let camera = test_camera();
         let mut tested = 0;
         for _ in 0..2_000 {
             let mut r = || unit(&mut rng) as f32;
@@ -801,22 +815,8 @@ mod tests {
     #[test]
     fn curved_step_passes_no_root() {
         let mut rng = XorShift64::new(0x0f1e_2d3c_4b5a_6978);
-        let camera = MetaCamera::new(
-            [0.0, 0.0, 6.0],
-            [0.0; 3],
-            [0.0, 1.0, 0.0],
-            60.0,
-            0.1,
-            20.0,
-            64,
-            64,
-        );
-        let Ok(camera) = camera else {
-            panic!("camera");
-        };
-        let Ok(light) = Light::new([0.0, 0.0, 1.0], 0.2, 0.8) else {
-            panic!("light");
-        };
+        let camera = test_camera();
+        let light = test_light();
         let (mut steps, mut longer) = (0, 0);
         for _ in 0..400 {
             let mut r = || unit(&mut rng) as f32;
@@ -889,18 +889,7 @@ mod tests {
     /// flat along the ray, so the curvature's step is many times the slope's.
     #[test]
     fn curved_step_crosses_a_tangent_graze() {
-        let Ok(camera) = MetaCamera::new(
-            [0.0, 0.0, 6.0],
-            [0.0; 3],
-            [0.0, 1.0, 0.0],
-            60.0,
-            0.1,
-            20.0,
-            64,
-            64,
-        ) else {
-            panic!("camera");
-        };
+        let camera = test_camera();
         let d = camera.direction(32, 32).map(|c| c.to_num::<f64>());
         let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         let unit_d = d.map(|c| c / length);
@@ -915,9 +904,7 @@ mod tests {
             &Ball::new(centre, 2.0, 1.0, Rgb888::BLACK),
             &camera,
         )];
-        let Ok(light) = Light::new([0.0, 0.0, 1.0], 0.2, 0.8) else {
-            panic!("light");
-        };
+        let light = test_light();
         let frame = Frame {
             balls: &balls,
             threshold: Wide::from_num(0.5),
