@@ -8,9 +8,11 @@
 //! cargo build --release --example panic_never --target riscv32imc-unknown-none-elf
 //! ```
 //!
-//! `cargo xtask test` builds it for all three targets, with the `firmware` profile and again
-//! with the size-optimised `lean` one (`opt-level = "z"`, which leaves closures out of line, and
-//! with them bounds checks, that `opt-level = 3` inlines and proves away). It covers what a firmware frame runs:
+//! `cargo xtask test` builds it for all three targets with the `firmware` profile, and for
+//! thumbv6m again with the size-optimised `lean` one (`opt-level = "z"`, which leaves closures
+//! out of line, and with them bounds checks, that `opt-level = 3` inlines and proves away; the
+//! other two targets link with it too: `cargo build -p scanline3d-firmware --profile lean
+//! --example panic_never --target …`). It covers what a firmware frame runs:
 //! scene and camera set-up, the vertex stage, clipping, projection, bucketing, the edge walk, the
 //! span z-buffer and the row sink, with the default arithmetic and the fast preset's narrow one,
 //! and every other hidden-surface method (`scanline3d::resolve`: band and full-frame z-buffer,

@@ -37,9 +37,18 @@ pub(crate) const LEAN_EXAMPLES: [&str; 5] = [
 /// build ends in a single-threaded link-time optimisation, so one cargo per target keeps both
 /// cores busy. Each build's output goes to a log beside its target directory, shown if it fails.
 pub(crate) fn build_firmware_examples(profile: &str, examples: &[&str]) -> Result<(), String> {
+    build_firmware_examples_on(&FIRMWARE.map(|(target, _)| target), profile, examples)
+}
+
+/// [`build_firmware_examples`] for some of the targets.
+pub(crate) fn build_firmware_examples_on(
+    targets: &[&str],
+    profile: &str,
+    examples: &[&str],
+) -> Result<(), String> {
     let started = std::time::Instant::now();
     let mut builds = Vec::new();
-    for (target, _) in FIRMWARE {
+    for &target in targets {
         let dir = firmware_target_dir(target);
         std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         let log_path = dir.with_extension("log");
