@@ -144,7 +144,7 @@ mod firmware {
         let rays = u64::from(stats.rays());
         let tests = u64::from(stats.intersection_tests);
         println!(
-            "frame {} hash {:08x} mode {} instructions {} instr_per_pixel {} instr_per_ray {} instr_per_test {} rays {} primary {} secondary {} shadow {} shadow_cache_hits {} tests {} tests_per_ray_x100 {} box_tests_per_ray_x100 {} fallback_rows {} shadow_fallback_rows {}",
+            "frame {} hash {:08x} mode {} instructions {} instr_per_pixel {} instr_per_ray {} instr_per_test {} rays {} primary {} secondary {} shadow {} shadow_cache_hits {} window_clear {} tests {} tests_per_ray_x100 {} box_tests_per_ray_x100 {} fallback_rows {} shadow_fallback_rows {}",
             frame,
             hash,
             mode,
@@ -157,6 +157,7 @@ mod firmware {
             stats.secondary_rays,
             stats.shadow_rays,
             stats.shadow_cache_hits,
+            stats.window_clear_rays,
             tests,
             tests * 100 / rays.max(1),
             u64::from(stats.box_tests) * 100 / rays.max(1),

@@ -154,6 +154,103 @@ impl TracedDraw {
         Some((text, Self::camera(d, case)))
     }
 
+    /// Case `case` of scenes like the classic: a square polygon floor (any orientation), up
+    /// to four bounded objects of every kind above it, one to three lights (point and
+    /// directional) and a camera looking down at it; `None` as for [`Self::case`]. The scene
+    /// the hybrid mode's shadow windows are for (`ShadowWindows` in the library).
+    pub fn floor_case(d: &mut Draw, case: usize) -> Option<(String, CameraSpec)> {
+        let scale = [1.0, 4.0, 16.0, 60.0][case % 4];
+        let xyz = |p: [f64; 3]| format!("{} {} {}", p[0], p[1], p[2]);
+        let unit = |d: &mut Draw| d.in_range(0.0, 1.0);
+        // The floor's normal (up, tilted at most about 45°) and two axes in its plane.
+        let tilt = [d.in_range(-0.7, 0.7), 1.0, d.in_range(-0.7, 0.7)];
+        let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let n = tilt.map(|c| c / len(tilt));
+        let a = {
+            let v = [n[1], -n[0], 0.0];
+            v.map(|c| c / len(v))
+        };
+        let b = [
+            n[1] * a[2] - n[2] * a[1],
+            n[2] * a[0] - n[0] * a[2],
+            n[0] * a[1] - n[1] * a[0],
+        ];
+        let at = |u: f64, v: f64, h: f64| -> [f64; 3] {
+            std::array::from_fn(|i| scale * (u * a[i] + v * b[i] + h * n[i]))
+        };
+        let mut text = format!("background 0.2 0.3 0.5\nambient {}\n", unit(d) * 0.5);
+        for k in 0..1 + case % 3 {
+            let intensity = d.in_range(0.2, 1.0);
+            let (u, v, h) = (
+                d.in_range(-1.5, 1.5),
+                d.in_range(-1.5, 1.5),
+                d.in_range(0.5, 3.0),
+            );
+            text += &if (case / 3 + k) % 3 == 2 {
+                let dir = [u, v, h];
+                format!(
+                    "light directional {} {intensity}\n",
+                    xyz(at(u, v, h).map(|c| c / scale / len(dir)))
+                )
+            } else {
+                format!("light point {} {intensity}\n", xyz(at(u, v, h)))
+            };
+        }
+        for (m, (kr, kt)) in [(0.0, 0.0), (0.8, 0.0), (0.1, 0.85)].iter().enumerate() {
+            text += &format!("material m{m} 0.9 0.5 0.3 0.3 0.7 {kr} {kt} glass\n");
+        }
+        text += "checker floor m0 m1 1\n";
+        // Counter-clockwise seen from the side n points to.
+        let corners: Vec<String> = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            .iter()
+            .map(|&(u, v)| xyz(at(u, v, 0.0)))
+            .collect();
+        text += &format!("polygon floor {}\n", corners.join(" "));
+        for object in 0..1 + (case / 4) % 4 {
+            let m = format!("m{}", object % 3);
+            let (u, v) = (d.in_range(-1.0, 1.0), d.in_range(-1.0, 1.0));
+            let r = d.in_range(0.05, 0.4);
+            let c = at(u, v, r + d.in_range(0.0, 1.0));
+            let s = r * scale;
+            text += &match (case + object) % 5 {
+                0 => format!("sphere {} {s} {m}\n", xyz(c)),
+                1 => format!("ellipsoid {} {s} {} {} {m}\n", xyz(c), s * 0.5, s * 1.5),
+                2 => format!(
+                    "box {} {} {m}\n",
+                    xyz(c.map(|x| x - s)),
+                    xyz(c.map(|x| x + s))
+                ),
+                3 => format!(
+                    "cylinder {} {} {} {m}\n",
+                    xyz(c),
+                    xyz(at(u, v, 2.0 * r)),
+                    s * 0.7
+                ),
+                _ => format!(
+                    "cone {} {s} {} 0 {m}\n",
+                    xyz(c),
+                    xyz(at(u, v + 0.2, 3.0 * r))
+                ),
+            };
+        }
+        let traced = TracedScene::parse(&text, Path::new("."), "random").ok()?;
+        FixedScene::new(&traced).ok()?;
+        let (u, v, h) = (
+            d.in_range(-2.0, 2.0),
+            d.in_range(-2.0, 2.0),
+            d.in_range(0.4, 3.0),
+        );
+        let camera = CameraSpec {
+            eye: at(u, v, h),
+            target: at(d.in_range(-0.3, 0.3), d.in_range(-0.3, 0.3), 0.0),
+            up: n,
+            fovy: d.in_range(20.0, 90.0),
+            near: 0.01 * scale,
+            far: 20.0 * scale,
+        };
+        Some((text, camera))
+    }
+
     /// A random camera for case `case`, at its scale.
     pub fn camera(d: &mut Draw, case: usize) -> CameraSpec {
         let scale = [1.0, 10.0, 100.0, 2000.0][case % 4];

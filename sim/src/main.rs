@@ -1047,7 +1047,7 @@ fn trace(a: TraceArgs) -> Result<(), String> {
             )?;
             let s = &f.stats;
             let summary = format!(
-                "{} objects, {} lights; fixed-point tracer{}: rays: {} primary, {} secondary, {} shadow ({} answered by the shadow cache); tests per ray ({:?}): {:.2} objects, {:.2} boxes, {:.2} grid cells; {} rays dropped (stack full); {} rows fell back to the pure primary search",
+                "{} objects, {} lights; fixed-point tracer{}: rays: {} primary, {} secondary, {} shadow ({} answered by the shadow cache, {} by the row's shadow windows); tests per ray ({:?}): {:.2} objects, {:.2} boxes, {:.2} grid cells; {} rays dropped (stack full); {} rows fell back to the pure primary search",
                 traced.objects.len(),
                 traced.lights.len(),
                 if hybrid { " (hybrid)" } else { "" },
@@ -1055,6 +1055,7 @@ fn trace(a: TraceArgs) -> Result<(), String> {
                 s.secondary_rays,
                 s.shadow_rays,
                 s.shadow_cache_hits,
+                s.window_clear_rays,
                 a.accel,
                 f64::from(s.intersection_tests) / f64::from(s.rays().max(1)),
                 f64::from(s.box_tests) / f64::from(s.rays().max(1)),

@@ -20,7 +20,7 @@ use heapless::{Vec, VecView};
 struct SortSpan<T> {
     l: i32,
     r: i32,
-    /// Depth at column `l` and per-column step, in [`Depth`] bits.
+    /// Depth at column `l` and per-column step, in [`Depth`](crate::depth::Depth) bits.
     q: i64,
     dq: i64,
     /// Position on the active list: on an exact depth tie the lower one wins. The background

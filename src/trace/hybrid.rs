@@ -25,11 +25,12 @@ use crate::depth::DepthRow;
 use crate::math::zip3;
 use crate::sink::{Row, RowPixel, RowSink};
 use crate::trace::bvh::{self, heap_sort_by_key, PAD};
-use crate::trace::row_shadow::{padded_box, row_region, row_shadows, RowShadows, ShadowCandidate};
+use crate::trace::row_shadow::{
+    ellipsoid_of, padded_box, row_region, row_shadows, shadow_windows, RowShadows, ShadowCandidate,
+};
 use crate::trace::shape::{Object, Shape};
 use crate::trace::tracer::{Nearest, PixelTrace, ShadowCache, TraceError, TraceStats, Tracer};
 use crate::trace::vector::Vec3;
-use fixed::types::{I16F16, I8F24};
 
 /// Pixels added on each side of a projected box: covers the truncation to whole pixels and the
 /// rounding of ray directions and of the projection (f32, relative error near 2^-20).
@@ -141,18 +142,6 @@ impl Scan<'_> {
     }
 }
 
-/// A sphere's or an ellipsoid's centre and semi-axes widened by [`PAD`] (world units, f32);
-/// `None` for the other shapes.
-fn ellipsoid_of(shape: &Shape<'_>) -> Option<([f32; 3], [f32; 3])> {
-    let (centre, radii) = match shape {
-        Shape::Sphere(s) => (s.centre, [s.radius; 3]),
-        Shape::Ellipsoid(e) => (e.centre, [e.radii.x, e.radii.y, e.radii.z]),
-        _ => return None,
-    };
-    let f = |v: I16F16| v.saturating_add(PAD).to_num::<f32>();
-    Some((centre.bits().map(|c| c as f32 / 65536.0), radii.map(f)))
-}
-
 /// The range of `X / Z` over an axis-aligned ellipsoid centred `c` (relative to the eye) with
 /// semi-axes `radii`, wholly in front of the eye (`Z = p·forward > 0` on it), where
 /// `X = p·axis / |axis|`: the slopes `m` of the two planes `X = m·Z` tangent to it, which
@@ -247,8 +236,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     pub fn screen_bounds(&self, bounds: &mut [ScreenBound]) -> (usize, bool) {
         let camera = self.camera();
         let (w, h) = (camera.width, camera.height);
-        let f = |v: [I8F24; 3]| v.map(|c| c.to_num::<f32>());
-        let (corner, right, down) = (f(camera.corner), f(camera.right), f(camera.down));
+        let [corner, right, down, eye] = camera.float_basis();
         let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
         // The view direction: the direction through the image centre.
         let (hw, hh) = (f32::from(w - 1) / 2.0, f32::from(h - 1) / 2.0);
@@ -256,7 +244,6 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         let (rr, dd) = (dot(right, right), dot(down, down));
         let (cr, cd) = (dot(corner, right), dot(corner, down));
         let near = camera.near.to_num::<f32>() / 2.0;
-        let eye = camera.eye.bits().map(|c| c as f32 / 65536.0);
         let full = (0, w - 1, 0, h - 1);
         // The pixel rectangle of coordinate ranges, widened by the margin; `None` off screen.
         let rect_of = |x: (f32, f32), y: (f32, f32)| {
@@ -384,9 +371,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             return None;
         }
         let camera = self.camera();
-        let f = |v: [I8F24; 3]| v.map(|c| c.to_num::<f32>());
-        let (corner, right, down) = (f(camera.corner), f(camera.right), f(camera.down));
-        let eye = camera.eye.bits().map(|c| c as f32 / 65536.0);
+        let [corner, right, down, eye] = camera.float_basis();
         let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
         let cross = |a: [f32; 3], b: [f32; 3]| {
             [
@@ -473,9 +458,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             return Some(Some((lo, hi)));
         };
         let camera = self.camera();
-        let f = |v: [I8F24; 3]| v.map(|c| c.to_num::<f32>());
-        let (corner, right, down) = (f(camera.corner), f(camera.right), f(camera.down));
-        let eye = camera.eye.bits().map(|c| c as f32 / 65536.0);
+        let [corner, right, down, eye] = camera.float_basis();
         let n = normal.bits().map(|c| c as f32 / 65536.0);
         let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
         // The plane is n·p + offset = 0; along eye + t·dir, t = −(n·eye + offset) / (n·dir).
@@ -600,6 +583,19 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 if !same {
                     lists = Some(region.and_then(|region| row_shadows(scene, region, shadow)));
                 }
+            }
+            if let Some(Some(l)) = lists.as_mut() {
+                // Windows for the first hits on the row's first planar object (the floor, in
+                // most scenes).
+                let planar = live.iter().find(|b| {
+                    scene
+                        .objects
+                        .get(b.object as usize)
+                        .is_some_and(|o| o.shape.plane().is_some())
+                });
+                l.windows = planar.and_then(|b| {
+                    shadow_windows(scene, self.camera(), l, b.object, (b.x0, b.x1), y)
+                });
             }
             let row_lists = lists.as_ref().and_then(Option::as_ref);
             // Per active rectangle (the first four), the columns where its object's outline
@@ -763,17 +759,7 @@ mod tests {
         let grey = Colour::new([I16F16::from_num(0.5); 3]).unwrap();
         let materials = [Material::new(grey, [I16F16::ONE; 4], I16F16::ONE).unwrap()];
         let scene = Scene::new(&objects, &materials, &[], Colour::BLACK, I16F16::ZERO).unwrap();
-        let camera = TraceCamera::new(
-            [0.0, 3.0, 7.0],
-            [0.0, 0.8, 0.0],
-            [0.0, 1.0, 0.0],
-            50.0,
-            0.1,
-            100.0,
-            48,
-            48,
-        )
-        .unwrap();
+        let camera = TraceCamera::classic(48, 48);
         let tracer = Tracer::<4>::new(&scene, &camera, TraceOptions::default());
         check(&objects[0], &tracer, &camera);
     }

@@ -24,8 +24,8 @@
 
 use crate::trace::bvh::{self, heap_sort_by_key, PAD};
 use crate::trace::intersect::{meets_plane, Ray};
-use crate::trace::scene::{LightKind, Scene, MAX_LIGHTS};
-use crate::trace::shape::Object;
+use crate::trace::scene::{LightKind, Scene, TraceCamera, MAX_LIGHTS};
+use crate::trace::shape::{Object, Shape};
 use crate::trace::vector::Vec3;
 use fixed::types::I16F16;
 
@@ -50,6 +50,8 @@ pub(crate) struct RowShadows<'b> {
     candidates: &'b [ShadowCandidate],
     ranges: [(u16, u16); MAX_LIGHTS],
     region: Option<([i32; 3], [i32; 3])>,
+    /// The current row's windows, if it has them (set row by row).
+    pub(crate) windows: Option<ShadowWindows>,
 }
 
 impl<'b> RowShadows<'b> {
@@ -79,6 +81,328 @@ impl<'b> RowShadows<'b> {
     pub(crate) fn region(&self) -> Region {
         self.region
     }
+
+    /// The row's windows if they serve the first hit of column `x` on object `id`.
+    #[inline]
+    pub(crate) fn windows_at(&self, x: u16, id: u32) -> Option<&ShadowWindows> {
+        self.windows
+            .as_ref()
+            .filter(|w| w.object == id && x >= w.served.0 && x <= w.served.1)
+    }
+
+    /// Light `k`'s list.
+    fn list(&self, k: usize) -> &'b [ShadowCandidate] {
+        self.ranges
+            .get(k)
+            .and_then(|&(start, end)| self.candidates.get(usize::from(start)..usize::from(end)))
+            .unwrap_or(&[])
+    }
+}
+
+/// A window that rules out no column.
+const EVERY_COLUMN: (u16, u16) = (0, u16::MAX);
+
+/// Extra radius (world units) of a candidate's bounding sphere in [`shadow_windows`]: above
+/// the first hit's own error in the rows windows are made for (a direction rounded within
+/// 2^-14 rad over at most [`WINDOW_REACH`], divided by at least [`WINDOW_COSINE`]: below 2^-5)
+/// and the `f32` estimate's (a few 2^-20 relative).
+const WINDOW_PAD: f32 = 0.125;
+/// Farthest first hit on the plane (world units from the eye) a row may have for windows.
+const WINDOW_REACH: f32 = 64.0;
+/// Smallest cosine between a row's rays and the plane's normal for windows: grazing rows
+/// move their hits far for a small error of direction.
+const WINDOW_COSINE: f32 = 0.125;
+/// Columns a window is widened by on each side, for the `f32` roots it is bounded by.
+const WINDOW_MARGIN: f32 = 2.0;
+
+/// Hybrid mode's shadow windows for one row: for the first hits the row's rays make on one
+/// planar object, per light, the columns whose shadow ray towards the light may meet one of
+/// the light's candidates; from the other columns of [`served`](Self::served) no candidate
+/// can block it, and the ray is not tested at all.
+///
+/// The row's rays meet the plane at `p(x) = eye + t(x)·d(x)` with `d(x)` linear in the column
+/// `x` and `t(x) = num / k(x)`, `k(x) = normal · d(x)` linear too, so `k(x)·(p(x) − L)` is
+/// linear in `x`. A candidate lies in its own sphere (a sphere or an ellipsoid's largest) or
+/// in the sphere through its padded box's corners, widened by [`WINDOW_PAD`]; a shadow ray
+/// towards a point light `L` meets that sphere only from points inside the cone from `L`
+/// tangent to it (the nappe towards it), one along a directional light only from inside the
+/// cylinder along it. Both are convex, so the columns whose hits lie inside form an interval,
+/// bounded by the roots of a quadratic in `x` (times `k(x)²`) and, for the cone, of a linear
+/// one: solved in `f32`, widened by [`WINDOW_MARGIN`] columns. A light's window is the hull
+/// of its candidates' (every column when one is unbounded or planar: only the hit's own
+/// object, which its shadow rays never test, is left out). Only a speed-up: a ray outside
+/// the window is one the full search finds unblocked, so the pixels are the full search's
+/// (test `windows_keep_every_blocker`, and `trace_hybrid` in the sim suite).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ShadowWindows {
+    /// The planar object whose first hits the windows are for.
+    object: u32,
+    /// The columns the windows are for (inclusive).
+    served: (u16, u16),
+    /// Per light, its window (inclusive; `(1, 0)`: no column).
+    windows: [(u16, u16); MAX_LIGHTS],
+}
+
+impl ShadowWindows {
+    /// Whether no candidate can block the shadow ray towards light `k` from the first hit of
+    /// column `x` (one the windows serve, [`RowShadows::windows_at`]).
+    #[inline]
+    pub(crate) fn clear(&self, k: usize, x: u16) -> bool {
+        self.windows
+            .get(k)
+            .is_some_and(|&(first, last)| x < first || x > last)
+    }
+}
+
+/// The windows of row `y` for the first hits on planar object `id` in columns `served`, from
+/// the row's candidate `lists`; `None` when the row's hits on its plane are too far or too
+/// oblique (or the eye lies in the plane), so every shadow ray is tested.
+pub(crate) fn shadow_windows(
+    scene: &Scene<'_>,
+    camera: &TraceCamera,
+    lists: &RowShadows<'_>,
+    id: u32,
+    served: (u16, u16),
+    y: u16,
+) -> Option<ShadowWindows> {
+    let (normal, offset) = scene.objects.get(id as usize)?.shape.plane()?;
+    let [corner, right, down, eye] = camera.float_basis();
+    let n = normal.bits().map(|c| c as f32 / 65536.0);
+    let row = f32::from(y);
+    let through: [f32; 3] = core::array::from_fn(|i| corner[i] + row * down[i]);
+    let line = RowLine {
+        k: (dot(n, through), dot(n, right)),
+        num: -(dot(n, eye) + offset.to_num::<f32>()),
+        eye,
+        through,
+        right,
+    };
+    // A ray meeting the plane in front (t = num / k > 0) has k of num's sign.
+    if line.num == 0.0 {
+        return None;
+    }
+    let s = if line.num > 0.0 { 1.0 } else { -1.0 };
+    // Checked a column beyond each end of `served`: k (linear, of one sign there) over |d|
+    // (convex) is smallest at an end, t·|d| = num·|d| / k largest at one.
+    let range = (f32::from(served.0) - 1.0, f32::from(served.1) + 1.0);
+    for x in [range.0, range.1] {
+        let d: [f32; 3] = core::array::from_fn(|i| through[i] + x * right[i]);
+        let (k, len) = (s * (line.k.0 + line.k.1 * x), libm::sqrtf(dot(d, d)));
+        if !(k >= WINDOW_COSINE * len && s * line.num * len <= WINDOW_REACH * k) {
+            return None;
+        }
+    }
+    // The lists name every object that can block a ray from the row's region within reach
+    // (`RowShadows::for_ray`), so the windows may leave the others out: the row's first hits
+    // on a bounded planar object lie in its row box (`Tracer::row_box`), part of the region,
+    // and towards a point light they are within reach when both ends of the segment they lie
+    // on are (a light out of reach keeps every column).
+    let ends = [range.0, range.1].map(|x| {
+        let d: [f32; 3] = core::array::from_fn(|i| through[i] + x * right[i]);
+        let t = line.num / (line.k.0 + line.k.1 * x);
+        core::array::from_fn::<f32, 3, _>(|i| eye[i] + t * d[i])
+    });
+    let reach = POINT_LIGHT_REACH.to_num::<f32>() - 1.0;
+    let mut windows = [EVERY_COLUMN; MAX_LIGHTS];
+    for (k, (light, window)) in scene.lights.iter().zip(windows.iter_mut()).enumerate() {
+        if let LightKind::Point(p) = light.kind {
+            let l = p.bits().map(|c| c as f32 / 65536.0);
+            let far = |e: &[f32; 3]| {
+                let v: [f32; 3] = core::array::from_fn(|i| e[i] - l[i]);
+                dot(v, v) >= reach * reach
+            };
+            if ends.iter().any(far) {
+                continue;
+            }
+        }
+        // The hull of the candidates' windows, the hit's own object left out.
+        let mut hull = Some((u16::MAX, 0u16));
+        for c in lists.list(k).iter().filter(|c| c.object != id) {
+            let found = scene
+                .objects
+                .get(c.object as usize)
+                .and_then(|o| candidate_window(&line, &light.kind, o, range));
+            hull = hull.zip(found).map(|((a, b), (first, last))| {
+                // An empty window (1, 0) leaves the hull as it is.
+                if first > last {
+                    (a, b)
+                } else {
+                    (a.min(first), b.max(last))
+                }
+            });
+        }
+        *window = match hull {
+            Some((first, last)) if first > last => (1, 0),
+            Some(found) => found,
+            None => EVERY_COLUMN,
+        };
+    }
+    Some(ShadowWindows {
+        object: id,
+        served,
+        windows,
+    })
+}
+
+/// A row's rays and the plane they meet: `k(x) = k.0 + k.1·x` (the normal's dot product with
+/// the direction of column `x`, `through + x·right`) and `num` (`t(x) = num / k(x)`).
+struct RowLine {
+    k: (f32, f32),
+    num: f32,
+    eye: [f32; 3],
+    through: [f32; 3],
+    right: [f32; 3],
+}
+
+impl RowLine {
+    /// `k(x)·(p(x) − q) = a0 + x·a1` for a point `q`, with `p(x)` column `x`'s hit.
+    fn relative(&self, q: [f32; 3]) -> ([f32; 3], [f32; 3]) {
+        let (k0, k1, num) = (self.k.0, self.k.1, self.num);
+        (
+            core::array::from_fn(|i| k0 * (self.eye[i] - q[i]) + num * self.through[i]),
+            core::array::from_fn(|i| k1 * (self.eye[i] - q[i]) + num * self.right[i]),
+        )
+    }
+}
+
+/// The columns of `range` whose hits on the row's plane may have a shadow ray towards `light`
+/// that meets `object` ([`ShadowWindows`]); `None`: every column (an unbounded or planar
+/// object, a point light inside its sphere, no finite estimate).
+fn candidate_window(
+    line: &RowLine,
+    light: &LightKind,
+    object: &Object<'_>,
+    range: (f32, f32),
+) -> Option<(u16, u16)> {
+    // A sphere around the candidate: its own for a sphere or an ellipsoid, else the one
+    // through its padded box's corners.
+    let (centre, radius) = match ellipsoid_of(&object.shape) {
+        Some((centre, radii)) => (centre, radii[0].max(radii[1]).max(radii[2])),
+        None => {
+            let (lo, hi) = padded_box(object).filter(|_| object.shape.plane().is_none())?;
+            let centre: [f32; 3] =
+                core::array::from_fn(|i| (lo[i] as f32 + hi[i] as f32) / 131_072.0);
+            let half: [f32; 3] =
+                core::array::from_fn(|i| (hi[i] as f32 - lo[i] as f32) / 131_072.0);
+            (centre, libm::sqrtf(dot(half, half)))
+        }
+    };
+    let r2 = (radius + WINDOW_PAD) * (radius + WINDOW_PAD);
+    let s = if line.num > 0.0 { 1.0 } else { -1.0 };
+    match light {
+        LightKind::Point(p) => {
+            let l = p.bits().map(|c| c as f32 / 65536.0);
+            let axis: [f32; 3] = core::array::from_fn(|i| centre[i] - l[i]);
+            let dist2 = dot(axis, axis);
+            // The light inside the sphere (or no finite distance): every column.
+            if dist2.is_nan() || dist2 <= r2 {
+                return None;
+            }
+            let cos2 = 1.0 - r2 / dist2;
+            let inv = 1.0 / libm::sqrtf(dist2);
+            let u = axis.map(|c| c * inv);
+            let (a0, a1) = line.relative(l);
+            // (w·u)² ≥ cos²·|w|² and s·(w·u) ≥ 0 for w = k·(p − L).
+            let (e0, e1) = (dot(a0, u), dot(a1, u));
+            let q = [
+                e1 * e1 - cos2 * dot(a1, a1),
+                2.0 * (e0 * e1 - cos2 * dot(a0, a1)),
+                e0 * e0 - cos2 * dot(a0, a0),
+            ];
+            columns_where(q, Some([s * e0, s * e1]), range)
+        }
+        LightKind::Directional(dir) => {
+            let u = dir.bits().map(|c| c as f32 / 65536.0);
+            let (a0, a1) = line.relative(centre);
+            let (k0, k1) = line.k;
+            // |w|² − (w·u)² ≤ r²·k² for w = k·(p − centre).
+            let (e0, e1) = (dot(a0, u), dot(a1, u));
+            let q = [
+                r2 * k1 * k1 - (dot(a1, a1) - e1 * e1),
+                2.0 * (r2 * k0 * k1 - (dot(a0, a1) - e0 * e1)),
+                r2 * k0 * k0 - (dot(a0, a0) - e0 * e0),
+            ];
+            columns_where(q, None, range)
+        }
+    }
+}
+
+fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The columns of `range` where `q[0]·x² + q[1]·x + q[2] ≥ 0` and (with `linear`)
+/// `linear[0] + linear[1]·x ≥ 0` hold, widened by [`WINDOW_MARGIN`]: `(1, 0)` when none do,
+/// `None` when the coefficients are not finite. The conditions keep their signs between the
+/// roots, so a piece between two consecutive roots (or ends) holds where its middle does.
+fn columns_where(q: [f32; 3], linear: Option<[f32; 2]>, range: (f32, f32)) -> Option<(u16, u16)> {
+    if !q
+        .iter()
+        .chain(linear.iter().flatten())
+        .all(|c| c.is_finite())
+    {
+        return None;
+    }
+    let holds = |x: f32| {
+        (q[0] * x + q[1]) * x + q[2] >= 0.0 && linear.is_none_or(|l| l[0] + l[1] * x >= 0.0)
+    };
+    let mut points = [range.0, range.1, range.0, range.0, range.0];
+    let mut count = 2;
+    let mut add = |x: f32| {
+        if x > range.0 && x < range.1 {
+            if let Some(slot) = points.get_mut(count) {
+                *slot = x;
+                count += 1;
+            }
+        }
+    };
+    if q[0] != 0.0 {
+        let disc = q[1] * q[1] - 4.0 * q[0] * q[2];
+        if disc >= 0.0 {
+            // The root of the larger magnitude first, the other from the product of the two.
+            let t = -0.5 * (q[1] + libm::copysignf(libm::sqrtf(disc), q[1]));
+            add(t / q[0]);
+            if t != 0.0 {
+                add(q[2] / t);
+            }
+        }
+    } else if q[1] != 0.0 {
+        add(-q[2] / q[1]);
+    }
+    if let Some(l) = linear.filter(|l| l[1] != 0.0) {
+        add(-l[0] / l[1]);
+    }
+    let points = points.get_mut(..count).unwrap_or(&mut []);
+    // At most five: a bubble sort (no panic path, unlike the library's sorts).
+    for _ in 1..points.len() {
+        for i in 1..points.len() {
+            if let Some([a, b]) = points.get_mut(i - 1..=i) {
+                if *b < *a {
+                    core::mem::swap(a, b);
+                }
+            }
+        }
+    }
+    let (mut first, mut last) = (f32::MAX, f32::MIN);
+    let mut take = |a: f32, b: f32| (first, last) = (first.min(a), last.max(b));
+    for (i, &x) in points.iter().enumerate() {
+        if holds(x) {
+            take(x, x);
+        }
+        if let Some(&next) = points.get(i + 1) {
+            if holds((x + next) / 2.0) {
+                take(x, next);
+            }
+        }
+    }
+    if first > last {
+        return Some((1, 0));
+    }
+    // `as` saturates: below 0 gives 0, beyond u16::MAX gives u16::MAX.
+    Some((
+        libm::floorf(first - WINDOW_MARGIN) as u16,
+        libm::ceilf(last + WINDOW_MARGIN) as u16,
+    ))
 }
 
 /// The padded box of an object, raw I16F16 bits; `None` for an unbounded one.
@@ -89,6 +413,18 @@ pub(crate) fn padded_box(object: &Object<'_>) -> Option<([i32; 3], [i32; 3])> {
         z: PAD,
     };
     bvh::bounds(&object.shape).map(|(lo, hi)| (lo.sub(pad).bits(), hi.add(pad).bits()))
+}
+
+/// A sphere's or an ellipsoid's centre and semi-axes widened by [`PAD`] (world units, f32);
+/// `None` for the other shapes.
+pub(crate) fn ellipsoid_of(shape: &Shape<'_>) -> Option<([f32; 3], [f32; 3])> {
+    let (centre, radii) = match shape {
+        Shape::Sphere(s) => (s.centre, [s.radius; 3]),
+        Shape::Ellipsoid(e) => (e.centre, [e.radii.x, e.radii.y, e.radii.z]),
+        _ => return None,
+    };
+    let f = |v: I16F16| v.saturating_add(PAD).to_num::<f32>();
+    Some((centre.bits().map(|c| c as f32 / 65536.0), radii.map(f)))
 }
 
 /// A box of raw I16F16 bits (inclusive), `None`: empty.
@@ -147,6 +483,7 @@ pub(crate) fn row_shadows<'b>(
         candidates: out.get(..used)?,
         ranges,
         region,
+        windows: None,
     })
 }
 
@@ -377,6 +714,7 @@ mod tests {
             candidates: &candidates,
             ranges,
             region: Some(cube([0, 0, 0], 1)),
+            windows: None,
         };
         let point = LightKind::Point(Vec3::from_bits(0, 10 << 16, 0));
         let up = LightKind::Directional(Vec3::from_bits(0, 1 << 16, 0));
@@ -395,6 +733,107 @@ mod tests {
         assert_eq!(rows.for_ray(0, &point, outside, near), None);
         assert_eq!(rows.for_ray(0, &point, inside, POINT_LIGHT_REACH), None);
         assert_eq!(rows.for_ray(MAX_LIGHTS, &up, inside, near), None);
+    }
+
+    /// The classic scene's floor, spheres and lights (`sim/scenes/classic.scene`) plus a
+    /// directional light, at 240×240 from above: per pixel whose first hit is on the floor,
+    /// a shadow ray towards a light that some candidate blocks is in the light's window, and
+    /// the windows leave most of the unblocked rays out.
+    #[test]
+    fn windows_keep_every_blocker() {
+        use crate::trace::scene::{Colour, Light, Material};
+        use crate::trace::shape::{Polygon, Sphere};
+        use crate::trace::tracer::EPSILON;
+        let v = |x: f64, y: f64, z: f64| {
+            let f = |c: f64| I16F16::from_num(c);
+            Vec3 {
+                x: f(x),
+                y: f(y),
+                z: f(z),
+            }
+        };
+        let floor = [
+            v(-4.0, 0.0, -4.0),
+            v(-4.0, 0.0, 4.0),
+            v(4.0, 0.0, 4.0),
+            v(4.0, 0.0, -4.0),
+        ];
+        let sphere = |c: Vec3, r: f64| Object {
+            shape: Shape::Sphere(Sphere::new(c, I16F16::from_num(r)).unwrap()),
+            material: 0,
+        };
+        let objects = [
+            sphere(v(-1.1, 1.0, -0.5), 1.0),
+            sphere(v(1.2, 0.9, 1.0), 0.9),
+            Object {
+                shape: Shape::Polygon(Polygon::new(&floor).unwrap()),
+                material: 0,
+            },
+        ];
+        let intensity = I16F16::from_num(0.5);
+        let lights = [
+            Light::point(v(-4.0, 7.0, 5.0), intensity).unwrap(),
+            Light::point(v(5.0, 6.0, -2.0), intensity).unwrap(),
+            Light::directional(v(0.6, 0.8, 0.0), intensity).unwrap(),
+        ];
+        let grey = Colour::new([I16F16::from_num(0.5); 3]).unwrap();
+        let materials = [Material::new(grey, [I16F16::ONE; 4], I16F16::ONE).unwrap()];
+        let scene = Scene::new(&objects, &materials, &lights, Colour::BLACK, I16F16::ZERO).unwrap();
+        let (w, h) = (240, 240);
+        let camera = TraceCamera::classic(w, h);
+        let mut out = [ShadowCandidate::default(); 3 * 3];
+        let lists = row_shadows(&scene, Some(cube([0, 0, 0], 8)), &mut out).unwrap();
+        let floor = &objects[2];
+        let (mut rays, mut clear, mut blocked, mut unwindowed) = (0, 0, 0, 0);
+        for y in 0..h {
+            let windows = shadow_windows(&scene, &camera, &lists, 2, (0, w - 1), y);
+            let mut seen = false;
+            for x in 0..w {
+                let Some(dir) = camera.pixel_direction(x, y).normalized() else {
+                    continue;
+                };
+                let primary = Ray {
+                    origin: camera.eye,
+                    dir,
+                };
+                let Some(t) = floor.shape.hit(&primary, EPSILON, I16F16::MAX) else {
+                    continue;
+                };
+                let point = camera.eye.along(dir, t);
+                seen = true;
+                let Some(windows) = &windows else {
+                    continue;
+                };
+                for (k, light) in lights.iter().enumerate() {
+                    let (towards, distance) = match light.kind {
+                        LightKind::Directional(d) => (d, I16F16::MAX),
+                        LightKind::Point(p) => p.sub(point).normalized_with_length().unwrap(),
+                    };
+                    let ray = Ray {
+                        origin: point,
+                        dir: towards,
+                    };
+                    let blocks = lists.list(k).iter().filter(|c| c.object != 2).any(|c| {
+                        objects[c.object as usize]
+                            .shape
+                            .blocks(&ray, EPSILON, distance)
+                    });
+                    rays += 1;
+                    blocked += u32::from(blocks);
+                    if windows.clear(k, x) {
+                        clear += 1;
+                        assert!(!blocks, "({x}, {y}) light {k}: blocked outside the window");
+                    }
+                }
+            }
+            unwindowed += u32::from(seen && windows.is_none());
+        }
+        assert_eq!(unwindowed, 0, "rows that see the floor without windows");
+        assert!(blocked > 1_000, "{blocked} blocked");
+        assert!(
+            clear * 10 > (rays - blocked) * 6,
+            "{clear} of {rays} rays clear, {blocked} blocked"
+        );
     }
 
     #[test]

@@ -498,6 +498,23 @@ impl TraceCamera {
         })
     }
 
+    /// The camera in `f32` for the hybrid mode's per-frame and per-row estimates: the
+    /// directions through pixel (0, 0), one column right and one row down, and the eye.
+    pub(crate) fn float_basis(&self) -> [[f32; 3]; 4] {
+        let f = |v: [I8F24; 3]| v.map(|c| c.to_num::<f32>());
+        let eye = self.eye.bits().map(|c| c as f32 / 65536.0);
+        [f(self.corner), f(self.right), f(self.down), eye]
+    }
+
+    /// The classic scene's view (`sim/scenes/classic.scene`, its corpus camera "front") at
+    /// `width × height`, for tests.
+    #[cfg(test)]
+    pub(crate) fn classic(width: u16, height: u16) -> TraceCamera {
+        let view = ([0.0, 3.0, 7.0], [0.0, 0.8, 0.0], [0.0, 1.0, 0.0]);
+        TraceCamera::new(view.0, view.1, view.2, 50.0, 0.1, 100.0, width, height)
+            .expect("the classic view is valid")
+    }
+
     /// The direction through the centre of pixel (`column`, `row`), not normalised: its
     /// component along the view direction is 1. Raw I16F16 bits.
     #[inline]

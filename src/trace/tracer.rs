@@ -28,7 +28,7 @@ use crate::depth::DepthRow;
 use crate::math::div_rem_u64_u32;
 use crate::sink::{Row, RowPixel, RowSink};
 use crate::trace::intersect::{reflect, Ray};
-use crate::trace::row_shadow::{any_blocks, RowShadows, ShadowCandidate};
+use crate::trace::row_shadow::{any_blocks, RowShadows, ShadowCandidate, ShadowWindows};
 use crate::trace::scene::{Colour, LightKind, Scene, TraceCamera, MAX_LIGHTS};
 use crate::trace::vector::{mul, narrow_bits, sqrt, wide, Vec3};
 use embedded_graphics::pixelcolor::Rgb888;
@@ -89,6 +89,9 @@ pub struct TraceStats {
     /// Shadow rays answered by the shadow cache: the object that blocked the previous shadow
     /// ray towards the same light blocked this one too (one test instead of a walk).
     pub shadow_cache_hits: u32,
+    /// Hybrid mode: shadow rays from a row's first hits on its plane that the row's shadow
+    /// windows found clear (no object can block them: no test).
+    pub window_clear_rays: u32,
     /// Hybrid mode: rows whose primary visibility fell back to the pure tracer's search because
     /// the screen-bound buffer or the active list was full (same image, more work).
     pub fallback_rows: u16,
@@ -121,6 +124,7 @@ impl TraceStats {
         self.grid_cells += o.grid_cells;
         self.dropped_rays += o.dropped_rays;
         self.shadow_cache_hits += o.shadow_cache_hits;
+        self.window_clear_rays += o.window_clear_rays;
         self.fallback_rows += o.fallback_rows;
         self.shadow_fallback_rows += o.shadow_fallback_rows;
         self.walked_primary_rays += o.walked_primary_rays;
@@ -417,8 +421,21 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             match hit {
                 None => add_weighted(&mut sum, &self.scene.background, ray.weight),
                 Some(hit) => {
-                    let (shadow, material) =
-                        self.shade(&ray, hit, &mut sum, &mut stack, cache, row_shadows, stats);
+                    // The row's shadow windows serve the first hits of its pixels only.
+                    let windows = row_shadows
+                        .filter(|_| is_primary)
+                        .and_then(|r| r.windows_at(column, hit.object))
+                        .map(|w| (w, column));
+                    let (shadow, material) = self.shade(
+                        &ray,
+                        hit,
+                        windows,
+                        &mut sum,
+                        &mut stack,
+                        cache,
+                        row_shadows,
+                        stats,
+                    );
                     if is_primary {
                         out.id = Some(hit.object);
                         out.depth = hit.t.checked_div(len).unwrap_or(I16F16::MAX);
@@ -585,7 +602,8 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
 
     /// Adds the local term at `hit` times the ray's weight to `sum`, pushes the reflected and
     /// refracted rays the rules allow, and returns the shadow mask at the hit and the index of
-    /// the material there.
+    /// the material there. `windows`: the row's shadow windows and the pixel's column, when
+    /// they serve this hit (a pixel's first hit in hybrid mode, [`RowShadows::windows_at`]).
     // The per-pixel state a ray adds to (colour sum, ray stack, shadow cache, the row's
     // shadow candidates, counts), each borrowed apart.
     #[allow(clippy::too_many_arguments)]
@@ -593,6 +611,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
         &self,
         pending: &Pending,
         hit: Hit,
+        windows: Option<(&ShadowWindows, u16)>,
         sum: &mut Colour,
         stack: &mut heapless::Vec<Pending, STACK>,
         cache: &mut ShadowCache,
@@ -632,9 +651,19 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                     origin: point,
                     dir: towards,
                 };
-                let candidates =
-                    row_shadows.and_then(|r| r.for_ray(k, &light.kind, point, distance));
-                !self.blocked(&shadow_ray, hit.object, distance, cached, candidates, stats)
+                // Outside its light's window nothing can block the ray: no test.
+                let clear = match windows {
+                    Some((w, x)) if w.clear(k, x) => {
+                        stats.window_clear_rays += 1;
+                        true
+                    }
+                    _ => false,
+                };
+                clear || {
+                    let candidates =
+                        row_shadows.and_then(|r| r.for_ray(k, &light.kind, point, distance));
+                    !self.blocked(&shadow_ray, hit.object, distance, cached, candidates, stats)
+                }
             };
             if lit {
                 diffuse = diffuse.saturating_add(mul(nl, light.intensity));

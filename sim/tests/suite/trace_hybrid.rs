@@ -131,6 +131,38 @@ fn every_search_gives_the_same_frame_on_random_scenes() {
     );
 }
 
+/// The row's shadow windows (`row_shadow::ShadowWindows`) answer a shadow ray without a test
+/// only where no object can block it: on random scenes of objects over a polygon floor (what
+/// they are for), the hybrid mode's frames equal the pure tracer's, and many shadow rays were
+/// answered by the windows.
+#[test]
+fn shadow_windows_change_no_pixel_on_random_scenes() {
+    let mut d = Draw::new(0x9e37_79b9_7f4a_7c15);
+    let (mut frames, mut clear) = (0, 0u64);
+    for case in 0..2_000usize {
+        let Some((text, cam)) = TracedDraw::floor_case(&mut d, case) else {
+            continue;
+        };
+        let parsed = TracedScene::parse(&text, Path::new("."), "random").unwrap();
+        let scene = fixed::FixedScene::new(&parsed).unwrap();
+        let options = fixed::options(1 + (case % 5) as u32, 1.0 / 256.0).unwrap();
+        let (w, h) = (24 + case % 41, 16 + (case / 3) % 29);
+        let render = |hybrid| fixed::render(&scene, &cam, w, h, options, fixed::Accel::Bvh, hybrid);
+        let Ok(pure) = render(false) else {
+            continue;
+        };
+        let hybrid = render(true).unwrap();
+        let what = format!("case {case}:\n{text}{cam:?} {w}x{h}");
+        assert_same_images(&pure, &hybrid, &what);
+        frames += 1;
+        clear += u64::from(hybrid.stats.window_clear_rays);
+    }
+    assert!(
+        frames > 1_900 && clear > 500_000,
+        "{frames} frames, {clear} clear shadow rays"
+    );
+}
+
 /// The shadow cache changes no pixel: each pixel traced with a cache of its own equals the
 /// frame traced with one cache kept from pixel to pixel, which answers some shadow rays with
 /// one test.
