@@ -114,6 +114,9 @@ const WINDOW_REACH: f32 = 64.0;
 const WINDOW_COSINE: f32 = 0.125;
 /// Columns a window is widened by on each side, for the `f32` roots it is bounded by.
 const WINDOW_MARGIN: f32 = 2.0;
+/// Most candidates a light may have for a window (a row computes one per candidate): lights
+/// with more, such as a mesh's, keep every column.
+const MAX_WINDOWED: usize = 16;
 
 /// Hybrid mode's shadow windows for one row: for the first hits the row's rays make on one
 /// planar object, per light, the columns whose shadow ray towards the light may meet one of
@@ -129,8 +132,8 @@ const WINDOW_MARGIN: f32 = 2.0;
 /// cylinder along it. Both are convex, so the columns whose hits lie inside form an interval,
 /// bounded by the roots of a quadratic in `x` (times `k(x)²`) and, for the cone, of a linear
 /// one: solved in `f32`, widened by [`WINDOW_MARGIN`] columns. A light's window is the hull
-/// of its candidates' (every column when one is unbounded or planar: only the hit's own
-/// object, which its shadow rays never test, is left out). Only a speed-up: a ray outside
+/// of its candidates' (every column when one is unbounded or planar, the hit's own object
+/// excepted, which its shadow rays never test, or when it has more than [`MAX_WINDOWED`]). Only a speed-up: a ray outside
 /// the window is one the full search finds unblocked, so the pixels are the full search's
 /// (test `windows_keep_every_blocker`, and `trace_hybrid` in the sim suite).
 #[derive(Clone, Copy, Debug)]
@@ -215,21 +218,27 @@ pub(crate) fn shadow_windows(
                 continue;
             }
         }
-        // The hull of the candidates' windows, the hit's own object left out.
+        let list = lists.list(k);
+        if list.len() > MAX_WINDOWED {
+            continue;
+        }
+        // The hull of the candidates' windows, the hit's own object left out; one candidate
+        // without a window leaves every column.
         let mut hull = Some((u16::MAX, 0u16));
-        for c in lists.list(k).iter().filter(|c| c.object != id) {
+        for c in list.iter().filter(|c| c.object != id) {
             let found = scene
                 .objects
                 .get(c.object as usize)
                 .and_then(|o| candidate_window(&line, &light.kind, o, range));
-            hull = hull.zip(found).map(|((a, b), (first, last))| {
+            hull = match (hull, found) {
                 // An empty window (1, 0) leaves the hull as it is.
-                if first > last {
-                    (a, b)
-                } else {
-                    (a.min(first), b.max(last))
+                (Some(h), Some((first, last))) if first > last => Some(h),
+                (Some((a, b)), Some((first, last))) => Some((a.min(first), b.max(last))),
+                _ => {
+                    hull = None;
+                    break;
                 }
-            });
+            };
         }
         *window = match hull {
             Some((first, last)) if first > last => (1, 0),
@@ -274,12 +283,15 @@ fn candidate_window(
     object: &Object<'_>,
     range: (f32, f32),
 ) -> Option<(u16, u16)> {
+    if object.shape.plane().is_some() {
+        return None;
+    }
     // A sphere around the candidate: its own for a sphere or an ellipsoid, else the one
     // through its padded box's corners.
     let (centre, radius) = match ellipsoid_of(&object.shape) {
         Some((centre, radii)) => (centre, radii[0].max(radii[1]).max(radii[2])),
         None => {
-            let (lo, hi) = padded_box(object).filter(|_| object.shape.plane().is_none())?;
+            let (lo, hi) = padded_box(object)?;
             let centre: [f32; 3] =
                 core::array::from_fn(|i| (lo[i] as f32 + hi[i] as f32) / 131_072.0);
             let half: [f32; 3] =
