@@ -154,8 +154,8 @@ impl TracedDraw {
         Some((text, Self::camera(d, case)))
     }
 
-    /// Case `case` of scenes like the classic: a square polygon floor (any orientation), up
-    /// to four bounded objects of every kind above it, one to three lights (point and
+    /// Case `case` of scenes like the classic: a square polygon floor (tilted up to about
+    /// 45°), up to four bounded objects of every kind above it, one to three lights (point and
     /// directional) and a camera looking down at it; `None` as for [`Self::case`]. The scene
     /// the hybrid mode's shadow windows are for (`ShadowWindows` in the library).
     pub fn floor_case(d: &mut Draw, case: usize) -> Option<(String, CameraSpec)> {
