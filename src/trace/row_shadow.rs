@@ -186,25 +186,23 @@ pub(crate) fn shadow_windows(
     }
     let s = if line.num > 0.0 { 1.0 } else { -1.0 };
     // Checked a column beyond each end of `served`: k (linear, of one sign there) over |d|
-    // (convex) is smallest at an end, t·|d| = num·|d| / k largest at one.
+    // (convex) is smallest at an end, t·|d| = num·|d| / k largest at one. The hits lie on the
+    // segment between the ends' hits.
     let range = (f32::from(served.0) - 1.0, f32::from(served.1) + 1.0);
-    for x in [range.0, range.1] {
+    let mut ends = [[0.0f32; 3]; 2];
+    for (x, end) in [range.0, range.1].into_iter().zip(ends.iter_mut()) {
         let d: [f32; 3] = core::array::from_fn(|i| through[i] + x * right[i]);
         let (k, len) = (s * (line.k.0 + line.k.1 * x), libm::sqrtf(dot(d, d)));
         if !(k >= WINDOW_COSINE * len && s * line.num * len <= WINDOW_REACH * k) {
             return None;
         }
+        *end = core::array::from_fn(|i| eye[i] + s * line.num / k * d[i]);
     }
     // The lists name every object that can block a ray from the row's region within reach
     // (`RowShadows::for_ray`), so the windows may leave the others out: the row's first hits
     // on a bounded planar object lie in its row box (`Tracer::row_box`), part of the region,
-    // and towards a point light they are within reach when both ends of the segment they lie
-    // on are (a light out of reach keeps every column).
-    let ends = [range.0, range.1].map(|x| {
-        let d: [f32; 3] = core::array::from_fn(|i| through[i] + x * right[i]);
-        let t = line.num / (line.k.0 + line.k.1 * x);
-        core::array::from_fn::<f32, 3, _>(|i| eye[i] + t * d[i])
-    });
+    // and towards a point light they are within reach when both ends of their segment are
+    // (a light out of reach keeps every column).
     let reach = POINT_LIGHT_REACH.to_num::<f32>() - 1.0;
     let mut windows = [EVERY_COLUMN; MAX_LIGHTS];
     for (k, (light, window)) in scene.lights.iter().zip(windows.iter_mut()).enumerate() {
