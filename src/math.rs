@@ -309,6 +309,33 @@ fn shr_i64_in_words(v: i64, s: u32) -> i64 {
     ((hi as i64) << 32) | shr_low_word_in_words(v, s) as u32 as i64
 }
 
+/// `v >> s` (logical, `s < 64`): as [`shr_i64`], from the two 32-bit words of `v` on cores
+/// without a wide multiply, elsewhere the 64-bit shift. The same value either way (test
+/// `shifts_in_words_are_exact`).
+#[inline]
+pub(crate) fn shr_u64(v: u64, s: u32) -> u64 {
+    if NO_WIDE_MULTIPLY {
+        shr_u64_in_words(v, s)
+    } else {
+        v >> (s & 63)
+    }
+}
+
+/// [`shr_u64`] in 32-bit shifts, on every target (tested on the host too).
+#[inline]
+fn shr_u64_in_words(v: u64, s: u32) -> u64 {
+    let (hi, lo) = ((v >> 32) as u32, v as u32);
+    let s = s & 63;
+    let (hi, lo) = if s >= 32 {
+        (0, hi >> (s - 32))
+    } else if s == 0 {
+        (hi, lo)
+    } else {
+        (hi >> s, lo >> s | hi << (32 - s))
+    };
+    (u64::from(hi) << 32) | u64::from(lo)
+}
+
 /// `(a · b) mod 2^64` for `0 <= b < 2^16`, as `a.wrapping_mul(b as i64)`: on cores without a
 /// wide multiply ([`NO_WIDE_MULTIPLY`]) from three 32-bit multiplies (`a`'s low word in two
 /// 16-bit halves and its high word, each times `b`, whose products fit 32 bits), elsewhere
@@ -837,6 +864,18 @@ pub(crate) fn bit_length_u64(v: u64) -> u32 {
     }
 }
 
+/// `v.leading_zeros()` for `v >= 1`: on ARMv6-M (no count-leading-zeros instruction, as for
+/// [`bit_length_u64`]) by [`normalize`]'s comparisons, elsewhere the instruction. The same
+/// either way (test `bit_length_is_64_minus_leading_zeros`).
+#[inline]
+pub(crate) fn leading_zeros_nonzero(v: u32) -> u32 {
+    if NO_HARDWARE_DIVIDE {
+        normalize(v).1
+    } else {
+        v.leading_zeros()
+    }
+}
+
 /// [`bit_length_u64`] from [`normalize`], on every target (tested on the host too).
 #[inline]
 fn bit_length_u64_in_words(v: u64) -> u32 {
@@ -1164,6 +1203,10 @@ mod tests {
             let x = rng.next_u64();
             let v = x >> (x % 64);
             assert_eq!(bit_length_u64_in_words(v), 64 - v.leading_zeros(), "{v}");
+            // `leading_zeros_nonzero`'s ARMv6-M form, on 32-bit values of every length.
+            let w = (v as u32).max(1);
+            assert_eq!(normalize(w).1, w.leading_zeros(), "{w}");
+            assert_eq!(leading_zeros_nonzero(w), w.leading_zeros(), "{w}");
         }
     }
 
@@ -1192,6 +1235,9 @@ mod tests {
                 assert_eq!(shr_low_word(v, s), (v >> s) as i32, "{v} >> {s}");
                 assert_eq!(shr_i64_in_words(v, s), v >> s, "{v} >> {s}");
                 assert_eq!(shr_i64(v, s), v >> s, "{v} >> {s}");
+                let u = v as u64;
+                assert_eq!(shr_u64_in_words(u, s), u >> s, "{u} >> {s}");
+                assert_eq!(shr_u64(u, s), u >> s, "{u} >> {s}");
             }
         }
     }

@@ -8,6 +8,7 @@
 //! on exact products and then divide in 32 bits ([`ratio16`], within 2^-25 relative); the
 //! other primitives' quotients are 64-bit integer divisions of raw bits.
 
+use crate::math::{mul_i64, mul_wide_u32};
 use crate::trace::shape::{AaBox, Ellipsoid, Facet, Frustum, Plane, Shape, Sphere};
 use crate::trace::vector::{mul, narrow, narrow_bits, ratio16, sqrt, wide, Vec3};
 use fixed::types::{I16F16, I32F32};
@@ -95,7 +96,7 @@ fn plane_t_in(
         // a u64, as does n · 2^16 for |n| < 2^47. A negative n gives t ≤ 0 < t_min.
         let (d, scaled) = (d as u64, (n as u64) << 16);
         let (lo, hi) = (t_min.to_bits() as u32, t_max.to_bits() as u32);
-        if n < 0 || scaled < u64::from(lo) * d || scaled >= u64::from(hi) * d {
+        if n < 0 || scaled < times_below_2_33(lo, d) || scaled >= times_below_2_33(hi, d) {
             return None;
         }
         // Inside the window: t without a 64-bit division (within 2^-25 relative, see
@@ -106,6 +107,19 @@ fn plane_t_in(
         return Some(I16F16::from_bits(t as i32));
     }
     quotient(-num, den).filter(|t| *t >= t_min && *t < t_max)
+}
+
+/// `a · d` for `d ≤ 2^33` and a product below 2^64: on ARMv6-M (no 32 × 32 → 64-bit
+/// multiply, `math::NO_WIDE_MULTIPLY`) from `d`'s low word's 32-bit multiplies and its high
+/// word (at most 2) times `a`, elsewhere the `u64` multiply. The same value either way (test
+/// `products_in_words_are_exact`).
+#[inline]
+fn times_below_2_33(a: u32, d: u64) -> u64 {
+    if crate::math::NO_WIDE_MULTIPLY {
+        mul_wide_u32(a, d as u32).wrapping_add(u64::from(a.wrapping_mul((d >> 32) as u32)) << 32)
+    } else {
+        u64::from(a) * d
+    }
 }
 
 fn plane(p: &Plane, ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
@@ -149,8 +163,9 @@ fn inside(vertices: &[Vec3], axis: u8, p: Vec3) -> bool {
         if (av > pv) != (bv > pv) {
             // p is left of the crossing point ⇔ (pu − au)(bv − av) < (pv − av)(bu − au), the
             // inequality flipping when bv < av.
-            let lhs = (pu - au) * (bv - av);
-            let rhs = (pv - av) * (bu - au);
+            // (`mul_i64`: 32-bit multiplies on ARMv6-M for differences that fit 32 bits.)
+            let lhs = mul_i64(pu - au, bv - av);
+            let rhs = mul_i64(pv - av, bu - au);
             if (bv > av && lhs < rhs) || (bv < av && lhs > rhs) {
                 inside = !inside;
             }
@@ -447,7 +462,9 @@ impl Shape<'_> {
         match self {
             Shape::Sphere(s) => {
                 let b = narrow(ray.dir.dot(ray.origin.sub(s.centre)))?;
-                let t = b.checked_mul_int(-2)?;
+                // −2b, or `None` outside the I16F16 range: in 64 bits, since a checked 32-bit
+                // product is a 64-bit multiply's library call on ARMv6-M.
+                let t = I16F16::from_bits(i32::try_from(-2 * i64::from(b.to_bits())).ok()?);
                 (t >= t_min && t < t_max).then_some(t)
             }
             Shape::Plane(_) | Shape::Polygon(_) | Shape::Triangle(_) => None,

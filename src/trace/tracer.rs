@@ -30,7 +30,7 @@ use crate::sink::{Row, RowPixel, RowSink};
 use crate::trace::intersect::{reflect, Ray};
 use crate::trace::row_shadow::{any_blocks, RowShadows, ShadowCandidate, ShadowWindows};
 use crate::trace::scene::{Colour, LightKind, Scene, TraceCamera, MAX_LIGHTS};
-use crate::trace::vector::{mul, narrow_bits, sqrt, wide, Vec3};
+use crate::trace::vector::{mul, mul_shr32, narrow_bits, sqrt, wide, Vec3};
 use embedded_graphics::pixelcolor::Rgb888;
 use fixed::types::{I16F16, I32F32};
 
@@ -721,8 +721,7 @@ pub fn refract(d: Vec3, n: Vec3, n1: I16F16, n2: I16F16) -> Option<Vec3> {
     // k = 1 − η²(1 − cos²θi): the squared cosine of the refracted angle.
     let sin2_i = I32F32::ONE - I32F32::from_bits(wide(cos_i.to_bits(), cos_i.to_bits()));
     let eta2 = I32F32::from_bits(wide(eta.to_bits(), eta.to_bits()));
-    let k = I32F32::ONE
-        - I32F32::from_bits(((eta2.to_bits() as i128 * sin2_i.to_bits() as i128) >> 32) as i64);
+    let k = I32F32::ONE - I32F32::from_bits(mul_shr32(eta2.to_bits(), sin2_i.to_bits()));
     if k < I32F32::ZERO {
         return None;
     }

@@ -12,7 +12,9 @@
 //! below one I16F16 step) and is checked: a value outside the I16F16 range is an error, never a
 //! wrapped number.
 
-use crate::math::div_rem_below;
+use crate::math::{
+    bit_length_u64, div_rem_below, leading_zeros_nonzero, mul_wide_u32, shr_low_word, shr_u64,
+};
 pub use crate::math::{isqrt32, isqrt32_bitwise, isqrt32_newton, wide_by_unsigned};
 use fixed::types::{I16F16, I32F32};
 
@@ -215,6 +217,32 @@ const fn wide_in_halves(a: i32, b: i32) -> i64 {
     (((ah * bh) as i64) << 32) + (cross << 16) + low
 }
 
+/// `(a · b) >> 32` truncated to 64 bits, exactly `((a as i128 * b as i128) >> 32) as i64` (the
+/// product of two I32F32 raw values, as I32F32): on ARMv6-M (no wide multiply, where the
+/// `i128` product is several library calls) from the 32-bit words, `a·b = ah·bh·2^64 +
+/// (ah·bl + al·bh)·2^32 + al·bl`, the last term's low word the only one the shift drops;
+/// elsewhere the `i128` product. Test `shifted_wide_products_are_exact`.
+#[inline]
+pub fn mul_shr32(a: i64, b: i64) -> i64 {
+    if crate::math::NO_WIDE_MULTIPLY {
+        mul_shr32_in_words(a, b)
+    } else {
+        ((a as i128 * b as i128) >> 32) as i64
+    }
+}
+
+/// [`mul_shr32`] from 32-bit words, on every target (tested on the host too).
+#[inline]
+fn mul_shr32_in_words(a: i64, b: i64) -> i64 {
+    let (ah, al) = ((a >> 32) as i32, a as u32);
+    let (bh, bl) = ((b >> 32) as i32, b as u32);
+    let high = (u64::from(ah.wrapping_mul(bh) as u32) << 32) as i64;
+    let low = (mul_wide_u32(al, bl) >> 32) as i64;
+    high.wrapping_add(wide_by_unsigned(ah, bl))
+        .wrapping_add(wide_by_unsigned(bh, al))
+        .wrapping_add(low)
+}
+
 /// An I32F32 narrowed to I16F16, or `None` outside the I16F16 range.
 #[inline]
 pub fn narrow(v: I32F32) -> Option<I16F16> {
@@ -325,7 +353,7 @@ pub const fn isqrt32_float(v: u32) -> u32 {
 /// (⌊√⌋) for a radicand below 1.0 (2^32 raw) and otherwise at most 2^k raw steps low,
 /// a relative error below 2^-15.
 #[inline]
-pub const fn sqrt(v: I32F32) -> I16F16 {
+pub fn sqrt(v: I32F32) -> I16F16 {
     let bits = v.to_bits();
     if bits <= 0 {
         return I16F16::ZERO;
@@ -336,10 +364,11 @@ pub const fn sqrt(v: I32F32) -> I16F16 {
         return I16F16::from_bits(root32(bits as u32) as i32);
     }
     // The smallest even shift that brings the radicand below 2^32 (2 to 32), from the high
-    // word alone: its 32 − lz bits rounded up to even.
-    let shift = (33 - high.leading_zeros()) & !1;
+    // word alone: its 32 − lz bits rounded up to even (`leading_zeros_nonzero` and
+    // `shr_low_word`: no library call on ARMv6-M for the count or the 64-bit shift).
+    let shift = (33 - leading_zeros_nonzero(high)) & !1;
     // root < 2^16 and shift / 2 ≤ 16: the product stays below 2^32.
-    let root = root32(((bits as u64) >> shift) as u32) << (shift / 2);
+    let root = root32(shr_low_word(bits, shift) as u32) << (shift / 2);
     if root > i32::MAX as u32 {
         I16F16::MAX
     } else {
@@ -426,33 +455,15 @@ pub fn reciprocal46_float(len: u32) -> Option<i64> {
 }
 
 /// ⌊2^62 / `l`⌋ for `l` in [2^30, 2^31) (so at most 2^32), exact, without a 64-bit division:
-/// a 32-bit division gives it to 14 bits, two Newton steps `r += r · (2^62 − l·r) / 2^62`
-/// (32 × 32 → 64-bit products, the second on the small remainder) bring it within a few
-/// units, and the remainder fixes the last ones.
+/// 2^62 = 2^30 · 2^32 with 2^30 < `l` makes the quotient fit 32 bits, so it is
+/// `math::div_rem_below`'s two 16-bit digits of 32-bit divisions (soft on ARMv6-M, by
+/// multiplies); `l` = 2^30 gives 2^32.
 #[inline]
 pub fn reciprocal62(l: u32) -> u64 {
-    let l64 = i64::from(l);
-    // ⌊(2^32 − 1) / (l >> 16)⌋ ≈ 2^48 / l within 2^-14 relative (either side); scaled to
-    // 2^62 / l it stays below 2^32.
-    let r0 = i64::from((u32::MAX / (l >> 16).max(1 << 14)).min(u32::MAX >> 14) << 14);
-    // err = 2^62 − l·r0, |err| < 2^49: the correction r0 · err / 2^62 from err and r0 with 29
-    // and 20 significant bits leaves r1 within 2^-27 relative, at most 2^6 units off.
-    let err = (1i64 << 62).wrapping_sub(l64 * r0);
-    let r1 = r0 + (((err >> 20) * (r0 >> 12)) >> 30);
-    // |err| < 2^37 now: the second correction is exact to a unit or two.
-    let err = (1i64 << 62).wrapping_sub(l64.wrapping_mul(r1));
-    let mut r = r1 + (((err >> 5) * (r1 >> 5)) >> 52);
-    // The last units: r·l ≤ 2^62 < (r + 1)·l.
-    let mut rem = (1i64 << 62).wrapping_sub(l64.wrapping_mul(r));
-    while rem < 0 {
-        r -= 1;
-        rem += l64;
+    if l <= 1 << 30 {
+        return 1 << 32;
     }
-    while rem >= l64 {
-        r += 1;
-        rem -= l64;
-    }
-    r as u64
+    u64::from(div_rem_below(1 << 30, 0, l).0)
 }
 
 /// ⌊n · 2^16 / d⌋ approximately, for `n` below 2^47 and `d` in (0, 2^34), without a 64-bit
@@ -465,16 +476,29 @@ pub fn ratio16(n: u64, d: u64) -> u64 {
     if n == 0 || d == 0 {
         return 0;
     }
-    // d ≈ D · 2^ds with D in [2^30, 2^31); n ≈ N · 2^ns with N below 2^32.
-    let ds = 33 - d.leading_zeros() as i32;
-    let big_d = if ds >= 0 { d >> ds } else { d << -ds } as u32;
-    let ns = (32 - n.leading_zeros() as i32).max(0);
-    let big_n = (n >> ns) as u32;
-    let product = u64::from(big_n) * reciprocal62(big_d); // ≈ N · 2^62 / D
-                                                          // n · 2^16 / d = N · 2^62 / D · 2^(ns + 16 − 62 − ds).
+    // d ≈ D · 2^ds with D in [2^30, 2^31); n ≈ N · 2^ns with N below 2^32. (The bit lengths,
+    // shifts and the product by `math`'s word forms: no library call on ARMv6-M.)
+    let ds = bit_length_u64(d) as i32 - 31;
+    let big_d = if ds >= 0 {
+        shr_low_word(d as i64, ds as u32) as u32
+    } else {
+        (d as u32) << -ds
+    };
+    let ns = (bit_length_u64(n) as i32 - 32).max(0);
+    let big_n = shr_low_word(n as i64, ns as u32) as u32;
+    // ≈ N · 2^62 / D; the reciprocal is 2^32 only for D = 2^30.
+    let product = match u32::try_from(reciprocal62(big_d)) {
+        Ok(r) => mul_wide_u32(big_n, r),
+        Err(_) => u64::from(big_n) << 32,
+    };
+    // n · 2^16 / d = N · 2^62 / D · 2^(ns + 16 − 62 − ds).
     let e = ns - ds - 46;
     if e <= 0 {
-        product.checked_shr((-e) as u32).unwrap_or(0)
+        if e <= -64 {
+            0
+        } else {
+            shr_u64(product, (-e) as u32)
+        }
     } else {
         product.checked_shl(e as u32).unwrap_or(u64::MAX)
     }
@@ -745,6 +769,48 @@ mod tests {
         };
         for v in wide_values() {
             assert_eq!(sqrt(I32F32::from_bits(v)).to_bits(), wide(v), "{v}");
+        }
+    }
+
+    #[test]
+    fn shifted_wide_products_are_exact() {
+        let mut rng = crate::test_rng::XorShift64::new(0x5851_f42d_4c95_7f2du64);
+        let edges = [
+            0i64,
+            1,
+            -1,
+            i64::MAX,
+            i64::MIN,
+            1 << 32,
+            -(1 << 32),
+            u32::MAX as i64,
+        ];
+        for k in 0..200_000u64 {
+            let (x, y) = (rng.next_u64(), rng.next_u64());
+            let (a, b) = match k % 3 {
+                0 => (x as i64, y as i64),
+                1 => ((x as i64) >> (y % 64), (y as i64) >> (x % 64)),
+                _ => (edges[(x % 8) as usize], (y as i64) >> (x % 64)),
+            };
+            let want = ((a as i128 * b as i128) >> 32) as i64;
+            assert_eq!(mul_shr32_in_words(a, b), want, "{a} · {b}");
+            assert_eq!(mul_shr32(a, b), want, "{a} · {b}");
+        }
+    }
+
+    #[test]
+    fn reciprocal62_is_the_exact_quotient() {
+        let mut rng = crate::test_rng::XorShift64::new(0x6a09_e667_f3bc_c908u64);
+        let edges = [
+            1u32 << 30,
+            (1 << 30) + 1,
+            (1 << 31) - 1,
+            (1 << 31) - 2,
+            3 << 29,
+        ];
+        let random = (0..200_000).map(|_| (1 << 30) | (rng.next_u64() as u32 >> 2));
+        for l in edges.into_iter().chain(random) {
+            assert_eq!(reciprocal62(l), (1u64 << 62) / u64::from(l), "{l}");
         }
     }
 
