@@ -110,16 +110,23 @@ fn plane_t_in(
 }
 
 /// `a · d` for `d ≤ 2^33` and a product below 2^64: on ARMv6-M (no 32 × 32 → 64-bit
-/// multiply, `math::NO_WIDE_MULTIPLY`) from `d`'s low word's 32-bit multiplies and its high
-/// word (at most 2) times `a`, elsewhere the `u64` multiply. The same value either way (test
-/// `products_in_words_are_exact`).
+/// multiply, `math::NO_WIDE_MULTIPLY`) [`times_below_2_33_in_words`], elsewhere the `u64`
+/// multiply.
 #[inline]
 fn times_below_2_33(a: u32, d: u64) -> u64 {
     if crate::math::NO_WIDE_MULTIPLY {
-        mul_wide_u32(a, d as u32).wrapping_add(u64::from(a.wrapping_mul((d >> 32) as u32)) << 32)
+        times_below_2_33_in_words(a, d)
     } else {
         u64::from(a) * d
     }
+}
+
+/// [`times_below_2_33`] from `d`'s low word's 32-bit multiplies (`math::mul_wide_u32`) and its
+/// high word (at most 2) times `a`, on every target (test
+/// `window_products_in_words_are_exact`, on the host too).
+#[inline]
+fn times_below_2_33_in_words(a: u32, d: u64) -> u64 {
+    mul_wide_u32(a, d as u32).wrapping_add(u64::from(a.wrapping_mul((d >> 32) as u32)) << 32)
 }
 
 fn plane(p: &Plane, ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
@@ -674,6 +681,28 @@ mod tests {
         }
     }
     const FAR: I16F16 = I16F16::MAX;
+
+    #[test]
+    fn window_products_in_words_are_exact() {
+        let mut rng = crate::test_rng::XorShift64::new(0x9b05_688c_2b3e_6c1fu64);
+        let edges = [0u64, 1, u32::MAX as u64, 1 << 32, (1 << 33) - 1, 1 << 33];
+        for k in 0..200_000u64 {
+            let (x, y) = (rng.next_u64(), rng.next_u64());
+            // t below 2^31 raw, d at most 2^33: the product fits a u64.
+            let a = (x as u32) >> 1 >> (y % 32);
+            let d = if k % 4 == 0 {
+                edges[(y % 6) as usize]
+            } else {
+                (y >> 31) >> (x % 34)
+            };
+            assert_eq!(
+                times_below_2_33_in_words(a, d),
+                u64::from(a) * d,
+                "{a} · {d}"
+            );
+            assert_eq!(times_below_2_33(a, d), u64::from(a) * d, "{a} · {d}");
+        }
+    }
 
     #[test]
     fn sphere_roots() {

@@ -479,6 +479,7 @@ pub fn ratio16(n: u64, d: u64) -> u64 {
     // d ≈ D · 2^ds with D in [2^30, 2^31); n ≈ N · 2^ns with N below 2^32. (The bit lengths,
     // shifts and the product by `math`'s word forms: no library call on ARMv6-M.)
     let ds = bit_length_u64(d) as i32 - 31;
+    // (`n` and `d` are below 2^63, so as `i64` they shift as they would unsigned.)
     let big_d = if ds >= 0 {
         shr_low_word(d as i64, ds as u32) as u32
     } else {
