@@ -755,14 +755,35 @@ fn add_weighted(sum: &mut Colour, c: &Colour, weight: I16F16) {
 /// Clamps each channel to [0, 1] and rounds `255·c` to nearest.
 #[inline]
 fn to_rgb888(c: &Colour) -> Rgb888 {
+    // On Armv7-M clamped to 2^16 − 1 raw rather than 2^16 (1.0): both round to 255, and the
+    // narrower clamp is one `usat` there (elsewhere it compiles to no fewer instructions).
+    const MAX: i32 = if cfg!(target_arch = "arm") && !crate::math::NO_WIDE_MULTIPLY {
+        0xFFFF
+    } else {
+        1 << 16
+    };
     let [r, g, b] =
-        c.0.map(|v| ((v.to_bits().clamp(0, 1 << 16) as u32 * 255 + (1 << 15)) >> 16) as u8);
+        c.0.map(|v| ((v.to_bits().clamp(0, MAX) as u32 * 255 + (1 << 15)) >> 16) as u8);
     Rgb888::new(r, g, b)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn channels_round_as_the_clamp_to_one_does() {
+        let one = |v: i32| ((v.clamp(0, 1 << 16) as u32 * 255 + (1 << 15)) >> 16) as u8;
+        // The Armv7-M form's clamp, checked here on the host.
+        let below_one = |v: i32| ((v.clamp(0, 0xFFFF) as u32 * 255 + (1 << 15)) >> 16) as u8;
+        let values = (-70_000..70_000).chain([i32::MIN, i32::MAX, 1 << 20, -(1 << 20)]);
+        for v in values {
+            let c = I16F16::from_bits(v);
+            let got = to_rgb888(&Colour([c, c, c]));
+            assert_eq!(got, Rgb888::new(one(v), one(v), one(v)), "{v}");
+            assert_eq!(below_one(v), one(v), "{v}");
+        }
+    }
 
     fn v(x: f32, y: f32, z: f32) -> Vec3 {
         Vec3 {
