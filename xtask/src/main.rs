@@ -109,7 +109,7 @@ fn main() -> ExitCode {
             Some(result) => result,
             None => {
                 eprintln!(
-                    "usage: cargo xtask test | package | firmware | trace | metaball | metaball-trade | patch | patch-trade | lean | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | profile trace [pure|hybrid] [TARGET] | profile patch [TARGET] | scene-ram SCENE [TARGET...] | speed [before|after|doc] | fuzz [SECONDS]"
+                    "usage: cargo xtask test | package | firmware | trace [alone] | metaball | metaball-trade | patch | patch-trade | lean | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | profile trace [pure|hybrid] [TARGET] | profile patch [TARGET] | scene-ram SCENE [TARGET...] | speed [before|after|doc] | fuzz [SECONDS]"
                 );
                 return ExitCode::from(2);
             }
@@ -140,6 +140,9 @@ fn host_task(task: &str) -> Option<Result<(), String>> {
     let result = match task {
         "test-targets" => test_targets(),
         "firmware" => install().and_then(|_| firmware()),
+        "trace" if std::env::args().nth(2).as_deref() == Some("alone") => {
+            install().and_then(|_| trace::trace_alone())
+        }
         "trace" => install().and_then(|_| trace::trace()),
         "lean" => install().and_then(|_| lean()),
         "metaball" => install().and_then(|_| metaball::metaball()),

@@ -1,6 +1,11 @@
 //! `cargo xtask trace`: the fixed-point tracer's firmware (`firmware/examples/trace.rs`, the
 //! classic scene at 240×240, pure and hybrid mode) on QEMU for every target, with its frame
 //! hashes checked against the host's fixed tracer rendering the same view.
+//!
+//! `cargo xtask trace alone`: the same with each mode in a firmware image of its own, as a
+//! user of one mode builds it: in the image of both, the two modes share the tracer's
+//! functions, which the compiler then keeps out of line where an image of one mode inlines
+//! them into its frame loop.
 
 use crate::*;
 
@@ -38,6 +43,13 @@ fn host_frame(hybrid: bool) -> Result<(u32, scanline3d::trace::TraceStats), Stri
 }
 
 pub(crate) fn trace() -> Result<(), String> {
+    let expected = host_hashes()?;
+    step("traced firmware for every target (a no-op when built)");
+    check_targets(&expected)
+}
+
+/// Host hashes of the firmware's frame, pure and hybrid.
+fn host_hashes() -> Result<Vec<u32>, String> {
     let mut expected = Vec::new();
     for (hybrid, mode) in [(false, "pure"), (true, "hybrid")] {
         let (hash, stats) = host_frame(hybrid)?;
@@ -49,7 +61,48 @@ pub(crate) fn trace() -> Result<(), String> {
         );
         expected.push(hash);
     }
-    step("traced firmware for every target (a no-op when built)");
+    Ok(expected)
+}
+
+/// `cargo xtask trace alone`: per target, each mode's frame from an image that renders it
+/// alone (`--cfg scanline3d_trace_only`), its hash checked against the host's, and how many
+/// times fewer instructions the hybrid frame takes.
+pub(crate) fn trace_alone() -> Result<(), String> {
+    let expected = host_hashes()?;
+    let mut summary = Vec::new();
+    for (target, machine) in FIRMWARE {
+        let mut counts = Vec::new();
+        for (mode, hash) in ["pure", "hybrid"].into_iter().zip(&expected) {
+            step(&format!(
+                "traced classic scene, {mode} frame alone, on QEMU {machine}, {target}"
+            ));
+            let cfgs = [format!("scanline3d_trace_only=\"{mode}\"")];
+            let elf = tradeoff::build_example_with_cfgs("trace", Some(target), &cfgs, None)?;
+            let out = tradeoff::run_on_qemu(target, &elf)?;
+            print!("{out}");
+            if frame_hashes(&out) != [*hash] {
+                return Err(format!(
+                    "{target}: the {mode} frame's hash differs from the host's {hash:08x}"
+                ));
+            }
+            counts.push(mean_frame_instructions(&out));
+        }
+        if let [pure, hybrid] = counts[..] {
+            summary.push(format!(
+                "{target}: each mode alone, pure {pure:.0} and hybrid {hybrid:.0} instructions a frame, hybrid {:.3}× fewer",
+                pure / hybrid
+            ));
+        }
+    }
+    println!();
+    for line in summary {
+        println!("{line}");
+    }
+    Ok(())
+}
+
+/// Builds the image of both modes for every target, runs it and checks its hashes.
+fn check_targets(expected: &[u32]) -> Result<(), String> {
     build_firmware_examples("firmware", &["trace"])?;
     for (target, machine) in FIRMWARE {
         step(&format!("traced classic scene on QEMU {machine}, {target}"));

@@ -110,7 +110,7 @@ pub(crate) fn build_example_with_cfgs(
 
 /// Runs a firmware ELF with the runner `.cargo/config.toml` gives for `target` (QEMU with a
 /// deterministic instruction clock); its standard output.
-fn run_on_qemu(target: &str, elf: &std::path::Path) -> Result<String, String> {
+pub(crate) fn run_on_qemu(target: &str, elf: &std::path::Path) -> Result<String, String> {
     run_on_qemu_with(target, elf, &[])
 }
 
