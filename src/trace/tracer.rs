@@ -388,7 +388,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             material: None,
         };
         let raw = self.camera.pixel_direction(column, row);
-        let Some((dir, len)) = raw.normalized_with_length() else {
+        let Some((dir, len)) = raw.normalized_with_length_inlined() else {
             return out;
         };
         // Eye depth = t / len (the raw direction has unit forward component).
@@ -514,7 +514,8 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     /// Whether object `id` blocks the shadow ray `ray` (which starts on object `from`) in
     /// `[EPSILON, t_max)` ([`Shape::blocks`](crate::trace::Shape::blocks); `t_max` = `I16F16::MAX` for a directional
     /// light).
-    #[inline]
+    // Inlined, as `shade` is (measured alike).
+    #[inline(always)]
     fn blocks(&self, id: u32, ray: &Ray, from: u32, t_max: I16F16) -> bool {
         let Some(object) = self.scene.objects.get(id as usize) else {
             return false;
@@ -607,6 +608,10 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
     // The per-pixel state a ray adds to (colour sum, ray stack, shadow cache, the row's
     // shadow candidates, counts), each borrowed apart.
     #[allow(clippy::too_many_arguments)]
+    // Inlined into each frame loop (pure, and the hybrid mode's two): out of line, as the
+    // compiler keeps it for several callers, every mode's frame took more instructions
+    // (`cargo xtask trace alone`, docs/tracing.md).
+    #[inline(always)]
     fn shade(
         &self,
         pending: &Pending,
@@ -640,7 +645,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 LightKind::Directional(d) => (d, I16F16::MAX),
                 LightKind::Point(p) => {
                     let v = p.sub(point);
-                    v.normalized_with_length()
+                    v.normalized_with_length_inlined()
                         .unwrap_or((Vec3::ZERO, I16F16::ZERO))
                 }
             };

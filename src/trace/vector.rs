@@ -165,6 +165,19 @@ impl Vec3 {
     /// self`), or `None` for a vector shorter than 2^-8: one square root for both.
     #[inline]
     pub fn normalized_with_length(self) -> Option<(Vec3, I16F16)> {
+        self.normalized_with_length_inlined()
+    }
+
+    /// [`normalized_with_length`](Self::normalized_with_length) inlined into its caller, for
+    /// the tracer's per-ray sites (the primary ray's direction, the light vector): the copies
+    /// there cost less than the calls, but on ARMv6-M (measured with `cargo xtask trace
+    /// alone`, docs/tracing.md).
+    #[cfg_attr(
+        not(all(target_arch = "arm", not(target_has_atomic = "32"))),
+        inline(always)
+    )]
+    #[cfg_attr(all(target_arch = "arm", not(target_has_atomic = "32")), inline)]
+    pub(crate) fn normalized_with_length_inlined(self) -> Option<(Vec3, I16F16)> {
         let len = sqrt(self.dot(self));
         normalize_by(self.bits(), len.to_bits()).map(|[x, y, z]| (Vec3::from_bits(x, y, z), len))
     }
