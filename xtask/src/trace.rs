@@ -85,11 +85,11 @@ pub(crate) fn trace_alone() -> Result<(), String> {
                     "{target}: the {mode} frame's hash differs from the host's {hash:08x}"
                 ));
             }
-            counts.push(mean_frame_instructions(&out));
+            counts.push((mean_frame_instructions(&out), text_bytes(&elf)?));
         }
-        if let [pure, hybrid] = counts[..] {
+        if let [(pure, pure_text), (hybrid, hybrid_text)] = counts[..] {
             summary.push(format!(
-                "{target}: each mode alone, pure {pure:.0} and hybrid {hybrid:.0} instructions a frame, hybrid {:.3}× fewer",
+                "{target}: each mode alone, pure {pure:.0} and hybrid {hybrid:.0} instructions a frame, hybrid {:.3}× fewer; .text {pure_text} B and {hybrid_text} B",
                 pure / hybrid
             ));
         }
@@ -115,6 +115,20 @@ fn check_targets(expected: &[u32]) -> Result<(), String> {
             ));
         }
         println!("traced frame hashes (pure, hybrid) equal the host's: {expected:08x?}");
+        println!(
+            "image of both modes: .text {} B",
+            text_bytes(&firmware_elf(target, "firmware", "trace"))?
+        );
     }
     Ok(())
+}
+
+/// Bytes of an ELF's `.text` section (the code).
+fn text_bytes(path: &std::path::Path) -> Result<u64, String> {
+    Ok(elf(path)?
+        .sections
+        .iter()
+        .filter(|s| s.0 == ".text")
+        .map(|s| s.1 as u64)
+        .sum())
 }
