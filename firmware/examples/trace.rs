@@ -52,9 +52,9 @@ mod firmware {
     use super::{arch, classic, row_count::RowCounted, view};
     use embedded_graphics::pixelcolor::Rgb565;
     use scanline3d::sink::HashSink;
-    use scanline3d::trace::{
-        Scene, ScreenBound, ShadowCandidate, TraceCamera, TraceOptions, TraceStats, Tracer,
-    };
+    use scanline3d::trace::{Scene, TraceCamera, TraceOptions, TraceStats, Tracer};
+    #[cfg(not(scanline3d_trace_only = "pure"))]
+    use scanline3d::trace::{ScreenBound, ShadowCandidate};
     use semihosting::println;
 
     use crate::measure::{self, _stack_start};

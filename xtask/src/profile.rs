@@ -120,6 +120,9 @@ struct Site {
     /// The function that frame is in, inlined or not, as [`function_name`] prints it (empty
     /// when none).
     function: String,
+    /// Where that function was inlined into its caller, as `path:line` (empty when it was not
+    /// inlined there or the caller lies outside this repository).
+    called_at: String,
     /// The outermost function inlined at the address (the one called in the symbol's own
     /// body; the symbol itself when nothing is inlined there).
     inlined: String,
@@ -188,22 +191,32 @@ fn source_lines(elf: &std::path::Path, addrs: &[u64]) -> Result<HashMap<u64, Sit
                 chain.push((function, lines.next().unwrap_or_default()));
             }
             // The innermost place in our sources, and the function it is in (inlined or not).
-            let ours = chain.iter().find_map(|(function, place)| {
+            let in_repo = |place: &str| {
                 place
                     .strip_prefix(&repo)
                     .filter(|p| p.starts_with("src/") || p.starts_with("firmware/examples/"))
-                    .map(|p| (p, *function))
-            });
+                    .map(str::to_string)
+            };
+            let ours = chain
+                .iter()
+                .enumerate()
+                .find_map(|(i, (function, place))| in_repo(place).map(|p| (i, p, *function)));
+            let called_at = ours
+                .as_ref()
+                .and_then(|(i, _, _)| chain.get(i + 1))
+                .and_then(|(_, place)| in_repo(place))
+                .unwrap_or_default();
             let outermost = chain.len().checked_sub(2).or(chain.len().checked_sub(1));
             let inlined = outermost.and_then(|i| chain.get(i)).map_or("?", |c| c.0);
-            let (line, function) = ours.map_or((String::new(), String::new()), |(p, f)| {
-                (p.to_string(), function_name(f))
+            let (line, function) = ours.map_or((String::new(), String::new()), |(_, p, f)| {
+                (p, function_name(f))
             });
             out.insert(
                 a,
                 Site {
                     line,
                     function,
+                    called_at,
                     inlined: inlined.to_string(),
                 },
             );
@@ -479,7 +492,13 @@ fn profile_elf(
     let mut by_line: HashMap<&str, u64> = HashMap::new();
     let mut by_function: HashMap<&str, u64> = HashMap::new();
     let mut by_inlined: HashMap<String, u64> = HashMap::new();
+    let mut by_call: HashMap<String, u64> = HashMap::new();
     for (site, n) in &c.per_site {
+        if let Some(s) = lines.get(site).filter(|s| !s.called_at.is_empty()) {
+            *by_call
+                .entry(format!("{} < {}", s.function, s.called_at))
+                .or_default() += n;
+        }
         let (line, function, inlined) = lines.get(site).map_or(("", "", "?"), |s| {
             (s.line.as_str(), s.function.as_str(), s.inlined.as_str())
         });
@@ -512,6 +531,14 @@ fn profile_elf(
     );
     for (function, n) in by_function.iter().take(40) {
         println!("{:6.2} %  {function}", percent(*n, total));
+    }
+    let mut by_call: Vec<_> = by_call.into_iter().collect();
+    by_call.sort_by_key(|l| std::cmp::Reverse(l.1));
+    println!(
+        "\nthose functions by the line they were inlined at (function < calling line), with the built-ins they call:"
+    );
+    for (call, n) in by_call.iter().take(40) {
+        println!("{:6.2} %  {call}", percent(*n, total));
     }
     let mut builtin_sites: HashMap<String, u64> = HashMap::new();
     for ((site, pc), n) in &c.builtin_site {
