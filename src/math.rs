@@ -905,6 +905,11 @@ pub(crate) fn fit_bits(v: [i64; 3], bits: u32) -> Option<[i32; 3]> {
     if max == 0 {
         return None;
     }
+    if max >> (bits - 1) == 1 {
+        // Already `bits` long (a vector fitted before, such as a face normal under the identity
+        // normal matrix): no shift, and no bit length to count (comparisons on ARMv6-M).
+        return Some(v.map(|c| c as i32));
+    }
     let len = bit_length_u64(max);
     Some(if len > bits {
         // |c >> s| <= 2^bits.
