@@ -446,11 +446,23 @@ pub(crate) fn lambert_i64(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
     }
     let square: u64 = s.iter().map(|&c| mul_wide(c, c) as u64).sum();
     // S < 3·2^60, so S' < 3·2^30; r >= 2^14 (S >= 2^58).
-    let r = isqrt32((square >> 30) as u32).max(1);
+    let (square_high, dot_high) = ((square >> 30) as u32, (dot >> 29) as u32);
     let a = if NO_HARDWARE_DIVIDE {
-        div_rem_u32_soft((dot >> 29) as u32, r).0
+        match root_and_quotient(square_high, dot_high) {
+            Some((_, a)) => a,
+            // Not met by any tested input (S' >= 2^28 here). Bounds that hold whatever the
+            // term: the caller takes the exact one.
+            None => {
+                return Some(Lambert {
+                    lo: 0,
+                    hi: i32::MAX,
+                    dot: dot as u64,
+                    square,
+                })
+            }
+        }
     } else {
-        (dot >> 29) as u32 / r
+        dot_high / isqrt32(square_high).max(1)
     };
     let lo = (a << 14).saturating_sub(a + 1);
     let hi = (a + 1).saturating_mul(1 << 14);
@@ -460,6 +472,80 @@ pub(crate) fn lambert_i64(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
         dot: dot as u64,
         square,
     })
+}
+
+/// `(⌊√x⌋, ⌊n / ⌊√x⌋⌋)` for `x` in `[2^28, 2^32)` from 32-bit multiplies alone, for cores
+/// without a divider: about 80 instructions where [`isqrt32_bitwise`] and the soft division
+/// take about 200 (ARMv6-M, the Lambert bounds of every lit face). An estimate `g ≈ 2^31 /
+/// √x4` of the reciprocal root of `x4 = x·4^e` in `[2^30, 2^32)` (a line on each half of the
+/// range, two Newton steps `g ← g·(3 − u·g²/2^46)/2` on `u = x4 / 2^16`) gives `√x4 ≈ u·g /
+/// 2^15`, one Newton step on the residual `x4 − s²` brings that within a unit or two, and the
+/// quotient is estimated from `g` and corrected by its remainder alike. Both are then checked
+/// exactly (`r² ≤ x < (r+1)²`, `0 ≤ n − a·r < r`) after at most three unit steps each; `None`
+/// if either is not reached (no `x` in range, tested), so a result is always exact. Tests
+/// `root_and_quotient_are_exact` and, over every `x`, `root_and_quotient_exhaustively`.
+#[inline]
+pub(crate) fn root_and_quotient(x: u32, n: u32) -> Option<(u32, u32)> {
+    if x < 1 << 28 {
+        return None;
+    }
+    let e = u32::from(x < 1 << 30); // x4 = x · 4^e, and ⌊√x⌋ = ⌊⌊√x4⌋ / 2^e⌋
+    let x4 = x << (2 * e);
+    let u = x4 >> 16; // in [2^14, 2^16)
+                      // g ≈ 2^23 / √u, in (2^15, 2^16]: each half's chord lowered by half its largest gap.
+    let mut g = if u >= 1 << 15 {
+        58_895 - ((u * 27_148) >> 16)
+    } else {
+        83_288 - ((u * 76_781) >> 16)
+    };
+    for _ in 0..2 {
+        // g < 2^16: g² fits; u·(g²/2^16) ≈ 2^30; g·(c/2^16) ≤ 2^16·3·2^14.
+        let t = (g * g) >> 16;
+        let c = (3u32 << 30).wrapping_sub(u.wrapping_mul(t));
+        g = (g.wrapping_mul(c >> 16) >> 15).min(65_535);
+    }
+    // s ≈ √x4 (u·g < 2^32), then s + (x4 − s²)/(2s) with 1/(2s) ≈ g / 2^32.
+    let s = (u * g) >> 15;
+    let residual = x4.wrapping_sub(s.wrapping_mul(s)) as i32;
+    let mut r4 = s.wrapping_add_signed((residual >> 6).wrapping_mul(g as i32) >> 26);
+    // ⌊√x4⌋ < 2^16: r4² fits, and x4 − r4² ≤ 2·r4 says (r4 + 1)² > x4.
+    let mut steps = 0;
+    while r4 > 65_535 || r4.wrapping_mul(r4) > x4 {
+        r4 = r4.wrapping_sub(1);
+        steps += 1;
+        if steps > 3 {
+            return None;
+        }
+    }
+    while x4 - r4 * r4 > 2 * r4 {
+        // (Below 2^16: x4 − 65,535² ≤ 2·65,535 ends the loop there.)
+        r4 += 1;
+        steps += 1;
+        if steps > 3 {
+            return None;
+        }
+    }
+    let r = r4 >> e;
+    // n / r ≈ n·g·2^e / 2^31 (r ≥ 2^14, so the quotient is below 2^18), then by the remainder.
+    let a = ((n >> 16) * g) >> (15 - e);
+    let rem = n.wrapping_sub(a.wrapping_mul(r)) as i32;
+    let mut a = a.wrapping_add_signed((rem >> 8).wrapping_mul(g as i32) >> (23 - e));
+    let mut rem = n.wrapping_sub(a.wrapping_mul(r)) as i32;
+    let mut steps = 0;
+    while rem < 0 || rem as u32 >= r {
+        if rem < 0 {
+            a = a.wrapping_sub(1);
+            rem = rem.wrapping_add(r as i32);
+        } else {
+            a += 1;
+            rem -= r as i32;
+        }
+        steps += 1;
+        if steps > 3 {
+            return None;
+        }
+    }
+    Some((r, a))
 }
 
 /// `n.div_euclid(d)` (the floor of `n / d`) for `d >= 1` (`d < 1` is taken as 1), through
@@ -1428,6 +1514,50 @@ mod tests {
             for n in 0..1 << 28 {
                 assert_eq!(div_rem_u32_soft(n, d), (n / d, n % d), "{n} / {d}");
             }
+        }
+    }
+
+    /// `root_and_quotient` against `isqrt` and `/`: every power of two and its neighbours in
+    /// range, the ends, random roots with numerators of every size; and the estimate path
+    /// answers every one (no `None`), which is what makes it the cheaper one.
+    #[test]
+    fn root_and_quotient_are_exact() {
+        let mut rng = crate::test_rng::XorShift64::new(0x3c6e_f372_fe94_f82bu64);
+        let mut xs: std::vec::Vec<u32> = (28..32)
+            .flat_map(|b| [(1u32 << b) - 1, 1 << b, (1 << b) + 1])
+            .chain([u32::MAX, u32::MAX - 1, 3 << 30])
+            .chain(
+                (1u32 << 14..=65_535)
+                    .step_by(7)
+                    .flat_map(|r| [r * r, r * r - 1, r * r + 2 * r]),
+            )
+            .filter(|&x| x >= 1 << 28)
+            .collect();
+        for _ in 0..300_000 {
+            // Uniform over [2^28, 2^32), and as many below 2^30 (the shifted half).
+            let x = (rng.next_u64() as u32) >> (rng.next_u64() % 4);
+            xs.push(x.max(1 << 28));
+        }
+        assert_eq!(root_and_quotient((1 << 28) - 1, 5), None);
+        for x in xs {
+            let r = x.isqrt();
+            let n = rng.next_u64() as u32;
+            for n in [n, n >> (n % 32), 0, u32::MAX, r - 1, r, r * (n % 1000)] {
+                assert_eq!(root_and_quotient(x, n), Some((r, n / r)), "{x} {n}");
+            }
+        }
+    }
+
+    /// Every `x` the root takes, each with a numerator near a multiple of the root: about three
+    /// minutes (`cargo test -p scanline3d --release --lib root_and_quotient -- --ignored`).
+    #[test]
+    #[ignore]
+    fn root_and_quotient_exhaustively() {
+        for x in 1u32 << 28..=u32::MAX {
+            let r = x.isqrt();
+            let n = x.rotate_left(7);
+            let n = n - n % r + (x % 3).saturating_sub(1) * (r - 1);
+            assert_eq!(root_and_quotient(x, n), Some((r, n / r)), "{x} {n}");
         }
     }
 
