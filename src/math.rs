@@ -475,8 +475,9 @@ pub(crate) fn lambert_i64(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
 }
 
 /// `(⌊√x⌋, ⌊n / ⌊√x⌋⌋)` for `x` in `[2^28, 2^32)` from 32-bit multiplies alone, for cores
-/// without a divider: about 80 instructions where [`isqrt32_bitwise`] and the soft division
-/// take about 200 (ARMv6-M, the Lambert bounds of every lit face). An estimate `g ≈ 2^31 /
+/// without a divider: on ARMv6-M, in the Lambert bounds of every lit face, about 200
+/// instructions fewer than [`isqrt32_bitwise`] and the soft division (corpus heightfield,
+/// `docs/speed.md` item 26). An estimate `g ≈ 2^31 /
 /// √x4` of the reciprocal root of `x4 = x·4^e` in `[2^30, 2^32)` (a line on each half of the
 /// range, two Newton steps `g ← g·(3 − u·g²/2^46)/2` on `u = x4 / 2^16`) gives `√x4 ≈ u·g /
 /// 2^15`, one Newton step on the residual `x4 − s²` brings that within a unit or two, and the
