@@ -477,14 +477,16 @@ pub(crate) fn lambert_i64(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
 /// `(⌊√x⌋, ⌊n / ⌊√x⌋⌋)` for `x` in `[2^28, 2^32)` from 32-bit multiplies alone, for cores
 /// without a divider: on ARMv6-M, in the Lambert bounds of every lit face, about 200
 /// instructions fewer than [`isqrt32_bitwise`] and the soft division (corpus heightfield,
-/// `docs/speed.md` item 26). An estimate `g ≈ 2^31 /
-/// √x4` of the reciprocal root of `x4 = x·4^e` in `[2^30, 2^32)` (a line on each half of the
-/// range, two Newton steps `g ← g·(3 − u·g²/2^46)/2` on `u = x4 / 2^16`) gives `√x4 ≈ u·g /
-/// 2^15`, one Newton step on the residual `x4 − s²` brings that within a unit or two, and the
-/// quotient is estimated from `g` and corrected by its remainder alike. Both are then checked
-/// exactly (`r² ≤ x < (r+1)²`, `0 ≤ n − a·r < r`) after at most three unit steps each; `None`
-/// if either is not reached (no `x` in range, tested), so a result is always exact. Tests
-/// `root_and_quotient_are_exact` and, over every `x`, `root_and_quotient_exhaustively`.
+/// `docs/speed.md` item 26).
+///
+/// An estimate `g ≈ 2^31 / √x4` of the reciprocal root of `x4 = x·4^e` in `[2^30, 2^32)` (a
+/// line on each half of the range, two Newton steps `g ← g·(3 − u·g²/2^46)/2` on `u = x4 /
+/// 2^16`) gives `√x4 ≈ u·g / 2^15`; one Newton step on the residual `x4 − s²` brings that
+/// within a unit or two, and the quotient is estimated from `g` and corrected by its remainder
+/// alike. Both are then checked exactly (`r² ≤ x < (r+1)²`, `0 ≤ n − a·r < r`) after at most
+/// three unit steps each; `None` if either is not reached (never, in the tests: every `x` in
+/// range, random numerators), so a result is always exact. Tests `root_and_quotient_are_exact`
+/// and, over every `x`, `root_and_quotient_exhaustively`.
 #[inline]
 pub(crate) fn root_and_quotient(x: u32, n: u32) -> Option<(u32, u32)> {
     if x < 1 << 28 {
@@ -492,8 +494,9 @@ pub(crate) fn root_and_quotient(x: u32, n: u32) -> Option<(u32, u32)> {
     }
     let e = u32::from(x < 1 << 30); // x4 = x · 4^e, and ⌊√x⌋ = ⌊⌊√x4⌋ / 2^e⌋
     let x4 = x << (2 * e);
-    let u = x4 >> 16; // in [2^14, 2^16)
-                      // g ≈ 2^23 / √u, in (2^15, 2^16]: each half's chord lowered by half its largest gap.
+    // u in [2^14, 2^16); g ≈ 2^23 / √u, in (2^15, 2^16]: each half's chord lowered by half its
+    // largest gap.
+    let u = x4 >> 16;
     let mut g = if u >= 1 << 15 {
         58_895 - ((u * 27_148) >> 16)
     } else {
