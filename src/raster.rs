@@ -230,8 +230,10 @@ fn place_narrow<const S: u32>(
 /// A triangle being walked row by row: a long edge on one side, two short edges on the other.
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleWalk {
-    long: EdgeWalk,
-    short: EdgeWalk,
+    /// The left and right edges on the current row: the long edge (top to bottom) on one side,
+    /// a short one on the other (kept by side, so a row's span needs no choice).
+    left: EdgeWalk,
+    right: EdgeWalk,
     /// The lower short edge, set up when the walk reaches `mid_row`.
     lower: [(i32, i32); 2],
     // Rows fit i16: the screen is at most 2048 rows and `mid_row` is clamped to [-1, i16::MAX],
@@ -303,9 +305,14 @@ impl TriangleWalk {
         } else {
             EdgeWalk::new::<S>(mid, bottom, r0 as i32)?
         };
+        let (left, right) = if long_is_left {
+            (long, short)
+        } else {
+            (short, long)
+        };
         Some(TriangleWalk {
-            long,
-            short,
+            left,
+            right,
             lower: [mid, bottom],
             row: r0,
             mid_row: r1,
@@ -323,11 +330,7 @@ impl TriangleWalk {
     /// The current row's span `[left, right)` in columns (not clipped to the screen; may be empty).
     #[inline]
     pub fn span(&self) -> (i32, i32) {
-        if self.long_is_left {
-            (self.long.column(), self.short.column())
-        } else {
-            (self.short.column(), self.long.column())
-        }
+        (self.left.column(), self.right.column())
     }
 
     /// The row after the walk's last row.
@@ -343,17 +346,23 @@ impl TriangleWalk {
         if self.row >= self.end_row {
             return false;
         }
-        self.long.step();
         if self.row == self.mid_row {
+            let (long, short) = if self.long_is_left {
+                (&mut self.left, &mut self.right)
+            } else {
+                (&mut self.right, &mut self.left)
+            };
+            long.step();
             match EdgeWalk::new::<S>(self.lower[0], self.lower[1], self.row as i32) {
-                Some(e) => self.short = e,
+                Some(e) => *short = e,
                 None => {
                     self.row = self.end_row;
                     return false;
                 }
             }
         } else {
-            self.short.step();
+            self.left.step();
+            self.right.step();
         }
         true
     }
@@ -744,6 +753,20 @@ pub struct DepthPlane {
 /// Extra fractional bits of the depth plane over [`Depth`].
 const DEPTH_PLANE_EXTRA_BITS: u32 = 10;
 
+/// A depth plane's value in [`Depth`] bits, clamped to `[0, i32::MAX]`:
+/// `(q >> DEPTH_PLANE_EXTRA_BITS).clamp(0, i32::MAX)`, with the usual case (the value already in
+/// range: its high word below `2^(DEPTH_PLANE_EXTRA_BITS − 1)`) tested on one word.
+#[inline(always)]
+fn clamped_depth(q: i64) -> i32 {
+    if (q >> 32) as i32 >> (DEPTH_PLANE_EXTRA_BITS - 1) == 0 {
+        (q >> DEPTH_PLANE_EXTRA_BITS) as i32
+    } else if q < 0 {
+        0
+    } else {
+        i32::MAX
+    }
+}
+
 /// `S +` the bits of an edge (doubled units) that [`PlaneSolver::plane_bounded`] takes.
 const SHORT_EDGE_BITS: u32 = 20;
 
@@ -809,8 +832,10 @@ impl DepthPlane {
     /// for triangles too thin to hold two centres in a row, where the step is never used.
     #[inline]
     pub fn span_start(&self, c: i32, r: i32) -> (i32, i32) {
-        let q = self.origin.at(&self.q, c, r) >> DEPTH_PLANE_EXTRA_BITS;
-        (q.clamp(0, i32::MAX as i64) as i32, depth_step(&self.q))
+        (
+            clamped_depth(self.origin.at(&self.q, c, r)),
+            depth_step(&self.q),
+        )
     }
 
     /// Depth at pixel centre `(c, r)` in I2F30, unclamped (for tests).
@@ -855,7 +880,7 @@ impl WalkDepth {
             Err(_) => self.q.dx.wrapping_mul(c as i64),
         };
         let q = self.q.value.wrapping_add(dx_c);
-        (q >> DEPTH_PLANE_EXTRA_BITS).clamp(0, i32::MAX as i64) as i32
+        clamped_depth(q)
     }
 
     /// [`DepthPlane::span_start`]'s per-pixel step (the same on every row: callers keep it).
@@ -1489,6 +1514,36 @@ mod tests {
 
     /// The steep slope's quotient and remainder are the division's, for every `|dx| < dy`, and
     /// it declines every shallower edge.
+    #[test]
+    fn clamped_depth_equals_the_clamp() {
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1d);
+        // Around every boundary of the range and of the high-word test, then at random
+        // magnitudes.
+        let edges = [
+            0i64,
+            1 << 41,
+            1 << 40,
+            1 << 32,
+            1 << 31,
+            1 << 10,
+            i64::MAX,
+            i64::MIN,
+        ];
+        let mut values = std::vec::Vec::new();
+        for e in edges {
+            for d in -1025i64..=1025 {
+                values.extend([e.wrapping_add(d), e.wrapping_neg().wrapping_add(d)]);
+            }
+        }
+        for _ in 0..200_000 {
+            values.push(rng.next_u64() as i64 >> (rng.next_u64() % 64));
+        }
+        for q in values {
+            let expected = (q >> DEPTH_PLANE_EXTRA_BITS).clamp(0, i32::MAX as i64) as i32;
+            assert_eq!(clamped_depth(q), expected, "{q}");
+        }
+    }
+
     #[test]
     fn steep_slope_equals_the_division() {
         let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
