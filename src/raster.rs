@@ -465,13 +465,7 @@ impl PlaneSolver {
         let (p0, p1, p2) = (p(&v[0]), p(&v[1]), p(&v[2]));
         let e1 = (p1.0 - p0.0, p1.1 - p0.1);
         let e2 = (p2.0 - p0.0, p2.1 - p0.1);
-        // On ARMv6-M the doubled edges' cross product is four times the sub-pixel one, whose
-        // products `signed_area_xy` takes without the `i64` multiply's call.
-        let area = if NO_WIDE_MULTIPLY {
-            signed_area_xy(&v.each_ref().map(xy)).wrapping_mul(4)
-        } else {
-            e1.0 * e2.1 - e2.0 * e1.1
-        };
+        let area = e1.0 * e2.1 - e2.0 * e1.1;
         if area == 0 {
             return None;
         }
@@ -1050,13 +1044,6 @@ fn signed_area_in_words(v: &[(i32, i32); 3]) -> Option<i64> {
     let [a, b, c] = *v;
     let e1 = (b.0.checked_sub(a.0)?, b.1.checked_sub(a.1)?);
     let e2 = (c.0.checked_sub(a.0)?, c.1.checked_sub(a.1)?);
-    // Edges that fit i16 (every triangle of a few hundred pixels at 4 sub-pixel bits): each
-    // product lies in (−2^30, 2^30], their difference in (−2^31, 2^31): two 32-bit multiplies
-    // instead of two wide ones.
-    let short = |e: i32| i16::try_from(e).is_ok();
-    if short(e1.0) && short(e1.1) && short(e2.0) && short(e2.1) {
-        return Some((e1.0 * e2.1 - e2.0 * e1.1) as i64);
-    }
     Some(mul_wide(e1.0, e2.1) - mul_wide(e2.0, e1.1))
 }
 
@@ -1848,31 +1835,6 @@ mod tests {
     }
 
     #[test]
-    fn plane_area_is_four_sub_pixel_areas() {
-        // `PlaneSolver::new` on ARMv6-M takes its doubled edges' cross product as four times
-        // the sub-pixel one from `signed_area_in_words`.
-        let mut rng = crate::test_rng::XorShift64::new(0x94d0_49bb_1331_11ebu64);
-        for k in 0..100_000u32 {
-            let x = rng.next_u64();
-            // Coordinates within ±2^20 sub-pixels (a screen with its guard band).
-            let p = |i: u32| (((x >> (i * 10)) as i32 & 0x1F_FFFF) - (1 << 20)) >> (k % 20);
-            let v = [(p(0), p(1)), (p(2), p(3)), (p(4), p(5))];
-            let d = v.map(|(x, y)| (2 * x as i64, 2 * y as i64));
-            let (e1, e2) = (
-                (d[1].0 - d[0].0, d[1].1 - d[0].1),
-                (d[2].0 - d[0].0, d[2].1 - d[0].1),
-            );
-            let doubled = e1.0 * e2.1 - e2.0 * e1.1;
-            assert_eq!(
-                signed_area_in_words(&v).map(|a| a * 4),
-                Some(doubled),
-                "{v:?}"
-            );
-            assert_eq!(signed_area_xy(&v) * 4, doubled, "{v:?}");
-        }
-    }
-
-    #[test]
     fn area_in_words_is_the_area() {
         let mut rng = crate::test_rng::XorShift64::new(0x5851_f42d_4c95_7f2du64);
         let wide = |v: &[(i32, i32); 3]| {
@@ -1881,21 +1843,7 @@ mod tests {
         };
         // Coordinates within ±2^30, where the `i64` form cannot overflow; differences up to
         // 2^31, so both sides of the 32-bit check are met.
-        // Around ±2^15 too, the bound of the 32-bit products.
-        let edges = [
-            0,
-            1,
-            -1,
-            (1 << 30) - 1,
-            1 << 30,
-            -(1 << 30),
-            3840,
-            -3840,
-            32767,
-            -32768,
-            32768,
-            -32769,
-        ];
+        let edges = [0, 1, -1, (1 << 30) - 1, 1 << 30, -(1 << 30), 3840, -3840];
         let mut seen = (0, 0);
         for k in 0..200_000u32 {
             let x = rng.next_u64();
