@@ -1512,8 +1512,6 @@ mod tests {
         }
     }
 
-    /// The steep slope's quotient and remainder are the division's, for every `|dx| < dy`, and
-    /// it declines every shallower edge.
     #[test]
     fn clamped_depth_equals_the_clamp() {
         let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1d);
@@ -1544,6 +1542,8 @@ mod tests {
         }
     }
 
+    /// The steep slope's quotient and remainder are the division's, for every `|dx| < dy`, and
+    /// it declines every shallower edge.
     #[test]
     fn steep_slope_equals_the_division() {
         let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15u64);
