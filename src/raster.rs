@@ -35,11 +35,12 @@ use crate::project::ScreenVertex;
 use fixed::types::I16F16;
 
 /// First row (or column) whose centre lies at or after position `p` (doubled units, S bits):
-/// `ceil((p − 2^S) / 2^(S+1))`.
+/// `ceil((p − 2^S) / 2^(S+1))`, which is `floor((p + 2^S − 1) / 2^(S+1))`, one shift. In 32
+/// bits for `|p| < 2^31 − 2^S`: every doubled vertex coordinate (vertices are within ±2^22
+/// sub-pixels, the bit budget above). Test `first_centre_is_the_rounded_up_division`.
 #[inline]
-fn first_centre_at_or_after<const S: u32>(p_doubled: i64) -> i64 {
-    let den = 1i64 << (S + 1);
-    -((-(p_doubled - (1i64 << S))).div_euclid(den))
+fn first_centre_at_or_after<const S: u32>(p_doubled: i32) -> i32 {
+    (p_doubled + ((1 << S) - 1)) >> (S + 1)
 }
 
 /// One edge, walked down the rows: `x` is the first column whose centre is at or right of the
@@ -290,15 +291,15 @@ impl TriangleWalk {
         // is `−(mid − top) × (bottom − top)`, is negative: when the sorted order's area is
         // positive, the original's with the permutation's sign.
         let long_is_left = negative == odd;
-        let row_of = |y: i32| first_centre_at_or_after::<S>(2 * y as i64);
-        let r0 = row_of(top.1).max(min_row as i64);
+        let row_of = |y: i32| first_centre_at_or_after::<S>(2 * y);
+        let r0 = row_of(top.1).max(min_row);
         let r1 = row_of(mid.1);
-        let r2 = row_of(bottom.1).min(max_row as i64);
+        let r2 = row_of(bottom.1).min(max_row);
         if r0 >= r2 {
             return None;
         }
         // r0, r2 are within [0, max_row] and max_row <= 2048.
-        let (r0, r1, r2) = (r0 as i16, r1.clamp(-1, i16::MAX as i64) as i16, r2 as i16);
+        let (r0, r1, r2) = (r0 as i16, r1.clamp(-1, i16::MAX as i32) as i16, r2 as i16);
         let long = EdgeWalk::new::<S>(top, bottom, r0 as i32)?;
         let short = if r0 < r1 {
             EdgeWalk::new::<S>(top, mid, r0 as i32)?
@@ -446,10 +447,11 @@ impl PixelOrigin {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PlaneSolver {
     origin: PixelOrigin,
-    /// Doubled-unit offset from vertex 0 to the reference centre, and the two edge vectors.
-    to_ref: (i64, i64),
-    e1: (i64, i64),
-    e2: (i64, i64),
+    /// Doubled-unit offset from vertex 0 to the reference centre (in `(−2^S, 2^S]`), and the
+    /// two edge vectors (below 2^24 in magnitude: vertices are within ±2^22 sub-pixels).
+    to_ref: (i32, i32),
+    e1: (i32, i32),
+    e2: (i32, i32),
     /// Twice the doubled-unit area, made positive (`flip` remembers the sign).
     area: i64,
     flip: bool,
@@ -460,18 +462,20 @@ pub struct PlaneSolver {
 
 impl PlaneSolver {
     /// Geometry shared by all planes of triangle `v`; `None` for zero area.
+    ///
+    /// In 32 bits but for the area, as [`EdgeWalk::new`]: the doubled edge vectors fit `i32`
+    /// for vertices within the bit budget's ±2^22 sub-pixels (any two within 2^30 of each
+    /// other), and their cross product is two 32 × 32 → 64-bit products.
     pub fn new<const S: u32>(v: &[ScreenVertex<S>; 3]) -> Option<Self> {
-        let p = |s: &ScreenVertex<S>| (2 * s.x.0 as i64, 2 * s.y.0 as i64);
-        let (p0, p1, p2) = (p(&v[0]), p(&v[1]), p(&v[2]));
-        let e1 = (p1.0 - p0.0, p1.1 - p0.1);
-        let e2 = (p2.0 - p0.0, p2.1 - p0.1);
-        let area = e1.0 * e2.1 - e2.0 * e1.1;
+        let [(x0, y0), (x1, y1), (x2, y2)] = [&v[0], &v[1], &v[2]].map(|s| (s.x.0, s.y.0));
+        let e1 = (2 * (x1 - x0), 2 * (y1 - y0));
+        let e2 = (2 * (x2 - x0), 2 * (y2 - y0));
+        let area = mul_wide(e1.0, e2.1) - mul_wide(e2.0, e1.1);
         if area == 0 {
             return None;
         }
-        let c = v[0].x.0 >> S;
-        let r = v[0].y.0 >> S;
-        let centre = |i: i32| ((2 * i as i64) + 1) << S;
+        // The reference centre `(2c + 1)·2^S` minus the doubled `x0 = c·2^S + f`: `2^S − 2f`.
+        let to_ref = |p: i32| (1 << S) - 2 * (p & ((1 << S) - 1));
         let short_edges = S <= SHORT_EDGE_BITS
             && (e1.0.unsigned_abs()
                 | e1.1.unsigned_abs()
@@ -479,8 +483,11 @@ impl PlaneSolver {
                 | e2.1.unsigned_abs())
                 < 1 << (SHORT_EDGE_BITS - S.min(SHORT_EDGE_BITS));
         Some(PlaneSolver {
-            origin: PixelOrigin { c, r },
-            to_ref: (centre(c) - p0.0, centre(r) - p0.1),
+            origin: PixelOrigin {
+                c: x0 >> S,
+                r: y0 >> S,
+            },
+            to_ref: (to_ref(x0), to_ref(y0)),
             e1,
             e2,
             area: area.abs(),
@@ -511,8 +518,9 @@ impl PlaneSolver {
             return p;
         }
         // Gradient per doubled unit = num / area.
-        let mut num_x = cross_diff(d1, self.e2.1, d2, self.e1.1);
-        let mut num_y = cross_diff(d2, self.e1.0, d1, self.e2.0);
+        let (e1, e2) = (self.e1_i64(), self.e2_i64());
+        let mut num_x = cross_diff(d1, e2.1, d2, e1.1);
+        let mut num_y = cross_diff(d2, e1.0, d1, e2.0);
         if self.flip {
             num_x = -num_x;
             num_y = -num_y;
@@ -534,6 +542,17 @@ impl PlaneSolver {
 }
 
 impl PlaneSolver {
+    /// The edge vectors widened, for the general solvers.
+    #[inline]
+    fn e1_i64(&self) -> (i64, i64) {
+        (self.e1.0 as i64, self.e1.1 as i64)
+    }
+
+    #[inline]
+    fn e2_i64(&self) -> (i64, i64) {
+        (self.e2.0 as i64, self.e2.1 as i64)
+    }
+
     /// [`PlaneSolver::plane`] in 64-bit arithmetic, `None` where an intermediate would not fit
     /// (then the 128-bit path decides). Every step is the 128-bit path's own operation on the
     /// same values, checked instead of widened, so a result is the same plane bit for bit; on
@@ -550,8 +569,9 @@ impl PlaneSolver {
     /// [`PlaneSolver::plane_i64`]'s checked steps, one by one.
     #[inline]
     fn plane_checked(&self, f0: i64, d1: i64, d2: i64, extra: u32) -> Option<Plane> {
-        let mut num_x = cross_diff_i64(d1, self.e2.1, d2, self.e1.1)?;
-        let mut num_y = cross_diff_i64(d2, self.e1.0, d1, self.e2.0)?;
+        let (e1, e2) = (self.e1_i64(), self.e2_i64());
+        let mut num_x = cross_diff_i64(d1, e2.1, d2, e1.1)?;
+        let mut num_y = cross_diff_i64(d2, e1.0, d1, e2.0)?;
         if self.flip {
             num_x = -num_x;
             num_y = -num_y;
@@ -559,8 +579,8 @@ impl PlaneSolver {
         let div = RoundDivisor::new(self.area);
         let px = 1i64.checked_shl(self.sub_bits + 1 + extra)?;
         let to_ref = num_x
-            .checked_mul(self.to_ref.0)?
-            .checked_add(num_y.checked_mul(self.to_ref.1)?)?;
+            .checked_mul(self.to_ref.0 as i64)?
+            .checked_add(num_y.checked_mul(self.to_ref.1 as i64)?)?;
         let scale = 1i64.checked_shl(extra)?;
         let value = f0
             .checked_mul(scale)?
@@ -602,8 +622,8 @@ impl PlaneSolver {
             return None;
         }
         // Factors below 2^30 (the values) and 2^20 (the edges): exact 32 x 32 -> 64 products.
-        let cross = |a: i64, b: i64, c: i64, d: i64| {
-            mul_wide(a as i32, b as i32).wrapping_sub(mul_wide(c as i32, d as i32))
+        let cross = |a: i64, b: i32, c: i64, d: i32| {
+            mul_wide(a as i32, b).wrapping_sub(mul_wide(c as i32, d))
         };
         let mut num_x = cross(d1, self.e2.1, d2, self.e1.1);
         let mut num_y = cross(d2, self.e1.0, d1, self.e2.0);
@@ -614,8 +634,8 @@ impl PlaneSolver {
         let div = RoundDivisor::new(self.area);
         let px = self.sub_bits + 1 + extra;
         // |to_ref| <= 2^S: products by an i32.
-        let to_ref = mul_i64_i32(num_x, self.to_ref.0 as i32)
-            .wrapping_add(mul_i64_i32(num_y, self.to_ref.1 as i32));
+        let to_ref =
+            mul_i64_i32(num_x, self.to_ref.0).wrapping_add(mul_i64_i32(num_y, self.to_ref.1));
         Some(Plane {
             value: f0
                 .wrapping_shl(extra)
@@ -1062,9 +1082,9 @@ pub fn first_row_xy<const S: u32>(v: &[(i32, i32); 3], width: i32, height: i32) 
             .iter()
             .map(k)
             .fold((i32::MAX, i32::MIN), |(l, h), x| (l.min(x), h.max(x)));
-        let first = first_centre_at_or_after::<S>(2 * lo as i64).max(0);
-        let end = first_centre_at_or_after::<S>(2 * hi as i64).min(limit as i64);
-        (first < end).then_some(first as i32)
+        let first = first_centre_at_or_after::<S>(2 * lo).max(0);
+        let end = first_centre_at_or_after::<S>(2 * hi).min(limit);
+        (first < end).then_some(first)
     };
     range(|p| p.0, width)?;
     range(|p| p.1, height)
@@ -1540,6 +1560,31 @@ mod tests {
             let expected = (q >> DEPTH_PLANE_EXTRA_BITS).clamp(0, i32::MAX as i64) as i32;
             assert_eq!(clamped_depth(q), expected, "{q}");
         }
+    }
+
+    /// The first centre at or after `p` is `ceil((p − 2^S) / 2^(S+1))` computed in 64 bits, for
+    /// every doubled position near zero, near the guard band's ±2^23 and near the 32-bit
+    /// envelope's ends, at every sub-pixel precision.
+    #[test]
+    fn first_centre_is_the_rounded_up_division() {
+        fn check<const S: u32>() {
+            let limit = i32::MAX - (1 << S);
+            let around = |c: i32| (-600..=600).map(move |d: i32| c.saturating_add(d));
+            let points = around(0)
+                .chain(around(1 << 23))
+                .chain(around(-(1 << 23)))
+                .chain(around(limit - 600))
+                .chain(around(-limit + 600));
+            for p in points.filter(|p| p.unsigned_abs() <= limit as u32) {
+                let den = 1i64 << (S + 1);
+                let want = -((-(p as i64 - (1i64 << S))).div_euclid(den));
+                assert_eq!(first_centre_at_or_after::<S>(p) as i64, want, "S {S} p {p}");
+            }
+        }
+        check::<0>();
+        check::<1>();
+        check::<4>();
+        check::<8>();
     }
 
     /// The steep slope's quotient and remainder are the division's, for every `|dx| < dy`, and
