@@ -343,11 +343,13 @@ impl TriangleWalk {
     /// Moves to the next row; `false` when the triangle is finished.
     #[inline]
     pub fn advance<const S: u32>(&mut self) -> bool {
-        self.row += 1;
-        if self.row >= self.end_row {
+        // Compared as i32, so no narrowing or widening of the i16 rows between the steps.
+        let row = self.row as i32 + 1;
+        self.row = row as i16;
+        if row >= self.end_row as i32 {
             return false;
         }
-        if self.row == self.mid_row {
+        if row == self.mid_row as i32 {
             let (long, short) = if self.long_is_left {
                 (&mut self.left, &mut self.right)
             } else {
