@@ -15,8 +15,8 @@
 
 use crate::depth::Depth;
 use crate::math::{
-    bit_length_u64, floor_div_i64, i16f16_from_f32, mul_i64_i32, mul_wide, shr_i64, SoftDivisor,
-    NO_HARDWARE_DIVIDE,
+    bit_length_u64, div_rem_below, floor_div_i64, i16f16_from_f32, mul_i64_i32, mul_wide, shr_i64,
+    SoftDivisor, NO_HARDWARE_DIVIDE,
 };
 use crate::vertex::EyePoint;
 use fixed::types::I16F16;
@@ -232,7 +232,7 @@ impl<const S: u32> Viewport<S> {
             )
         };
         let q = if depth {
-            floor_div_i64((self.near.to_bits() as i64) << 30, w)
+            depth_of(self.near.to_bits(), p.w.to_bits())
         } else {
             0
         };
@@ -306,6 +306,25 @@ impl<const S: u32> Viewport<S> {
             0
         };
         Some(screen_vertex(x, y, q, color))
+    }
+}
+
+/// The exact depth `⌊near·2^30 / w⌋` (`near`, `w` raw I16F16, `w > 0`) wherever it is below
+/// 2^32, and some value of at least 2^32 elsewhere, which [`screen_vertex`] saturates as it
+/// does the quotient: for `near > 0` the quotient fits 32 bits exactly when the numerator's
+/// high word is below `w` (a vertex no nearer than `near / 4`), and then one 64 / 32-bit step
+/// ([`div_rem_below`]) divides it, without the general division's high-word step and signs.
+/// Test `depth_of_saturates_as_the_division`. Not inlined, as the division it replaces was
+/// not: inlined, it made `Viewport::project_with` too large to be inlined itself.
+#[inline(never)]
+fn depth_of(near: i32, w: i32) -> i64 {
+    let n = (near as i64) << 30;
+    match (u64::try_from(n), u32::try_from(w)) {
+        (Ok(n), Ok(w)) if ((n >> 32) as u32) < w => {
+            div_rem_below((n >> 32) as u32, n as u32, w).0 as i64
+        }
+        (Ok(_), Ok(_)) => 1 << 32,
+        _ => floor_div_i64(n, w as i64),
     }
 }
 
@@ -408,6 +427,51 @@ impl<const S: u32> Viewport<S> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+
+    /// `depth_of` is the exact floored quotient wherever that is below 2^32 and at least 2^32
+    /// elsewhere, so the vertex's saturated depth is the division's: every `w` around the
+    /// boundary `near / 4` and the near plane, the extremes, and random pairs.
+    #[test]
+    fn depth_of_saturates_as_the_division() {
+        let check = |near: i32, w: i32| {
+            let exact = floor_div_i64((near as i64) << 30, w as i64);
+            let got = depth_of(near, w);
+            if exact < 1 << 32 {
+                assert_eq!(got, exact, "near {near} w {w}");
+            } else {
+                assert!(got >= 1 << 32, "near {near} w {w}: {got}");
+            }
+            assert_eq!(got.min(i32::MAX as i64), exact.min(i32::MAX as i64));
+        };
+        for near in [
+            1,
+            2,
+            3,
+            655,
+            1 << 16,
+            6_553_600,
+            i32::MAX - 1,
+            i32::MAX,
+            0,
+            -1,
+            -65_536,
+        ] {
+            let quarter = (near / 4).max(1);
+            for w in (1..200)
+                .chain(quarter.saturating_sub(100)..quarter.saturating_add(100))
+                .chain(near.saturating_sub(100).max(1)..near.saturating_add(100).max(2))
+                .chain(i32::MAX - 100..=i32::MAX)
+            {
+                check(near, w.max(1));
+            }
+        }
+        let mut rng = crate::test_rng::XorShift32::new(0x2468_ace1u32);
+        for _ in 0..100_000 {
+            let near = (rng.next_u32() >> (rng.next_u32() % 32)) as i32;
+            let w = ((rng.next_u32() >> (rng.next_u32() % 32)) as i32).max(1);
+            check(near, w);
+        }
+    }
 
     /// The 32-bit path of `floor_div` gives the 64-bit quotient, on both sides of its limits.
     #[test]
