@@ -133,8 +133,14 @@ impl CachedVertex {
     /// The sub-pixel screen positions `(x, y)` of `v`, if all three have one cached.
     #[inline]
     pub(crate) fn positions(v: [&Self; 3]) -> Option<[(i32, i32); 3]> {
-        let projected = (v[0].q[0] | v[1].q[0] | v[2].q[0]) & NOT_PROJECTED == 0;
-        projected.then(|| v.map(|c| (c.x as i32, c.y as i32)))
+        Self::all_projected(v).then(|| v.map(|c| (c.x as i32, c.y as i32)))
+    }
+
+    /// Whether all three of `v` have a cached screen position (so they are inside every clip
+    /// plane).
+    #[inline]
+    pub(crate) fn all_projected(v: [&Self; 3]) -> bool {
+        (v[0].q[0] | v[1].q[0] | v[2].q[0]) & NOT_PROJECTED == 0
     }
 
     /// Whether all of `v` lie outside one clip plane (the triangle is invisible).

@@ -622,12 +622,16 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
         let clipped = 'pieces: {
             let cv = match self.cached(cache, idx) {
                 Some(c) => {
+                    // Three cached positions first (their colours made only then): vertices
+                    // with one are inside every plane, so the outcode test could not reject.
+                    if CachedVertex::all_projected(c) {
+                        if let Some(s) = CachedVertex::triangle::<S>(c, colors()) {
+                            emit(&s, filed);
+                            break 'pieces false;
+                        }
+                    }
                     if CachedVertex::all_outside_one_plane(c) {
                         return Fate::Rejected;
-                    }
-                    if let Some(s) = CachedVertex::triangle::<S>(c, colors()) {
-                        emit(&s, filed);
-                        break 'pieces false;
                     }
                     // The cache keeps no eye-space points: transform again (same result).
                     self.clip_vertices::<A>(idx, colors())
