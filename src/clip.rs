@@ -9,6 +9,7 @@
 //! polygon's winding, so two triangles sharing an edge get bit-identical new vertices and stay
 //! watertight. The arithmetic is i128: distances reach 2^56 and coordinate differences 2^31.
 
+use crate::math::div_rem_u64_u32;
 use crate::project::Viewport;
 use crate::vertex::EyePoint;
 use fixed::types::I16F16;
@@ -127,9 +128,9 @@ pub fn classify<const S: u32>(vp: &Viewport<S>, tri: &[ClipVertex; 3]) -> Clippe
 const T_BITS: u32 = 62;
 
 fn intersect(inside: &ClipVertex, d_in: i64, outside: &ClipVertex, d_out: i64) -> ClipVertex {
-    // d_in >= 0 > d_out, so 0 < den < 2^58 and t <= 2^62: one 128-bit division per new vertex.
-    let den = d_in as i128 - d_out as i128;
-    let t = ((d_in as i128) << T_BITS) / den;
+    // d_in >= 0 > d_out, so 0 <= d_in < den < 2^64 and t < 2^62.
+    let den = (d_in as i128 - d_out as i128) as u64;
+    let t = ratio_62(d_in as u64, den) as i128;
     // a + (b − a)·t, rounded to nearest: |b − a| < 2^32, so the product is below 2^94, and the
     // result lies between a and b.
     let f = |a: I16F16, b: I16F16| {
@@ -149,6 +150,39 @@ fn intersect(inside: &ClipVertex, d_in: i64, outside: &ClipVertex, d_out: i64) -
             f(inside.color[2], outside.color[2]),
         ],
     }
+}
+
+/// `⌊n · 2^62 / d⌋` for `n < d` (so below 2^62): the intersection parameter, as the 128-bit
+/// division gives it. Both normalised so `d` has its top bit set, the numerator is two 64-bit
+/// words whose high one is below `d`, and its quotient two 32-bit digits, each estimated by a
+/// 64 / 32-bit division ([`div_rem_u64_u32`]) and corrected at most twice (Knuth, Algorithm D;
+/// `divlu` in Hacker's Delight). On 32-bit cores the 128-bit division is a loop of a bit an
+/// iteration. Test `ratio_62_equals_the_128_bit_division`.
+fn ratio_62(n: u64, d: u64) -> u64 {
+    const B: u64 = 1 << 32;
+    let s = d.leading_zeros() % 64;
+    let (v, a) = (d << s, n << s);
+    // a·2^62 = (a >> 2)·2^64 + (a & 3)·2^62, and a >> 2 < a < v.
+    let (u1, u0) = (a >> 2, (a & 3) << 62);
+    let (vn1, vn0) = (v >> 32, v & (B - 1));
+    // One quotient digit of (top·2^32 + next) / v, for top < v; and the remainder.
+    let digit = |top: u64, next: u64| -> (u64, u64) {
+        let (mut q, r) = div_rem_u64_u32(top, vn1 as u32);
+        let mut rhat = r as u64;
+        while q >= B || q * vn0 > (rhat << 32 | next) {
+            q -= 1;
+            rhat += vn1;
+            if rhat >= B {
+                break;
+            }
+        }
+        // The true remainder is below v: the wrapping arithmetic gives it exactly.
+        let rem = (top << 32 | next).wrapping_sub(q.wrapping_mul(v));
+        (q, rem)
+    };
+    let (q1, r1) = digit(u1, u0 >> 32);
+    let (q0, _) = digit(r1, u0 & (B - 1));
+    q1 << 32 | q0
 }
 
 /// Clips a triangle against the viewport's six planes. When it is cut, the remaining polygon
@@ -220,6 +254,43 @@ mod tests {
                 w: I16F16::from_num(w),
             },
             color: [I16F16::ZERO; 3],
+        }
+    }
+
+    /// `ratio_62` is the 128-bit division for numerators and divisors of every size, the
+    /// extremes included.
+    #[test]
+    fn ratio_62_equals_the_128_bit_division() {
+        let check = |n: u64, d: u64| {
+            let want = ((n as u128) << 62) / d as u128;
+            assert_eq!(ratio_62(n, d) as u128, want, "n {n} d {d}");
+        };
+        for d in [
+            1,
+            2,
+            3,
+            1 << 31,
+            (1 << 32) - 1,
+            1 << 32,
+            (1 << 32) + 1,
+            1 << 57,
+            u64::MAX,
+        ] {
+            for n in [0, 1, d / 2, d.saturating_sub(2), d - 1] {
+                if n < d {
+                    check(n, d);
+                }
+            }
+        }
+        let mut rng = crate::test_rng::XorShift64::new(0x9E37_79B9_7F4A_7C15u64);
+        for _ in 0..200_000 {
+            let d = (rng.next_u64() >> (rng.next_u64() % 64)).max(1);
+            let n = match rng.next_u64() % 4 {
+                0 => d - 1,
+                1 => d - 1 - (rng.next_u64() % d.min(1 << 20)),
+                _ => rng.next_u64() % d,
+            };
+            check(n, d);
         }
     }
 
