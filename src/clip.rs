@@ -7,7 +7,9 @@
 //!
 //! Intersections are computed from the (inside, outside) vertex pair in that order, whatever the
 //! polygon's winding, so two triangles sharing an edge get bit-identical new vertices and stay
-//! watertight. The arithmetic is i128: distances reach 2^56 and coordinate differences 2^31.
+//! watertight. Distances reach 2^56 and coordinate differences 2^31: the parameter is a
+//! 128-bit quotient, taken by 32-bit digits (`ratio_62`), and the interpolation's products
+//! are i128.
 
 use crate::math::div_rem_u64_u32;
 use crate::project::Viewport;
