@@ -594,7 +594,10 @@ pub(crate) fn div_rem_u64_u32(n: u64, d: u32) -> (u64, u32) {
 fn div_rem_u64_u32_in_halves(n: u64, d: u32) -> (u64, u32) {
     let d = d.max(1);
     let (hi, lo) = ((n >> 32) as u32, n as u32);
-    let (q_hi, r_hi) = if NO_HARDWARE_DIVIDE {
+    // A quotient below 2^32 (a numerator whose high word is below `d`) needs no high step.
+    let (q_hi, r_hi) = if hi < d {
+        (0, hi)
+    } else if NO_HARDWARE_DIVIDE {
         div_rem_u32_soft(hi, d)
     } else {
         (hi / d, hi % d)
