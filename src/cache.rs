@@ -108,26 +108,34 @@ impl CachedVertex {
     /// The screen vertex with colour `color`, if this vertex has one.
     #[inline]
     pub(crate) fn screen<const S: u32>(&self, color: [I16F16; 3]) -> Option<ScreenVertex<S>> {
-        let q = (self.q[0] as i32) << 16 | self.q[1] as i32;
-        self.projected().then_some(ScreenVertex {
-            x: SubPx(self.x as i32),
-            y: SubPx(self.y as i32),
-            q: Depth::from_bits(q),
-            color,
-        })
+        self.projected().then(|| self.position(color))
     }
 
-    /// The screen triangle of `v` with vertex colours `colors`, if all three have a cached
-    /// position.
+    /// The screen vertex with colour `color` from the entry's fields, which hold one if
+    /// [`Self::projected`].
+    #[inline]
+    fn position<const S: u32>(&self, color: [I16F16; 3]) -> ScreenVertex<S> {
+        ScreenVertex {
+            x: SubPx(self.x as i32),
+            y: SubPx(self.y as i32),
+            q: Depth::from_bits((self.q[0] as i32) << 16 | self.q[1] as i32),
+            color,
+        }
+    }
+
+    /// The screen triangle of `v` with vertex colours `colors`, for three entries with a cached
+    /// position ([`Self::all_projected`]; built as a value, not an `Option` of one, so it is
+    /// written once where the caller keeps it).
     #[inline]
     pub(crate) fn triangle<const S: u32>(
         v: [&Self; 3],
         colors: [[I16F16; 3]; 3],
-    ) -> Option<[ScreenVertex<S>; 3]> {
-        let [Some(a), Some(b), Some(c)] = zip3(v, colors, |v, c| v.screen::<S>(c)) else {
-            return None;
-        };
-        Some([a, b, c])
+    ) -> [ScreenVertex<S>; 3] {
+        debug_assert!(
+            Self::all_projected(v),
+            "internal error: a vertex without a position"
+        );
+        zip3(v, colors, |v, color| v.position(color))
     }
 
     /// The sub-pixel screen positions `(x, y)` of `v`, if all three have one cached.

@@ -625,10 +625,8 @@ impl<T: TransformPrecision> InstanceSetup<'_, T> {
                     // Three cached positions first (their colours made only then): vertices
                     // with one are inside every plane, so the outcode test could not reject.
                     if CachedVertex::all_projected(c) {
-                        if let Some(s) = CachedVertex::triangle::<S>(c, colors()) {
-                            emit(&s, filed);
-                            break 'pieces false;
-                        }
+                        emit(&CachedVertex::triangle::<S>(c, colors()), filed);
+                        break 'pieces false;
                     }
                     if CachedVertex::all_outside_one_plane(c) {
                         return Fate::Rejected;
