@@ -623,10 +623,35 @@ impl PlaneSolver {
         {
             return None;
         }
+        Some(self.plane_within_bounds(f0, d1 as i32, d2 as i32, extra))
+    }
+
+    /// [`PlaneSolver::plane_bounded`] for three non-negative 32-bit values (depths): their
+    /// differences are then exact in `i32`, and the bounds are tested there. The same plane.
+    #[inline]
+    fn plane_bounded_i32(&self, f: [i32; 3], extra: u32) -> Option<Plane> {
+        const D: u32 = 1 << 30;
+        let [f0, f1, f2] = f;
+        // Non-negative: each difference lies in (−2^31, 2^31).
+        if (f0 | f1 | f2) < 0 {
+            return None;
+        }
+        let (d1, d2) = (f1 - f0, f2 - f0);
+        if !(self.short_edges
+            && extra <= DEPTH_PLANE_EXTRA_BITS
+            && d1.unsigned_abs() < D
+            && d2.unsigned_abs() < D)
+        {
+            return None;
+        }
+        Some(self.plane_within_bounds(f0 as i64, d1, d2, extra))
+    }
+
+    /// The bounded solver's arithmetic, for the premise [`PlaneSolver::plane_bounded`] tests.
+    #[inline(always)]
+    fn plane_within_bounds(&self, f0: i64, d1: i32, d2: i32, extra: u32) -> Plane {
         // Factors below 2^30 (the values) and 2^20 (the edges): exact 32 x 32 -> 64 products.
-        let cross = |a: i64, b: i32, c: i64, d: i32| {
-            mul_wide(a as i32, b).wrapping_sub(mul_wide(c as i32, d))
-        };
+        let cross = |a: i32, b: i32, c: i32, d: i32| mul_wide(a, b).wrapping_sub(mul_wide(c, d));
         let mut num_x = cross(d1, self.e2.1, d2, self.e1.1);
         let mut num_y = cross(d2, self.e1.0, d1, self.e2.0);
         if self.flip {
@@ -638,13 +663,13 @@ impl PlaneSolver {
         // |to_ref| <= 2^S: products by an i32.
         let to_ref =
             mul_i64_i32(num_x, self.to_ref.0).wrapping_add(mul_i64_i32(num_y, self.to_ref.1));
-        Some(Plane {
+        Plane {
             value: f0
                 .wrapping_shl(extra)
                 .wrapping_add(div.round_div_bounded(to_ref.wrapping_shl(extra))),
             dx: div.round_div_bounded(num_x.wrapping_shl(px)),
             dy: div.round_div_bounded(num_y.wrapping_shl(px)),
-        })
+        }
     }
 }
 
@@ -795,10 +820,12 @@ const SHORT_EDGE_BITS: u32 = 20;
 impl DepthPlane {
     /// Depth plane of triangle `v`; `None` for zero area.
     pub fn new<const S: u32>(solver: &PlaneSolver, v: &[ScreenVertex<S>; 3]) -> Self {
-        let q = solver.plane(
-            v.each_ref().map(|s| s.q.to_bits() as i64),
-            DEPTH_PLANE_EXTRA_BITS,
-        );
+        let f = v.each_ref().map(|s| s.q.to_bits());
+        // Depths are non-negative 32-bit values: the bounded solver's premise tested in 32 bits.
+        let q = match solver.plane_bounded_i32(f, DEPTH_PLANE_EXTRA_BITS) {
+            Some(q) => q,
+            None => solver.plane(f.map(i64::from), DEPTH_PLANE_EXTRA_BITS),
+        };
         DepthPlane {
             origin: solver.origin(),
             q,
@@ -1328,6 +1355,51 @@ mod tests {
     /// `plane_bounded` takes every triangle and value it may, and gives `plane_checked`'s
     /// plane for each: edges up to its limit (and just past it), values up to `2^32` apart
     /// from `f0` and differences up to `2^30` (and just past both), both signs of the area.
+    /// The bounded solver with its premise tested in 32 bits gives `plane_bounded`'s plane for
+    /// non-negative values, and declines exactly where that does or a value is negative.
+    #[test]
+    fn bounded_plane_from_32_bit_values_equals_the_bounded_plane() {
+        let mut rng = crate::test_rng::XorShift64::new(0x0DDB_1A5E_5BAD_5EEDu64);
+        let mut next = move || rng.next_u64();
+        let (mut solved, mut declined) = (0, 0);
+        for _ in 0..50_000 {
+            let span = 1i64 << (4 + next() % 19);
+            let mut coord = || (next() % (2 * span as u64)) as i64 - span;
+            let v: [ScreenVertex<4>; 3] = core::array::from_fn(|_| ScreenVertex {
+                x: crate::project::SubPx(coord() as i32),
+                y: crate::project::SubPx(coord() as i32),
+                q: Depth::ZERO,
+                color: [I16F16::ZERO; 3],
+            });
+            let Some(s) = PlaneSolver::new(&v) else {
+                continue;
+            };
+            let mut value = || match next() % 8 {
+                0 => (next() as i32).min(-1),
+                1 => i32::MAX - (next() % 4) as i32,
+                2 => (1 << 30) + (next() % 4) as i32 - 2,
+                _ => (next() >> (34 + next() % 30)) as i32,
+            };
+            let f = [value(), value(), value()];
+            for extra in [0, DEPTH_PLANE_EXTRA_BITS, DEPTH_PLANE_EXTRA_BITS + 1] {
+                let got = s.plane_bounded_i32(f, extra);
+                let want = if f.iter().all(|&q| q >= 0) {
+                    let f0 = f[0] as i64;
+                    s.plane_bounded(f0, f[1] as i64 - f0, f[2] as i64 - f0, extra)
+                } else {
+                    None
+                };
+                assert_eq!(got, want, "{v:?} {f:?} {extra}");
+                if let Some(p) = got {
+                    assert_eq!(p, s.plane(f.map(i64::from), extra), "{v:?} {f:?} {extra}");
+                }
+                solved += got.is_some() as u32;
+                declined += got.is_none() as u32;
+            }
+        }
+        assert!(solved > 10_000 && declined > 10_000, "{solved} {declined}");
+    }
+
     #[test]
     fn bounded_plane_equals_checked_plane() {
         fn run<const S: u32>(cases: u32, seed: u64) -> (u32, u32) {
