@@ -1352,9 +1352,6 @@ mod tests {
         assert!(walked > 10_000, "{walked}");
     }
 
-    /// `plane_bounded` takes every triangle and value it may, and gives `plane_checked`'s
-    /// plane for each: edges up to its limit (and just past it), values up to `2^32` apart
-    /// from `f0` and differences up to `2^30` (and just past both), both signs of the area.
     /// The bounded solver with its premise tested in 32 bits gives `plane_bounded`'s plane for
     /// non-negative values, and declines exactly where that does or a value is negative.
     #[test]
@@ -1400,6 +1397,9 @@ mod tests {
         assert!(solved > 10_000 && declined > 10_000, "{solved} {declined}");
     }
 
+    /// `plane_bounded` takes every triangle and value it may, and gives `plane_checked`'s
+    /// plane for each: edges up to its limit (and just past it), values up to `2^32` apart
+    /// from `f0` and differences up to `2^30` (and just past both), both signs of the area.
     #[test]
     fn bounded_plane_equals_checked_plane() {
         fn run<const S: u32>(cases: u32, seed: u64) -> (u32, u32) {
@@ -1638,7 +1638,7 @@ mod tests {
 
     /// The first centre at or after `p` is `ceil((p − 2^S) / 2^(S+1))` computed in 64 bits, for
     /// every doubled position near zero, near the guard band's ±2^23 and near the 32-bit
-    /// envelope's ends, at every sub-pixel precision.
+    /// envelope's ends, at 0, 1, 4 and 8 sub-pixel bits.
     #[test]
     fn first_centre_is_the_rounded_up_division() {
         fn check<const S: u32>() {
