@@ -1249,6 +1249,19 @@ mod tests {
         }
     }
 
+    /// A random triangle with 4 sub-pixel bits and zero depths, its coordinates from a pixel's
+    /// worth to the guard band's ±2^22 sub-pixels.
+    fn random_triangle(next: &mut impl FnMut() -> u64) -> [ScreenVertex<4>; 3] {
+        let span = 1i64 << (4 + next() % 19);
+        let mut coord = || (next() % (2 * span as u64)) as i64 - span;
+        core::array::from_fn(|_| ScreenVertex {
+            x: crate::project::SubPx(coord() as i32),
+            y: crate::project::SubPx(coord() as i32),
+            q: Depth::ZERO,
+            color: [I16F16::ZERO; 3],
+        })
+    }
+
     /// `plane` (64-bit where every step fits, else 128-bit) equals the plane computed wholly in
     /// 128 bits, for small, large and extreme triangles and values, with and without extra bits.
     #[test]
@@ -1278,15 +1291,7 @@ mod tests {
         let mut next = move || rng.next_u64();
         let mut fast = 0;
         for i in 0..20_000 {
-            // Coordinates from a pixel's worth to the guard band's ±2^22 sub-pixels.
-            let span = 1i64 << (4 + next() % 19);
-            let mut coord = || (next() % (2 * span as u64)) as i64 - span;
-            let v: [ScreenVertex<4>; 3] = core::array::from_fn(|_| ScreenVertex {
-                x: crate::project::SubPx(coord() as i32),
-                y: crate::project::SubPx(coord() as i32),
-                q: Depth::ZERO,
-                color: [I16F16::ZERO; 3],
-            });
+            let v = random_triangle(&mut next);
             let Some(s) = PlaneSolver::new(&v) else {
                 continue;
             };
@@ -1360,14 +1365,7 @@ mod tests {
         let mut next = move || rng.next_u64();
         let (mut solved, mut declined) = (0, 0);
         for _ in 0..50_000 {
-            let span = 1i64 << (4 + next() % 19);
-            let mut coord = || (next() % (2 * span as u64)) as i64 - span;
-            let v: [ScreenVertex<4>; 3] = core::array::from_fn(|_| ScreenVertex {
-                x: crate::project::SubPx(coord() as i32),
-                y: crate::project::SubPx(coord() as i32),
-                q: Depth::ZERO,
-                color: [I16F16::ZERO; 3],
-            });
+            let v = random_triangle(&mut next);
             let Some(s) = PlaneSolver::new(&v) else {
                 continue;
             };
