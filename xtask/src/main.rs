@@ -109,7 +109,7 @@ fn main() -> ExitCode {
             Some(result) => result,
             None => {
                 eprintln!(
-                    "usage: cargo xtask test | package | firmware | trace [alone] | metaball | metaball-trade | patch | patch-trade | lean | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | profile trace [pure|hybrid] [TARGET] | profile patch [TARGET] | scene-ram SCENE [TARGET...] | speed [before|after|doc] | fuzz [SECONDS]"
+                    "usage: cargo xtask test | package | firmware | trace [alone] | metaball | metaball-trade | patch | patch-trade | lean | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | profile trace [pure|hybrid] [TARGET] | profile patch [TARGET] (each profile [--blocks PATTERN]) | scene-ram SCENE [TARGET...] | speed [before|after|doc] | fuzz [SECONDS]"
                 );
                 return ExitCode::from(2);
             }
@@ -132,6 +132,17 @@ fn host_task(task: &str) -> Option<Result<(), String>> {
             .args(["run", "--package", "xtask", "--features", "host", "--"])
             .args(std::env::args().skip(1)))
     })
+}
+
+/// `args` without `--blocks PATTERN` (the profile commands' option), and PATTERN.
+#[cfg(feature = "host")]
+fn blocks_option(mut args: Vec<String>) -> (Vec<String>, Option<String>) {
+    let Some(at) = args.iter().position(|a| a == "--blocks") else {
+        return (args, None);
+    };
+    let pattern = (at + 1 < args.len()).then(|| args.remove(at + 1));
+    args.remove(at);
+    (args, pattern)
 }
 
 /// The commands that render on the host; `test-targets` is the test command's second stage.
@@ -159,7 +170,7 @@ fn host_task(task: &str) -> Option<Result<(), String>> {
             install().and_then(|_| speed::speed(&label))
         }
         "profile" if std::env::args().nth(2).as_deref() == Some("trace") => {
-            let rest: Vec<String> = std::env::args().skip(3).collect();
+            let (rest, blocks) = blocks_option(std::env::args().skip(3).collect());
             let target = rest
                 .iter()
                 .find(|a| a.contains("-none-") || a.contains("-unknown-"))
@@ -168,17 +179,17 @@ fn host_task(task: &str) -> Option<Result<(), String>> {
                 .iter()
                 .find(|a| a.as_str() != target)
                 .map_or("pure", String::as_str);
-            install().and_then(|_| profile::profile_trace(mode, target))
+            install().and_then(|_| profile::profile_trace(mode, target, blocks.as_deref()))
         }
         "profile" if std::env::args().nth(2).as_deref() == Some("patch") => {
-            let target = std::env::args()
-                .nth(3)
-                .unwrap_or_else(|| "thumbv7em-none-eabihf".into());
-            install().and_then(|_| profile::profile_patch(&target))
+            let (rest, blocks) = blocks_option(std::env::args().skip(3).collect());
+            let target = rest.first().map_or("thumbv7em-none-eabihf", String::as_str);
+            install().and_then(|_| profile::profile_patch(target, blocks.as_deref()))
         }
         "profile" => {
-            let variant = std::env::args().nth(2).unwrap_or_else(|| "balanced".into());
-            let rest: Vec<String> = std::env::args().skip(3).collect();
+            let (args, blocks) = blocks_option(std::env::args().skip(2).collect());
+            let variant = args.first().cloned().unwrap_or_else(|| "balanced".into());
+            let rest = args.get(1..).unwrap_or_default();
             let cache = rest.iter().any(|a| a == "cache");
             let target = rest
                 .iter()
@@ -188,7 +199,8 @@ fn host_task(task: &str) -> Option<Result<(), String>> {
                 .iter()
                 .find(|a| *a != "cache" && a.as_str() != target)
                 .map(String::as_str);
-            install().and_then(|_| profile::profile(&variant, cache, target, scene))
+            install()
+                .and_then(|_| profile::profile(&variant, cache, target, scene, blocks.as_deref()))
         }
         "scene-ram" => {
             let args: Vec<String> = std::env::args().skip(2).collect();

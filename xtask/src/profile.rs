@@ -15,7 +15,9 @@
 //! traced firmware's frame in one mode (thumbv7em unless a TARGET is named), and also prints per
 //! symbol the functions inlined into it (which separates, say, the shadow rays' walk in `shade`
 //! from the nearest-hit walk in `nearest`). `cargo xtask profile patch [TARGET]` profiles the
-//! patch firmware's teapot frames. The log goes through a named pipe, never to disk.
+//! patch firmware's teapot frames. Any of them with `--blocks PATTERN` also takes apart the
+//! symbols whose name contains PATTERN block by block (instructions a frame, where in the
+//! sources). The log goes through a named pipe, never to disk.
 
 use crate::tradeoff::{build_example_with_cfgs, run_on_qemu_with, CORPUS};
 use crate::{root, step};
@@ -234,6 +236,7 @@ pub fn profile(
     cache: bool,
     target: &str,
     scene: Option<&str>,
+    blocks: Option<&str>,
 ) -> Result<(), String> {
     step(&format!(
         "trade-off firmware, {variant} alone{}, {}, for {target}",
@@ -257,7 +260,7 @@ pub fn profile(
     }
     let generated = scene.map(|_| (CORPUS, corpus_file.as_path()));
     let elf = build_example_with_cfgs("tradeoff", Some(target), &cfgs, generated)?;
-    profile_elf(target, &elf, variant, |l| {
+    profile_elf(target, &elf, variant, blocks, |l| {
         l.starts_with("variant ") || l.starts_with("corpus ") || l.starts_with("summary ")
     })
 }
@@ -322,7 +325,7 @@ pub fn scene_ram(scene: &str, targets: &[&str]) -> Result<(), String> {
 
 /// `cargo xtask profile trace [pure|hybrid] [TARGET]`: the traced firmware's frame in one mode
 /// alone (`--cfg scanline3d_trace_only`), profiled like a trade-off variant.
-pub fn profile_trace(mode: &str, target: &str) -> Result<(), String> {
+pub fn profile_trace(mode: &str, target: &str, blocks: Option<&str>) -> Result<(), String> {
     if !["pure", "hybrid"].contains(&mode) {
         return Err(format!("trace mode {mode:?}: pure or hybrid"));
     }
@@ -331,17 +334,17 @@ pub fn profile_trace(mode: &str, target: &str) -> Result<(), String> {
     ));
     let cfgs = [format!("scanline3d_trace_only=\"{mode}\"")];
     let elf = build_example_with_cfgs("trace", Some(target), &cfgs, None)?;
-    profile_elf(target, &elf, &format!("trace {mode}"), |l| {
+    profile_elf(target, &elf, &format!("trace {mode}"), blocks, |l| {
         l.starts_with("frame ")
     })
 }
 
 /// `cargo xtask profile patch [TARGET]`: the patch firmware's teapot frames (tolerance
 /// 0.5 px), profiled like a trade-off variant (thumbv7em unless a TARGET is named).
-pub fn profile_patch(target: &str) -> Result<(), String> {
+pub fn profile_patch(target: &str, blocks: Option<&str>) -> Result<(), String> {
     step(&format!("patch firmware (teapot, 0.5 px) for {target}"));
     let elf = build_example_with_cfgs("patch", Some(target), &[], None)?;
-    profile_elf(target, &elf, "patch", |l| l.starts_with("frame "))
+    profile_elf(target, &elf, "patch", blocks, |l| l.starts_with("frame "))
 }
 
 /// What the log says ran: per block and per instruction address, with the built-ins apart.
@@ -421,11 +424,13 @@ fn count_blocks(log: impl BufRead, syms: &[(u64, u64, String)]) -> Result<Counts
 /// Runs `elf` on QEMU with every executed block logged into a named pipe that is read as QEMU
 /// writes it (no multi-gigabyte file), and prints the output lines `frame_line` picks, the share
 /// of compiler built-ins, the top functions, the top source lines, the top functions of our
-/// sources (inlined or not) and the functions inlined into each symbol.
+/// sources (inlined or not) and the functions inlined into each symbol; with `blocks`, also
+/// the executed blocks of the symbols whose name contains it ([`print_blocks`]).
 fn profile_elf(
     target: &str,
     elf: &std::path::Path,
     what: &str,
+    blocks: Option<&str>,
     frame_line: impl Fn(&str) -> bool,
 ) -> Result<(), String> {
     let fifo = root().join("target/profile-trace.fifo");
@@ -466,7 +471,11 @@ fn profile_elf(
     for line in &frame_lines {
         println!("{line}");
     }
-    let frames = frame_lines.len();
+    // (A `summary` line, printed with the frames, is not one.)
+    let frames = frame_lines
+        .iter()
+        .filter(|l| !l.starts_with("summary "))
+        .count();
     let total = c.total;
     println!(
         "\n{frames} frames of `{what}` on {target}: {total} instructions ({} a frame, set-up and output included), {:.1} % of them in compiler built-ins (software 64-bit multiply and divide, memcpy, ...)",
@@ -565,7 +574,87 @@ fn profile_elf(
     for (name, n) in by_inlined.iter().take(30) {
         println!("{:6.2} %  {name}", percent(*n, total));
     }
+    if let Some(pattern) = blocks {
+        print_blocks(&c, &syms, &lines, pattern, frames.max(1) as f64);
+    }
     Ok(())
+}
+
+/// `--blocks PATTERN`: per symbol whose name contains `pattern`, its instructions a frame
+/// (with the built-ins it calls) and its 40 costliest blocks as QEMU translated them (a block:
+/// straight-line code entered at its first address; a loop's first iteration can share its
+/// entry's block): instructions a frame, runs a frame times length, first address, and the
+/// innermost source functions of its instructions (`function @ path:line (instructions)`, the
+/// three most common); then the built-ins it called, a frame each. A function's cost taken
+/// apart to the branch without a debugger.
+fn print_blocks(
+    c: &Counts,
+    syms: &[(u64, u64, String)],
+    lines: &HashMap<u64, Site>,
+    pattern: &str,
+    frames: f64,
+) {
+    let mut symbols: HashMap<&str, u64> = HashMap::new();
+    for (site, n) in &c.per_site {
+        let name = name_of(syms, *site);
+        if short_name(name).contains(pattern) {
+            *symbols.entry(name).or_default() += n;
+        }
+    }
+    let mut symbols: Vec<_> = symbols.into_iter().collect();
+    symbols.sort_by_key(|s| std::cmp::Reverse(s.1));
+    if symbols.is_empty() {
+        println!("\nno executed symbol's name contains `{pattern}`");
+    }
+    for (symbol, n) in symbols {
+        println!(
+            "\n{}: {:.0} instructions a frame, with the built-ins it calls; its costliest blocks:",
+            short_name(symbol),
+            n as f64 / frames
+        );
+        let mut blocks: Vec<(f64, f64, usize, u64, String)> = c
+            .runs
+            .iter()
+            .filter(|(pc, _)| name_of(syms, **pc) == symbol)
+            .map(|(pc, runs)| {
+                let one = [*pc];
+                let addrs = c.blocks.get(pc).map_or(&one[..], Vec::as_slice);
+                let mut from: HashMap<String, usize> = HashMap::new();
+                for a in addrs {
+                    if let Some(s) = lines.get(a).filter(|s| !s.line.is_empty()) {
+                        *from.entry(format!("{} @ {}", s.function, s.line)).or_default() += 1;
+                    }
+                }
+                let mut from: Vec<_> = from.into_iter().collect();
+                from.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
+                let source = from
+                    .iter()
+                    .take(3)
+                    .map(|(f, k)| format!("{f} ({k})"))
+                    .collect::<Vec<_>>()
+                    .join("; ");
+                let per_frame = *runs as f64 / frames;
+                let len = addrs.len();
+                (per_frame * len as f64, per_frame, len, *pc, source)
+            })
+            .collect();
+        blocks.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.3.cmp(&b.3)));
+        for (instructions, runs, len, pc, source) in blocks.iter().take(40) {
+            println!("{instructions:10.0} = {runs:9.1} x {len:3}  {pc:#x}  {source}");
+        }
+        // The built-ins' instructions are in the symbol's total, not in its blocks.
+        let mut builtins: HashMap<String, u64> = HashMap::new();
+        for ((site, pc), n) in &c.builtin_site {
+            if name_of(syms, *site) == symbol {
+                *builtins.entry(short_name(name_of(syms, *pc))).or_default() += n;
+            }
+        }
+        let mut builtins: Vec<_> = builtins.into_iter().collect();
+        builtins.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
+        for (name, n) in builtins {
+            println!("{:10.0}   in built-in {name}", n as f64 / frames);
+        }
+    }
 }
 
 /// A symbol without its hash and crate path: `Tracer<_>::shade`.
