@@ -90,6 +90,36 @@ pub(crate) const NO_WIDE_MULTIPLY: bool =
 pub(crate) const NO_HARDWARE_DIVIDE: bool =
     cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
 
+/// Whether quotients start from a single-precision estimate: on Arm cores with a hardware FPU
+/// (the `eabihf` targets, Cortex-M4F and the like), where a conversion, multiply or divide of
+/// `f32` is one instruction. The integer corrections after the estimate make every result
+/// exactly that of the integer forms, on every target.
+pub(crate) const FLOAT_ESTIMATES: bool = cfg!(all(target_arch = "arm", target_abi = "eabihf"));
+
+/// `⌊n / d⌋` for a quotient below 2^32 (`n < d·2^32`) from an `f32` estimate and one 32-bit
+/// division of its remainder, or `None` where that remainder does not fit 32 bits (for `n`
+/// above about 2^52 or `d` above about 2^29, for a quotient below 2, whose estimate taken down
+/// wraps, and for `d = 0`): the caller then divides in integers. The estimate `q` errs relatively by less than 2^-22 (the numerator's two words
+/// converted and summed, `d` converted, the quotient: each rounded by 2^-24); taken down to
+/// `q0 = q − q/2^21 − 2`, below the exact quotient, its remainder `n − q0·d` is non-negative
+/// and below `(⌊n/d⌋/2^20 + 4)·d`, and `q0 + ⌊remainder / d⌋` is the quotient. Exact whatever
+/// the estimate gives: a `q0` above the quotient leaves a wrapped remainder of at least 2^33 − 1,
+/// which the check turns away (test `float_estimated_division_is_exact`).
+#[inline]
+pub(crate) fn div_below_float(n: u64, d: u32) -> Option<u32> {
+    debug_assert!(
+        ((n >> 32) as u32) < d,
+        "quotient of {n} / {d} beyond 32 bits"
+    );
+    const TWO_TO_32: f32 = 4_294_967_296.0;
+    let estimate = ((n >> 32) as u32 as f32 * TWO_TO_32 + n as u32 as f32) / d as f32;
+    let q0 = estimate as u32; // (saturating; 0 for a NaN)
+    let q0 = q0.wrapping_sub(q0 >> 21).wrapping_sub(2);
+    let remainder = n.wrapping_sub(u64::from(q0) * u64::from(d));
+    let remainder = u32::try_from(remainder).ok()?;
+    Some(q0.wrapping_add(remainder.checked_div(d)?))
+}
+
 /// `(n / d, n % d)` for 32-bit operands (`d = 0` is taken as 1) from multiplies, for cores
 /// without a divider ([`NO_HARDWARE_DIVIDE`]; on every target, tested on the host too): `n < d` by one
 /// comparison, quotients 1 and 2 by subtraction, else by a [`SoftDivisor`].
@@ -1566,6 +1596,72 @@ mod tests {
             let n = n - n % r + (x % 3).saturating_sub(1) * (r - 1);
             assert_eq!(root_and_quotient(x, n), Some((r, n / r)), "{x} {n}");
         }
+    }
+
+    /// `div_below_float` gives the quotient or `None`, never another value, for every divisor
+    /// class and numerator below `d·2^32`; and gives it (`Some`) wherever the error bound says
+    /// the remainder fits (`n < 2^50`, `d < 2^29`, a quotient of at least 2), the depth's
+    /// numerators `near·2^30` included.
+    #[test]
+    fn float_estimated_division_is_exact() {
+        let mut rng = crate::test_rng::XorShift64::new(0x5851_f42d_4c95_7f2du64);
+        // Divisions the bound covers: each must be answered, and there must be many.
+        let mut covered = 0u32;
+        let mut check = |n: u64, d: u32| {
+            let want = n / d as u64;
+            let got = div_below_float(n, d);
+            if let Some(q) = got {
+                assert_eq!(q as u64, want, "{n} / {d}");
+            }
+            if n < 1 << 50 && d < 1 << 29 && want >= 2 {
+                assert!(got.is_some(), "{n} / {d} given up");
+                covered += 1;
+            }
+        };
+        let ds = [
+            1u32,
+            2,
+            3,
+            255,
+            0xFFFF,
+            1 << 20,
+            (1 << 29) - 1,
+            1 << 31,
+            u32::MAX,
+        ];
+        for d in ds {
+            let top = (d as u64) << 32;
+            for n in [
+                0,
+                1,
+                d as u64 - 1,
+                d as u64,
+                top / 3,
+                top - d as u64,
+                top - 1,
+            ] {
+                check(n, d);
+            }
+        }
+        for _ in 0..1_000_000 {
+            let x = rng.next_u64();
+            let d = ((x as u32) >> ((x >> 32) % 32)).max(1);
+            // Numerators of every length up to the quotient's limit.
+            let n = rng.next_u64() >> ((x >> 40) % 64);
+            let n = n % ((d as u64) << 32);
+            check(n, d);
+        }
+        // The vertex depth's divisions: `near·2^30 / w` for `w` from `near / 4` up.
+        for _ in 0..200_000 {
+            let x = rng.next_u64();
+            let near = ((x as u32) >> (12 + (x >> 32) % 20)).max(1);
+            let w = (near / 4 + 1).saturating_add((x >> 40) as u32 >> ((x >> 36) % 16));
+            let n = (near as u64) << 30;
+            if n >> 32 < w as u64 {
+                check(n, w);
+            }
+        }
+        assert!(covered > 300_000, "{covered} covered divisions");
     }
 
     #[test]

@@ -15,8 +15,8 @@
 
 use crate::depth::Depth;
 use crate::math::{
-    bit_length_u64, div_rem_below, floor_div_i64, i16f16_from_f32, mul_i64_i32, mul_wide, shr_i64,
-    SoftDivisor, NO_HARDWARE_DIVIDE,
+    bit_length_u64, div_below_float, div_rem_below, floor_div_i64, i16f16_from_f32, mul_i64_i32,
+    mul_wide, shr_i64, SoftDivisor, FLOAT_ESTIMATES, NO_HARDWARE_DIVIDE,
 };
 use crate::vertex::EyePoint;
 use fixed::types::I16F16;
@@ -316,15 +316,25 @@ impl<const S: u32> Viewport<S> {
 /// 2^32, and some value of at least 2^32 elsewhere, which [`screen_vertex`] saturates as it
 /// does the quotient: for `near > 0` the quotient fits 32 bits exactly when the numerator's
 /// high word is below `w` (a vertex no nearer than `near / 4`), and then one 64 / 32-bit step
-/// ([`div_rem_below`]) divides it, without the general division's high-word step and signs.
-/// Test `depth_of_saturates_as_the_division`. Not inlined, as the division it replaces was
+/// ([`div_rem_below`]) divides it, without the general division's high-word step and signs;
+/// on a core with an FPU, an `f32` estimate and one 32-bit division of its remainder
+/// ([`div_below_float`], the same quotient). Test `depth_of_saturates_as_the_division`. Not inlined, as the division it replaces was
 /// not: inlined, it made `Viewport::project_with` too large to be inlined itself.
 #[inline(never)]
 fn depth_of(near: i32, w: i32) -> i64 {
     let n = (near as i64) << 30;
     match (u64::try_from(n), u32::try_from(w)) {
         (Ok(n), Ok(w)) if ((n >> 32) as u32) < w => {
-            div_rem_below((n >> 32) as u32, n as u32, w).0 as i64
+            // On an FPU core, from an `f32` estimate (exact all the same).
+            let float = if FLOAT_ESTIMATES {
+                div_below_float(n, w)
+            } else {
+                None
+            };
+            match float {
+                Some(q) => q as i64,
+                None => div_rem_below((n >> 32) as u32, n as u32, w).0 as i64,
+            }
         }
         (Ok(_), Ok(_)) => 1 << 32,
         _ => floor_div_i64(n, w as i64),

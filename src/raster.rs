@@ -28,8 +28,8 @@
 
 use crate::depth::Depth;
 use crate::math::{
-    div_rem_u32_soft, floor_div_i64, mul_i64_i32, mul_i64_u16, mul_wide, Divisor32,
-    NO_HARDWARE_DIVIDE, NO_WIDE_MULTIPLY,
+    div_below_float, div_rem_u32_soft, floor_div_i64, mul_i64_i32, mul_i64_u16, mul_wide,
+    Divisor32, FLOAT_ESTIMATES, NO_HARDWARE_DIVIDE, NO_WIDE_MULTIPLY,
 };
 use crate::project::ScreenVertex;
 use fixed::types::I16F16;
@@ -674,13 +674,12 @@ impl PlaneSolver {
 }
 
 /// [`round_div_i64`] by one divisor `d` several times (a plane's three quotients by its
-/// triangle's area): where `2d` fits 32 bits, one reciprocal ([`Divisor32`]) and multiplies
-/// for each quotient instead of a 64 / 32-bit division each. The same quotients (test
-/// `round_divisor_equals_round_div`).
+/// triangle's area): where `2d` fits 32 bits, each quotient by a [`PlaneDivisor`] instead of
+/// a 64 / 32-bit division. The same quotients (test `round_divisor_equals_round_div`).
 #[derive(Clone, Copy, Debug)]
 struct RoundDivisor {
     d: i64,
-    by: Option<Divisor32>,
+    by: Option<PlaneDivisor>,
 }
 
 impl RoundDivisor {
@@ -691,7 +690,7 @@ impl RoundDivisor {
         let by = d
             .checked_mul(2)
             .and_then(|d2| u32::try_from(d2).ok())
-            .map(Divisor32::new);
+            .map(<PlaneDivisor as FloorDivisor>::new);
         RoundDivisor { d, by }
     }
 
@@ -700,7 +699,10 @@ impl RoundDivisor {
     #[inline(always)]
     fn round_div(&self, n: i64) -> Option<i64> {
         match self.by {
-            Some(by) => Some(by.floor_div(n.checked_mul(2)?.checked_add(self.d)?)),
+            Some(by) => Some(FloorDivisor::floor_div(
+                &by,
+                n.checked_mul(2)?.checked_add(self.d)?,
+            )),
             None => round_div_i64(n, self.d),
         }
     }
@@ -711,10 +713,84 @@ impl RoundDivisor {
     fn round_div_bounded(&self, n: i64) -> i64 {
         let num = n.wrapping_mul(2).wrapping_add(self.d);
         match self.by {
-            Some(by) => by.floor_div(num),
+            Some(by) => FloorDivisor::floor_div(&by, num),
             None => floor_div_i64(num, self.d.wrapping_mul(2)),
         }
     }
+}
+
+/// Floored division of 64-bit numerators by one 32-bit divisor.
+trait FloorDivisor: Copy + core::fmt::Debug {
+    fn new(d: u32) -> Self;
+    /// `num.div_euclid(d)`.
+    fn floor_div(&self, num: i64) -> i64;
+}
+
+impl FloorDivisor for Divisor32 {
+    #[inline]
+    fn new(d: u32) -> Self {
+        Divisor32::new(d)
+    }
+    #[inline(always)]
+    fn floor_div(&self, num: i64) -> i64 {
+        Divisor32::floor_div(self, num)
+    }
+}
+
+/// The divisor itself, for quotients from an `f32` estimate ([`floor_div_by_float`]), and the
+/// general division where that gives up: no reciprocal to make.
+#[derive(Clone, Copy, Debug)]
+#[allow(dead_code)] // (outside the tests, only FPU cores use it)
+struct FloatDivisor(u32);
+
+impl FloorDivisor for FloatDivisor {
+    #[inline]
+    fn new(d: u32) -> Self {
+        FloatDivisor(d)
+    }
+    #[inline]
+    fn floor_div(&self, num: i64) -> i64 {
+        floor_div_by_float(num, self.0).unwrap_or_else(|| floor_div_i64(num, i64::from(self.0)))
+    }
+}
+
+/// [`FloatDivisor`] on cores with an FPU ([`FLOAT_ESTIMATES`]: a conversion or division of
+/// `f32` is one instruction there), the reciprocal ([`Divisor32`]) elsewhere.
+type PlaneDivisor = <Pick<FLOAT_ESTIMATES> as PickDivisor>::Divisor;
+
+/// Chooses [`PlaneDivisor`] by a constant.
+struct Pick<const FLOAT: bool>;
+
+trait PickDivisor {
+    type Divisor: FloorDivisor;
+}
+
+impl PickDivisor for Pick<true> {
+    type Divisor = FloatDivisor;
+}
+
+impl PickDivisor for Pick<false> {
+    type Divisor = Divisor32;
+}
+
+/// `⌊num / d⌋` from an `f32` estimate ([`div_below_float`]) where the quotient's magnitude
+/// fits 32 bits, `None` elsewhere and where the estimate gives up (the caller then divides in
+/// integers): a negative `num`'s floor is minus the ceiling of `|num| / d`, the floor of
+/// `(|num| + d − 1) / d`. (A quotient beyond 32 bits, a sliver's steep gradient, is a few in a
+/// hundred: a high word's division here as well measured slower than the fallback.) Test
+/// `float_floor_division_is_floor_div`.
+#[inline(always)]
+fn floor_div_by_float(num: i64, d: u32) -> Option<i64> {
+    let magnitude = num.unsigned_abs();
+    let rounded_up = match num < 0 {
+        true => magnitude.checked_add(u64::from(d.checked_sub(1)?))?,
+        false => magnitude,
+    };
+    if (rounded_up >> 32) as u32 >= d {
+        return None;
+    }
+    let q = i64::from(div_below_float(rounded_up, d)?);
+    Some(if num < 0 { -q } else { q })
 }
 
 /// [`cross_diff`] where every factor fits 31 bits (`None` otherwise): exact in 64 bits.
@@ -1915,6 +1991,41 @@ mod tests {
         let (q, dq) = p.span_start(2, 3);
         assert!((q as f64 / (1u64 << 30) as f64 - (0.5 - 0.05 + 0.15)).abs() < 1e-8);
         assert!((dq as f64 / (1u64 << 30) as f64 + 0.025).abs() < 1e-8);
+    }
+
+    /// `floor_div_by_float` is the floored division (`floor_div_i64`) or `None`, for numerators
+    /// of both signs and every length, and answers every division its estimate covers (a
+    /// quotient's magnitude from 2 to 2^32, `|num| < 2^50`, `d < 2^29`); `FloatDivisor`, with
+    /// the general division behind it, is always the floor.
+    #[test]
+    fn float_floor_division_is_floor_div() {
+        let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
+        for k in 0..1_000_000u32 {
+            let x = rng.next_u64();
+            let d = ((x as u32) >> ((x >> 32) % 32)).max(1);
+            let num = match k % 4 {
+                // Around multiples of d, on both sides of zero.
+                0 => (rng.next_u64() % (1 << 40)) as i64 / d as i64 * d as i64 - (k as i64 % 3),
+                _ => (rng.next_u64() as i64) >> ((x >> 40) % 64),
+            };
+            let got = floor_div_by_float(num, d);
+            // With the fallback, the FPU cores' plane divisor: always the floor.
+            let floored = FloorDivisor::floor_div(&FloatDivisor(d), num);
+            assert_eq!(floored, num.div_euclid(d as i64), "{num} / {d}");
+            if let Some(q) = got {
+                assert_eq!(q, floor_div_i64(num, d as i64), "{num} / {d}");
+            } else {
+                let magnitude = num.unsigned_abs();
+                let quotient = magnitude / d as u64;
+                let covered =
+                    magnitude < 1 << 50 && d < 1 << 29 && (2..1 << 32).contains(&quotient);
+                assert!(!covered, "{num} / {d} given up");
+            }
+        }
+        assert_eq!(floor_div_by_float(-6, 2), Some(-3));
+        assert_eq!(floor_div_by_float(-7, 2), Some(-4));
+        assert_eq!(floor_div_by_float(i64::MIN, 1), None);
+        assert_eq!(floor_div_by_float(5, 0), None);
     }
 
     #[test]

@@ -268,7 +268,7 @@ pub fn narrow(v: I32F32) -> Option<I16F16> {
 /// point: on Arm cores with a hardware FPU (the `eabihf` targets, Cortex-M4F and the like), where
 /// a conversion, multiply or divide of `f32` is one instruction. The integer corrections after the
 /// estimate make the results exactly those of the integer forms on every target.
-pub const FLOAT_ESTIMATES: bool = cfg!(all(target_arch = "arm", target_abi = "eabihf"));
+pub const FLOAT_ESTIMATES: bool = crate::math::FLOAT_ESTIMATES;
 
 /// ⌊√v⌋ for a 32-bit integer, the tracer's: [`isqrt32_float`] where the core has an FPU
 /// ([`FLOAT_ESTIMATES`]), [`isqrt32_table`] on ARMv6-M (no divider), else [`isqrt32`]. The
