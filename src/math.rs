@@ -97,14 +97,15 @@ pub(crate) const NO_HARDWARE_DIVIDE: bool =
 pub(crate) const FLOAT_ESTIMATES: bool = cfg!(all(target_arch = "arm", target_abi = "eabihf"));
 
 /// `⌊n / d⌋` for a quotient below 2^32 (`n < d·2^32`) from an `f32` estimate and one 32-bit
-/// division of its remainder, or `None` where that remainder does not fit 32 bits (for `n`
-/// above about 2^52 or `d` above about 2^29, for a quotient below 2, whose estimate taken down
-/// wraps, and for `d = 0`): the caller then divides in integers. The estimate `q` errs relatively by less than 2^-22 (the numerator's two words
-/// converted and summed, `d` converted, the quotient: each rounded by 2^-24); taken down to
-/// `q0 = q − q/2^21 − 2`, below the exact quotient, its remainder `n − q0·d` is non-negative
-/// and below `(⌊n/d⌋/2^20 + 4)·d`, and `q0 + ⌊remainder / d⌋` is the quotient. Exact whatever
-/// the estimate gives: a `q0` above the quotient leaves a wrapped remainder of at least 2^33 − 1,
-/// which the check turns away (test `float_estimated_division_is_exact`).
+/// division of its remainder, or `None` where that remainder does not fit 32 bits (for `n` above
+/// about 2^52 or `d` above about 2^29, for a quotient below 2, whose estimate taken down wraps, and
+/// for `d = 0`): the caller then divides in integers. The estimate `q` errs relatively by less than
+/// 2^-22 (the numerator's two words converted and summed, `d` converted, the quotient: each rounded
+/// by 2^-24); taken down to `q0 = q − q/2^21 − 2`, below the exact quotient, its remainder
+/// `n − q0·d` is non-negative and below `(⌊n/d⌋/2^20 + 4)·d`, and `q0 + ⌊remainder / d⌋` is the
+/// quotient. Exact whatever the estimate gives: a `q0` above the quotient leaves a wrapped
+/// remainder of at least 2^33 − 1, which the check turns away (test
+/// `float_estimated_division_is_exact`).
 #[inline]
 pub(crate) fn div_below_float(n: u64, d: u32) -> Option<u32> {
     debug_assert!(

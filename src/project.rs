@@ -312,14 +312,15 @@ impl<const S: u32> Viewport<S> {
     }
 }
 
-/// The exact depth `⌊near·2^30 / w⌋` (`near`, `w` raw I16F16, `w > 0`) wherever it is below
-/// 2^32, and some value of at least 2^32 elsewhere, which [`screen_vertex`] saturates as it
-/// does the quotient: for `near > 0` the quotient fits 32 bits exactly when the numerator's
-/// high word is below `w` (a vertex no nearer than `near / 4`), and then one 64 / 32-bit step
-/// ([`div_rem_below`]) divides it, without the general division's high-word step and signs;
-/// on a core with an FPU, an `f32` estimate and one 32-bit division of its remainder
-/// ([`div_below_float`], the same quotient). Test `depth_of_saturates_as_the_division`. Not inlined, as the division it replaces was
-/// not: inlined, it made `Viewport::project_with` too large to be inlined itself.
+/// The exact depth `⌊near·2^30 / w⌋` (`near`, `w` raw I16F16, `w > 0`) wherever it is below 2^32,
+/// and some value of at least 2^32 elsewhere, which [`screen_vertex`] saturates as it does the
+/// quotient: for `near > 0` the quotient fits 32 bits exactly when the numerator's high word is
+/// below `w` (a vertex no nearer than `near / 4`), and then one 64 / 32-bit step
+/// ([`div_rem_below`]) divides it, without the general division's high-word step and signs; on a
+/// core with an FPU, an `f32` estimate and one 32-bit division of its remainder
+/// ([`div_below_float`], the same quotient). Test `depth_of_saturates_as_the_division`. Not
+/// inlined, as the division it replaces was not: inlined, it made `Viewport::project_with` too
+/// large to be inlined itself.
 #[inline(never)]
 fn depth_of(near: i32, w: i32) -> i64 {
     let n = (near as i64) << 30;

@@ -721,6 +721,7 @@ impl RoundDivisor {
 
 /// Floored division of 64-bit numerators by one 32-bit divisor.
 trait FloorDivisor: Copy + core::fmt::Debug {
+    /// The divisor `d` (at least 1).
     fn new(d: u32) -> Self;
     /// `num.div_euclid(d)`.
     fn floor_div(&self, num: i64) -> i64;
