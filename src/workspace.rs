@@ -74,7 +74,10 @@ impl<P: RowPixel, S: Shading, Z: DepthFormat> Resolve<P, S> for SpanZBuffer<'_, 
     fn begin_band(&mut self, _: i32, _: usize) {
         let (lo, hi) = self.dirty;
         if let (Some(d), Some(p)) = (self.depth.get_mut(lo..hi), self.pixels.get_mut(lo..hi)) {
-            d.fill(Z::FAR);
+            // The far depth hidden from the optimizer, which would otherwise make the fill a
+            // call of `memclr` (the far depth is zero): this loop's paired stores take about
+            // half its instructions on Cortex-M4, and fewer on Cortex-M0 and RISC-V too.
+            fill_by_fours(d, core::hint::black_box(Z::FAR));
             fill_by_fours(p, self.background);
         } else {
             // Only a clean row (lo > hi: nothing written) has no range to clear.
