@@ -95,7 +95,10 @@ fn symbols(elf: &std::path::Path) -> Result<Vec<(u64, u64, String)>, String> {
                 return None;
             }
             let start = u64::from_str_radix(start, 16).ok()? & !1;
-            Some((start, u64::from_str_radix(size, 16).ok()?, name.to_string()))
+            let size = u64::from_str_radix(size, 16).ok()?;
+            // Labels and mapping symbols (`$t`, `$x`, and RISC-V's local `.L0` labels inside
+            // functions) have no size: kept, they would hide the function around them.
+            (size > 0).then(|| (start, size, name.to_string()))
         })
         .collect();
     syms.sort();
