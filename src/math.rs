@@ -367,30 +367,6 @@ fn shr_u64_in_words(v: u64, s: u32) -> u64 {
     (u64::from(hi) << 32) | u64::from(lo)
 }
 
-/// `(a · b) mod 2^64` for `0 <= b < 2^16`, as `a.wrapping_mul(b as i64)`: on cores without a
-/// wide multiply ([`NO_WIDE_MULTIPLY`]) from three 32-bit multiplies (`a`'s low word in two
-/// 16-bit halves and its high word, each times `b`, whose products fit 32 bits), elsewhere
-/// the `i64` multiply. The same bits either way (test `narrow_products_are_exact`).
-#[inline]
-pub(crate) fn mul_i64_u16(a: i64, b: u16) -> i64 {
-    if NO_WIDE_MULTIPLY {
-        mul_i64_u16_in_words(a, b)
-    } else {
-        a.wrapping_mul(b as i64)
-    }
-}
-
-/// [`mul_i64_u16`] from 32-bit multiplies, on every target (tested on the host too).
-#[inline]
-fn mul_i64_u16_in_words(a: i64, b: u16) -> i64 {
-    let b = b as u32;
-    let (hi, lo) = ((a >> 32) as u32, a as u32);
-    // a·b = hi·b·2^32 + (lo >> 16)·b·2^16 + (lo & 0xFFFF)·b; both halves' products < 2^32.
-    let (mid, low) = ((lo >> 16) * b, (lo & 0xFFFF) * b);
-    let low_word = ((mid as u64) << 16) + low as u64;
-    low_word.wrapping_add((hi.wrapping_mul(b) as u64) << 32) as i64
-}
-
 /// Cosine of the angle between an integer vector `v` of any scale and a unit vector `unit`
 /// (I2F30 bits), in I2F30 bits truncated towards zero; `None` for the zero vector.
 ///
@@ -1304,11 +1280,6 @@ mod tests {
                 // Either factor wider than 32 bits, or both within.
                 assert_eq!(mul_i64(a, b as i64), a * b as i64, "{a} * {b}");
                 assert_eq!(mul_i64(b as i64, a), a * b as i64, "{b} * {a}");
-            }
-            for b in [(x >> 48) as u16, 0, 1, u16::MAX, (x >> 20) as u16 & 0x7FF] {
-                let want = a.wrapping_mul(b as i64);
-                assert_eq!(mul_i64_u16_in_words(a, b), want, "{a} * {b}");
-                assert_eq!(mul_i64_u16(a, b), want, "{a} * {b}");
             }
         }
     }

@@ -28,8 +28,8 @@
 
 use crate::depth::Depth;
 use crate::math::{
-    div_below_float, div_rem_u32_soft, floor_div_i64, mul_i64_i32, mul_i64_u16, mul_wide,
-    Divisor32, FLOAT_ESTIMATES, NO_HARDWARE_DIVIDE, NO_WIDE_MULTIPLY,
+    div_below_float, div_rem_u32_soft, floor_div_i64, mul_i64_i32, mul_wide, Divisor32,
+    FLOAT_ESTIMATES, NO_HARDWARE_DIVIDE, NO_WIDE_MULTIPLY,
 };
 use crate::project::ScreenVertex;
 use fixed::types::I16F16;
@@ -759,8 +759,8 @@ impl FloorDivisor for FloatDivisor {
 /// `f32` is one instruction there), the reciprocal ([`Divisor32`]) elsewhere.
 type PlaneDivisor = <Pick<FLOAT_ESTIMATES> as PickDivisor>::Divisor;
 
-/// Chooses [`PlaneDivisor`] by a constant.
-struct Pick<const FLOAT: bool>;
+/// Chooses [`PlaneDivisor`] and [`WalkDepth`] by a constant.
+pub(crate) struct Pick<const B: bool>;
 
 trait PickDivisor {
     type Divisor: FloorDivisor;
@@ -941,15 +941,16 @@ impl DepthPlane {
 
     /// The plane walked down the rows from row `r` ([`WalkDepth`]).
     #[inline]
-    pub fn walk_from(&self, r: i32) -> WalkDepth {
-        WalkDepth {
-            // `row_q = value − dx·c_ref + dy·(r − r_ref)`, wrapping (mod 2^64) as
-            // `PixelOrigin::at` does, so `row_q + dx·c` is its value at `(c, r)` to the bit.
-            q: Plane {
-                value: self.origin.at(&self.q, 0, r),
-                ..self.q
-            },
-        }
+    pub(crate) fn walk_from<W: DepthWalk>(&self, r: i32) -> W {
+        // `row_q = value − dx·c_ref + dy·(r − r_ref)`, wrapping (mod 2^64) as
+        // `PixelOrigin::at` does, so `row_q + dx·c` is its value at `(c, r)` to the bit.
+        W::new(self.origin.at(&self.q, 0, r), &self.q)
+    }
+
+    /// The per-pixel step of [`DepthPlane::span_start`] (the same on every row).
+    #[inline]
+    pub fn step(&self) -> i32 {
+        depth_step(&self.q)
     }
 
     /// Start value and per-pixel step, in [`Depth`] bits, for the span starting at `(c, r)`.
@@ -979,40 +980,135 @@ fn depth_step(q: &Plane) -> i32 {
     dq.clamp(i32::MIN as i64, i32::MAX as i64) as i32
 }
 
-/// A [`DepthPlane`] walked down a triangle's rows: the plane's value is kept at column 0 of
-/// the walk's current row, so a span's start takes one multiply instead of two, with the same
-/// result as [`DepthPlane::span_start`] to the bit.
+/// A [`DepthPlane`] walked down a triangle's rows, its value kept at column 0 of the walk's
+/// current row so that a span's start takes one product instead of two: [`SplitWalk`] on
+/// Arm, [`WideWalk`] elsewhere (on RISC-V the split form measured slower: `cargo xtask
+/// profile`, docs/speed.md item 31). The same start either way.
+pub(crate) type WalkDepth = <Pick<{ cfg!(target_arch = "arm") }> as PickWalk>::Walk;
+
+/// Chooses [`WalkDepth`] by a constant.
+pub(crate) trait PickWalk {
+    type Walk: DepthWalk;
+}
+
+impl PickWalk for Pick<true> {
+    type Walk = SplitWalk;
+}
+
+impl PickWalk for Pick<false> {
+    type Walk = WideWalk;
+}
+
+/// A depth plane walked down the rows ([`WalkDepth`]).
+pub(crate) trait DepthWalk: Copy + core::fmt::Debug {
+    /// The walk of plane `q` from a row where it is `value` at column 0.
+    fn new(value: i64, q: &Plane) -> Self;
+    /// Moves one row down.
+    fn next_row(&mut self);
+    /// [`DepthPlane::span_start`]'s start for the span starting at column `c` (on the screen:
+    /// `0 ≤ c < 2^12`) of the current row, at a centre the triangle covers.
+    fn span_start(&self, c: i32) -> i32;
+}
+
+/// The plane in 64-bit words: `value` at column 0 of the current row.
 #[derive(Clone, Copy, Debug)]
-pub struct WalkDepth {
-    /// `value`: the plane at column 0 of the current row.
+pub(crate) struct WideWalk {
     q: Plane,
 }
 
-impl WalkDepth {
-    /// Moves one row down.
+impl DepthWalk for WideWalk {
     #[inline]
-    pub fn next_row(&mut self) {
+    fn new(value: i64, q: &Plane) -> Self {
+        WideWalk {
+            q: Plane { value, ..*q },
+        }
+    }
+
+    #[inline]
+    fn next_row(&mut self) {
         self.q.value = self.q.value.wrapping_add(self.q.dy);
     }
 
-    /// [`DepthPlane::span_start`]'s start for the span starting at column `c` of the current
-    /// row.
     #[inline]
-    pub fn span_start(&self, c: i32) -> i32 {
-        // Spans start on the screen, `0 <= c < 2048`: a product by a 16-bit column, cheaper
-        // on cores without a wide multiply (the same bits).
-        let dx_c = match u16::try_from(c) {
-            Ok(c) => mul_i64_u16(self.q.dx, c),
-            Err(_) => self.q.dx.wrapping_mul(c as i64),
-        };
-        let q = self.q.value.wrapping_add(dx_c);
-        clamped_depth(q)
+    fn span_start(&self, c: i32) -> i32 {
+        clamped_depth(self.q.value.wrapping_add(self.q.dx.wrapping_mul(c as i64)))
+    }
+}
+
+/// The largest vertex depth of a drawn triangle, in [`Depth`] bits: a drawn vertex has
+/// `w ≥ near` (inside the near plane) or lies on a clip plane within half an I16F16 unit of
+/// `w` (the clipper's rounding), and `near` is at least [`MIN_NEAR`](crate::scene::MIN_NEAR)
+/// = 256 units, so `q = near · 2^30 / w ≤ 2^30 · 256 / 255 < 2^30 + 2^23`.
+pub(crate) const MAX_DRAWN_DEPTH: i32 = (1 << 30) + (1 << 23);
+
+/// The plane's value and column step in 32-bit words, split at its extra bits: `value = hi ·
+/// 2^10 + lo`, `dx = dx_hi · 2^10 + dx_lo` (`0 ≤ dx_lo, dy_lo < 2^10`; the high words modulo
+/// 2^32, `lo` not carried into `hi` as the rows add `dy_lo`, so after at most 2^12 rows it is
+/// below 2^22). Then `⌊(value + dx·c) / 2^10⌋ = hi + dx_hi·c + ⌊(lo + dx_lo·c) / 2^10⌋`, of
+/// which 32-bit arithmetic keeps the value modulo 2^32: the depth itself wherever that lies in
+/// `[−2^31, 2^31)`. At a span's first pixel, a covered centre, it does: there the plane is
+/// within the triangle's vertex depths (`0 ..= MAX_DRAWN_DEPTH`) up to its rounding, a few
+/// units. So the start is [`WideWalk`]'s to the bit (tests
+/// `walked_span_start_equals_span_start`, `walked_span_start_is_exact_at_covered_centres`)
+/// from two 32-bit multiplies instead of a 64-bit product (on ARMv6-M, three multiplies and
+/// their carries).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SplitWalk {
+    hi: i32,
+    lo: u32,
+    dx_hi: i32,
+    dx_lo: u32,
+    dy_hi: i32,
+    dy_lo: u32,
+}
+
+/// `v` split at the depth plane's extra bits: `(⌊v / 2^10⌋ mod 2^32, v mod 2^10)`.
+#[inline]
+fn split_extra_bits(v: i64) -> (i32, u32) {
+    (
+        (v >> DEPTH_PLANE_EXTRA_BITS) as i32,
+        (v & ((1 << DEPTH_PLANE_EXTRA_BITS) - 1)) as u32,
+    )
+}
+
+impl DepthWalk for SplitWalk {
+    #[inline]
+    fn new(value: i64, q: &Plane) -> Self {
+        let ((hi, lo), (dx_hi, dx_lo), (dy_hi, dy_lo)) = (
+            split_extra_bits(value),
+            split_extra_bits(q.dx),
+            split_extra_bits(q.dy),
+        );
+        SplitWalk {
+            hi,
+            lo,
+            dx_hi,
+            dx_lo,
+            dy_hi,
+            dy_lo,
+        }
     }
 
-    /// [`DepthPlane::span_start`]'s per-pixel step (the same on every row: callers keep it).
     #[inline]
-    pub fn step(&self) -> i32 {
-        depth_step(&self.q)
+    fn next_row(&mut self) {
+        self.hi = self.hi.wrapping_add(self.dy_hi);
+        self.lo = self.lo.wrapping_add(self.dy_lo);
+    }
+
+    #[inline]
+    fn span_start(&self, c: i32) -> i32 {
+        debug_assert!(
+            (0..1 << 12).contains(&c),
+            "internal error: span start {c} off the screen"
+        );
+        let fraction = self.lo.wrapping_add(self.dx_lo.wrapping_mul(c as u32));
+        let q = self
+            .hi
+            .wrapping_add(self.dx_hi.wrapping_mul(c))
+            .wrapping_add((fraction >> DEPTH_PLANE_EXTRA_BITS) as i32);
+        // (`clamped_depth` of the value in range: only the rounding below a zero vertex
+        // depth takes a covered centre out of `[0, i32::MAX]`.)
+        q.max(0)
     }
 }
 
@@ -1983,8 +2079,8 @@ mod tests {
         // Vertices on pixel centres so the plane is sampled exactly there.
         let v = [sv(8, 8, 0.5), sv(8 + 160, 8, 0.25), sv(8, 8 + 160, 1.0)];
         let p = DepthPlane::new(&PlaneSolver::new(&v).unwrap(), &v);
-        let walk = p.walk_from(3);
-        assert_eq!((walk.span_start(2), walk.step()), p.span_start(2, 3));
+        let walk: WalkDepth = p.walk_from(3);
+        assert_eq!((walk.span_start(2), p.step()), p.span_start(2, 3));
         assert_eq!(p.depth_at(0, 0), Depth::from_num(0.5));
         assert!((p.depth_at(10, 0).to_num::<f64>() - 0.25).abs() < 1e-8);
         assert!((p.depth_at(0, 10).to_num::<f64>() - 1.0).abs() < 1e-8);
@@ -2029,12 +2125,16 @@ mod tests {
         assert_eq!(floor_div_by_float(5, 0), None);
     }
 
+    /// The walked span start is [`DepthPlane::span_start`]'s: [`WideWalk`]'s everywhere,
+    /// [`SplitWalk`]'s wherever the plane's depth lies in `[−2^31, 2^31)`. Planes of any value
+    /// and gradients (wrapping included), stepped down 40 rows from a random first row, at
+    /// random columns (for the split walk, those whose depth is out of range counted, not
+    /// compared).
     #[test]
     fn walked_span_start_equals_span_start() {
-        // Planes of any value and gradients (wrapping included), stepped down 40 rows from a
-        // random first row, against the direct evaluation at every column tried.
         let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1du64);
         let mut next = || rng.next_u64();
+        let (mut compared, mut outside) = (0, 0);
         for case in 0..5_000 {
             let r = next();
             let scale = (r % 64) as u32;
@@ -2048,19 +2148,97 @@ mod tests {
                 PixelOrigin::new((next() % 4096) as i32 - 2048, (next() % 4096) as i32 - 2048);
             let first = (next() % 2048) as i32;
             let plane = DepthPlane { origin, q };
-            let mut walk = plane.walk_from(first);
+            let mut wide: WideWalk = plane.walk_from(first);
+            let mut split: SplitWalk = plane.walk_from(first);
             for row in first..first + 40 {
                 for _ in 0..4 {
                     let c = (next() % 2048) as i32;
-                    assert_eq!(
-                        (walk.span_start(c), walk.step()),
-                        plane.span_start(c, row),
-                        "case {case} row {row} column {c}"
-                    );
+                    let want = plane.span_start(c, row).0;
+                    // The 64-bit walk everywhere, the split one where the depth is in range.
+                    assert_eq!(wide.span_start(c), want, "case {case} row {row} column {c}");
+                    let depth = origin.at(&q, c, row) >> DEPTH_PLANE_EXTRA_BITS;
+                    if (i32::MIN as i64..=i32::MAX as i64).contains(&depth) {
+                        assert_eq!(
+                            split.span_start(c),
+                            want,
+                            "case {case} row {row} column {c}"
+                        );
+                        compared += 1;
+                    } else {
+                        outside += 1;
+                    }
                 }
-                walk.next_row();
+                wide.next_row();
+                split.next_row();
             }
         }
+        // Most planes here are in range at most columns; many are far outside.
+        assert!(
+            compared > 400_000 && outside > 100_000,
+            "{compared} {outside}"
+        );
+    }
+
+    /// The premise of [`SplitWalk`] on real triangles: on every row, at covered centres (each
+    /// span's ends and middle), the walked start equals the 64-bit one, for vertex depths at the extremes a drawn
+    /// triangle can have (0, 1, `MAX_DRAWN_DEPTH`, mixed), slivers and triangles reaching
+    /// far off the screen included.
+    #[test]
+    fn walked_span_start_is_exact_at_covered_centres() {
+        let mut rng = crate::test_rng::XorShift64::new(0x3C6E_F372_FE94_F82B);
+        let mut next = move || rng.next_u64();
+        let depths = [
+            0,
+            1,
+            2,
+            1 << 20,
+            1 << 29,
+            1 << 30,
+            MAX_DRAWN_DEPTH - 1,
+            MAX_DRAWN_DEPTH,
+        ];
+        let mut spans = 0;
+        for i in 0..20_000 {
+            let span = 1i64 << (3 + next() % 14);
+            let mut coord = || ((next() % (2 * span as u64)) as i64 - span / 2) as i32;
+            let mut v = [(coord(), coord()), (coord(), coord()), (coord(), coord())];
+            if i % 5 == 0 {
+                v[2] = (v[0].0 + 1, v[1].1); // a sliver
+            }
+            let sv: [ScreenVertex<4>; 3] = v.map(|(x, y)| ScreenVertex {
+                x: crate::project::SubPx(x),
+                y: crate::project::SubPx(y),
+                q: Depth::from_bits(if i % 2 == 0 {
+                    depths[(next() % depths.len() as u64) as usize]
+                } else {
+                    (next() % (MAX_DRAWN_DEPTH as u64 + 1)) as i32
+                }),
+                color: [I16F16::ZERO; 3],
+            });
+            let (Some(solver), Some(mut walk)) =
+                (PlaneSolver::new(&sv), TriangleWalk::new::<4>(v, 0, 2048))
+            else {
+                continue;
+            };
+            let plane = DepthPlane::new(&solver, &sv);
+            let mut depth: SplitWalk = plane.walk_from(walk.row());
+            loop {
+                let (l, r) = walk.span();
+                let (l, r) = (l.max(0), r.min(2048));
+                if l < r {
+                    let row = walk.row();
+                    for c in [l, (l + r) / 2, r - 1] {
+                        assert_eq!(depth.span_start(c), plane.span_start(c, row).0, "{sv:?}");
+                    }
+                    spans += 1;
+                }
+                depth.next_row();
+                if !walk.advance::<4>() {
+                    break;
+                }
+            }
+        }
+        assert!(spans > 100_000, "{spans}");
     }
 
     #[test]

@@ -22,8 +22,8 @@ use crate::options::RenderOptions;
 use crate::project::ProjectionPrecision;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{
-    color_channels, depth_planes_fit_i64, first_row_xy, signed_area_xy, xy, DepthPlane,
-    PlaneSolver, TriangleWalk, WalkDepth,
+    color_channels, depth_planes_fit_i64, first_row_xy, signed_area_xy, xy, DepthPlane, DepthWalk,
+    PlaneSolver, TriangleWalk, WalkDepth, MAX_DRAWN_DEPTH,
 };
 use crate::scene::{Instance, MeshColors, Scene, MAX_SCENE_TRIANGLES};
 use crate::shading::{Shading, SpanDepth};
@@ -40,8 +40,8 @@ use heapless::{Vec, VecView};
 pub(crate) struct ActiveTri<T, K = ()> {
     pub(crate) walk: TriangleWalk,
     pub(crate) depth: WalkDepth,
-    /// `depth`'s per-pixel step ([`WalkDepth::step`]), kept here rather than in `depth`, whose
-    /// 8-byte alignment would pad it to 8 bytes.
+    /// `depth`'s per-pixel step ([`DepthPlane::step`]), kept here rather than in `depth`: the
+    /// span loop's, not the walk's.
     pub(crate) depth_step: i32,
     pub(crate) payload: T,
     pub(crate) key: K,
@@ -1098,10 +1098,15 @@ fn activate_row<P: RowPixel, S: Shading, const SUB: u32, R: Resolve<P, S>, Q: Ro
             true => DepthPlane::new_i64(&solver, s),
             false => DepthPlane::new(&solver, s),
         };
-        let depth = depth.walk_from(walk.row());
+        // The walk's span starts take the plane in 32-bit words, exact for vertex depths up to
+        // MAX_DRAWN_DEPTH, which every vertex of a drawn triangle is.
+        debug_assert!(
+            s.iter().all(|v| v.q.to_bits() <= MAX_DRAWN_DEPTH),
+            "internal error: a drawn vertex beyond the near plane"
+        );
         let mut tri_state = ActiveTri {
             walk,
-            depth,
+            depth: depth.walk_from(walk.row()),
             depth_step: depth.step(),
             payload: S::payload::<P, SUB>(face, id, &solver, s),
             key: R::Key::from_raw(key),

@@ -5,12 +5,13 @@
 //!
 //! `4·W` depth row + `size_of::<P>()·W` pixel row + `b·H` bucket heads + `(b + 2)·TRIS` bucket
 //! lists (`b` = 2, or 1 with `u8` heads: [`BucketHead`]) + `ACTIVE · size_of` of an active
-//! triangle (96 for flat shading with pixels of up to 2 bytes, 104 with larger ones) + `VERTS ·`
-//! [`CachedVertex::BYTES`]. See [`Workspace::BYTES`] and [`workspace_bytes_with`].
+//! triangle (96 for flat shading with pixels of up to 2 bytes; with larger ones 100 on Arm, 104
+//! elsewhere, where the depth walk keeps 64-bit words) + `VERTS ·` [`CachedVertex::BYTES`].
+//! See [`Workspace::BYTES`] and [`workspace_bytes_with`].
 //!
 //! The lean minimal build (240×240, `TRIS` = 29, `ACTIVE` = 11, `u8` heads, flat `Rgb565`):
-//! 960 + 480 + 240 + 87 + 11 · 96 bytes, 2,840 with the background pixel and the active list's
-//! length (padded to 8 bytes on 32-bit targets).
+//! 960 + 480 + 240 + 87 + 11 · 96 bytes, with the background pixel and the active list's
+//! length 2,832 on Arm (padded to 4 bytes), 2,840 on RISC-V (padded to 8).
 
 use crate::arithmetic::Arithmetic;
 use crate::cache::CachedVertex;

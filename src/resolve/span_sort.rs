@@ -4,6 +4,7 @@ use crate::arithmetic::Arithmetic;
 use crate::clip::Clipping;
 use crate::depth::DepthRow;
 use crate::options::{RenderOptions, MAX_INSTANCES};
+use crate::raster::DepthWalk;
 use crate::render::Unbounded;
 use crate::render::{
     drive, internal, viewport, ActiveTri, FinishedRow, Frame, IdOrder, Resolve, NO_ENTRY,
