@@ -976,8 +976,16 @@ impl DepthPlane {
 /// The per-pixel step of depth plane `q` in [`Depth`] bits, saturated at ±2^31.
 #[inline]
 fn depth_step(q: &Plane) -> i32 {
-    let dq = q.dx >> DEPTH_PLANE_EXTRA_BITS;
-    dq.clamp(i32::MIN as i64, i32::MAX as i64) as i32
+    // In range (`dx >> 10` fits `i32`) exactly when `dx`'s top 64 − 41 bits are all its sign,
+    // which the high word alone shows: one test of one word, as `clamped_depth` does.
+    let high = (q.dx >> 32) as i32;
+    if high >> (41 - 32) == high >> 31 {
+        (q.dx >> DEPTH_PLANE_EXTRA_BITS) as i32
+    } else if high < 0 {
+        i32::MIN
+    } else {
+        i32::MAX
+    }
 }
 
 /// A [`DepthPlane`] walked down a triangle's rows, its value kept at column 0 of the walk's
@@ -1778,7 +1786,7 @@ mod tests {
     }
 
     #[test]
-    fn clamped_depth_equals_the_clamp() {
+    fn clamped_depth_and_depth_step_equal_the_clamps() {
         let mut rng = crate::test_rng::XorShift64::new(0x2545_f491_4f6c_dd1d);
         // Around every boundary of the range and of the high-word test, then at random
         // magnitudes.
@@ -1804,6 +1812,14 @@ mod tests {
         for q in values {
             let expected = (q >> DEPTH_PLANE_EXTRA_BITS).clamp(0, i32::MAX as i64) as i32;
             assert_eq!(clamped_depth(q), expected, "{q}");
+            // The per-pixel step saturates at both ends, tested on its high word the same way.
+            let plane = Plane {
+                value: 0,
+                dx: q,
+                dy: 0,
+            };
+            let step = (q >> DEPTH_PLANE_EXTRA_BITS).clamp(i32::MIN as i64, i32::MAX as i64);
+            assert_eq!(depth_step(&plane), step as i32, "{q}");
         }
     }
 
