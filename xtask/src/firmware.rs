@@ -153,7 +153,13 @@ pub(crate) fn frame_hashes(output: &str) -> Vec<u32> {
 
 /// Mean instructions per frame over the `frame` lines of firmware output.
 pub(crate) fn mean_frame_instructions(output: &str) -> f64 {
-    let counts: Vec<u64> = output
+    let counts = frame_instructions(output);
+    counts.iter().sum::<u64>() as f64 / counts.len().max(1) as f64
+}
+
+/// Each frame's instruction count in firmware output, in frame order.
+fn frame_instructions(output: &str) -> Vec<u64> {
+    output
         .lines()
         .filter_map(|l| l.strip_prefix("frame "))
         .filter_map(|l| {
@@ -162,8 +168,7 @@ pub(crate) fn mean_frame_instructions(output: &str) -> f64 {
                 .find(|p| p[0] == "instructions")
                 .and_then(|p| p[1].parse().ok())
         })
-        .collect();
-    counts.iter().sum::<u64>() as f64 / counts.len().max(1) as f64
+        .collect()
 }
 
 /// The demo firmware again with a vertex cache holding every demo vertex (`--cfg
@@ -180,8 +185,13 @@ pub(crate) fn vertex_cache_on_target(
         mean_frame_instructions(uncached),
         mean_frame_instructions(&out),
     );
+    let frames = frame_instructions(&out);
+    let (low, high) = (
+        frames.iter().min().copied().unwrap_or(0),
+        frames.iter().max().copied().unwrap_or(0),
+    );
     println!(
-        "vertex cache: the same hashes; {:.2} M instructions per frame against {:.2} M ({:.2}× fewer); renderer RAM {} B against {} B",
+        "vertex cache: the same hashes; {:.2} M instructions per frame (mean {cached:.0}, frames {low}–{high}) against {:.2} M ({:.2}× fewer); renderer RAM {} B against {} B",
         cached / 1e6,
         plain / 1e6,
         plain / cached.max(1.0),
