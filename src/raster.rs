@@ -1044,9 +1044,10 @@ impl DepthWalk for WideWalk {
 }
 
 /// The largest vertex depth of a drawn triangle, in [`Depth`] bits: a drawn vertex has
-/// `w ≥ near` (inside the near plane) or lies on a clip plane within half an I16F16 unit of
-/// `w` (the clipper's rounding), and `near` is at least [`MIN_NEAR`](crate::scene::MIN_NEAR)
-/// = 256 units, so `q = near · 2^30 / w ≤ 2^30 · 256 / 255 < 2^30 + 2^23`.
+/// `w ≥ near` (inside the near plane), or the clipper made it on the near plane with its `w`
+/// rounded to within half an I16F16 unit of `near`; `near` is at least
+/// [`MIN_NEAR`](crate::scene::MIN_NEAR) = 256 units, so `q = near · 2^30 / w ≤ 2^30 · 256 /
+/// 255 < 2^30 + 2^23`.
 pub(crate) const MAX_DRAWN_DEPTH: i32 = (1 << 30) + (1 << 23);
 
 /// The plane's value and column step in 32-bit words, split at its extra bits: `value = hi ·

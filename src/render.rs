@@ -1098,8 +1098,8 @@ fn activate_row<P: RowPixel, S: Shading, const SUB: u32, R: Resolve<P, S>, Q: Ro
             true => DepthPlane::new_i64(&solver, s),
             false => DepthPlane::new(&solver, s),
         };
-        // The walk's span starts take the plane in 32-bit words, exact for vertex depths up to
-        // MAX_DRAWN_DEPTH, which every vertex of a drawn triangle is.
+        // On Arm the walk's span starts take the plane in 32-bit words (`SplitWalk`), exact for
+        // vertex depths up to MAX_DRAWN_DEPTH, which every vertex of a drawn triangle has.
         debug_assert!(
             s.iter().all(|v| v.q.to_bits() <= MAX_DRAWN_DEPTH),
             "internal error: a drawn vertex beyond the near plane"
