@@ -331,6 +331,14 @@ pub(crate) fn shr_i64(v: i64, s: u32) -> i64 {
     }
 }
 
+/// `v >> s` for `32 <= s < 64`: the high word's shift alone (test
+/// `shifts_in_words_are_exact`).
+#[inline]
+pub(crate) fn shr_i64_high(v: i64, s: u32) -> i64 {
+    debug_assert!((32..64).contains(&s), "shr_i64_high by {s}");
+    ((v >> 32) as i32 >> (s & 31)) as i64
+}
+
 /// [`shr_i64`] in 32-bit shifts, on every target (tested on the host too).
 #[inline]
 fn shr_i64_in_words(v: i64, s: u32) -> i64 {
@@ -1335,6 +1343,9 @@ mod tests {
                 assert_eq!(shr_low_word(v, s), (v >> s) as i32, "{v} >> {s}");
                 assert_eq!(shr_i64_in_words(v, s), v >> s, "{v} >> {s}");
                 assert_eq!(shr_i64(v, s), v >> s, "{v} >> {s}");
+                if s >= 32 {
+                    assert_eq!(shr_i64_high(v, s), v >> s, "{v} >> {s}");
+                }
                 let u = v as u64;
                 assert_eq!(shr_u64_in_words(u, s), u >> s, "{u} >> {s}");
                 assert_eq!(shr_u64(u, s), u >> s, "{u} >> {s}");

@@ -16,7 +16,8 @@
 use crate::depth::Depth;
 use crate::math::{
     bit_length_u64, div_below_float, div_rem_below, floor_div_i64, i16f16_from_f32, mul_i64_i32,
-    mul_wide, shr_i64, SoftDivisor, FLOAT_ESTIMATES, NO_HARDWARE_DIVIDE,
+    mul_wide, shr_i64, shr_i64_high, SoftDivisor, FLOAT_ESTIMATES, NO_HARDWARE_DIVIDE,
+    NO_WIDE_MULTIPLY,
 };
 use crate::vertex::EyePoint;
 use fixed::types::I16F16;
@@ -95,7 +96,14 @@ impl Scale {
     pub fn apply(self, v: i32) -> i64 {
         // The mantissa is below 2^25: a 32 × 32 → 64-bit product, and the shift by a variable
         // amount in 32-bit words (neither a call on ARMv6-M).
-        shr_i64(mul_wide(self.mantissa, v), self.shift)
+        let product = mul_wide(self.mantissa, v);
+        if NO_WIDE_MULTIPLY && self.shift >= 32 {
+            // On ARMv6-M, where a 64-bit shift by a variable amount is two words' shifts and
+            // their carries, the high word's alone for a shift of 32 or more (the demo's and
+            // the corpus's projections).
+            return shr_i64_high(product, self.shift);
+        }
+        shr_i64(product, self.shift)
     }
 
     /// `floor(self · v) >> k` for `|v| <= 2^31`, `k < 64`, as one shift: floors by powers
