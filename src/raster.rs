@@ -32,6 +32,7 @@ use crate::math::{
     FLOAT_ESTIMATES, NO_HARDWARE_DIVIDE, NO_WIDE_MULTIPLY,
 };
 use crate::project::ScreenVertex;
+use core::cmp::Ordering;
 use fixed::types::I16F16;
 
 /// First row (or column) whose centre lies at or after position `p` (doubled units, S bits):
@@ -1278,6 +1279,40 @@ fn signed_area_in_words(v: &[(i32, i32); 3]) -> Option<i64> {
     Some(mul_wide(e1.0, e2.1) - mul_wide(e2.0, e1.1))
 }
 
+/// A value with the sign of [`signed_area_xy`] (negative for a front face, positive for a
+/// back face, zero for zero area): the area itself, or on the core without a wide multiply
+/// −1, 0 or 1 from [`short_area_sign`] where it answers.
+#[inline]
+pub fn area_sign(v: &[(i32, i32); 3]) -> i64 {
+    if NO_WIDE_MULTIPLY {
+        if let Some(sign) = short_area_sign(v) {
+            return sign as i64;
+        }
+    }
+    signed_area_xy(v)
+}
+
+/// The sign of [`signed_area_xy`] for a triangle whose edges' four differences fit `i16`
+/// (every triangle of on-screen positions with up to 2^11 columns and rows at 4 sub-pixel
+/// bits), `None` for others: two 32-bit products, each at most 2^30 in magnitude, compared,
+/// where [`signed_area_xy`] makes two 64-bit ones (four multiplies each on ARMv6-M). Test
+/// `short_area_sign_is_the_areas_sign`.
+#[inline]
+fn short_area_sign(v: &[(i32, i32); 3]) -> Option<Ordering> {
+    let [a, b, c] = *v;
+    let d = [
+        b.0.wrapping_sub(a.0),
+        b.1.wrapping_sub(a.1),
+        c.0.wrapping_sub(a.0),
+        c.1.wrapping_sub(a.1),
+    ];
+    // A difference in [−2^15, 2^15) is below 2^16 once offset by 2^15 (a wrapped one is not).
+    let offset = d
+        .iter()
+        .fold(0u32, |acc, &x| acc | x.wrapping_add(1 << 15) as u32);
+    (offset < 1 << 16).then(|| (d[0] * d[3]).cmp(&(d[2] * d[1])))
+}
+
 /// The first row a triangle's walk would cover on a `width × height` screen, or `None` when
 /// its bounding box holds no pixel centre of the screen (by the same half-open rules as the
 /// walk, so nothing the walk would draw is rejected). Used by bucketing.
@@ -2296,5 +2331,34 @@ mod tests {
         }
         // Both paths taken often.
         assert!(seen.0 > 100_000 && seen.1 > 1_000, "{seen:?}");
+    }
+
+    #[test]
+    fn short_area_sign_is_the_areas_sign() {
+        let mut rng = crate::test_rng::XorShift64::new(0x0a4e_a519_0000_0001);
+        let edges = [0, 1, -1, 32_767, -32_768, 16_384, -16_384, 3840];
+        let mut short = 0;
+        for k in 0..200_000u32 {
+            let x = rng.next_u64();
+            let p = |i: u32| match (k + i / 4) % 3 {
+                0 => (x >> (i * 5)) as i16 as i32,
+                1 => edges[((x >> (i * 3)) % 8) as usize],
+                _ => ((x >> (i * 7)) as i32 % 4000) - 200,
+            };
+            let v = [(p(0), p(1)), (p(2), p(3)), (p(4), p(5))];
+            let [a, b, c] = v;
+            let fits = |p: i32, q: i32| i16::try_from(p - q).is_ok();
+            let fit = fits(b.0, a.0) && fits(b.1, a.1) && fits(c.0, a.0) && fits(c.1, a.1);
+            let sign = signed_area_xy(&v).cmp(&0);
+            assert_eq!(short_area_sign(&v), fit.then_some(sign), "{v:?}");
+            assert_eq!(area_sign(&v).cmp(&0), sign, "{v:?}");
+            short += fit as u32;
+        }
+        // Both answers are met, and a degenerate triangle.
+        assert_eq!(
+            short_area_sign(&[(5, 5), (5, 5), (9, -3)]),
+            Some(Ordering::Equal)
+        );
+        assert!(short > 50_000 && short < 190_000, "{short}");
     }
 }

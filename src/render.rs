@@ -22,7 +22,7 @@ use crate::options::RenderOptions;
 use crate::project::ProjectionPrecision;
 use crate::project::{ScreenVertex, Viewport};
 use crate::raster::{
-    color_channels, depth_planes_fit_i64, first_row_xy, signed_area_xy, xy, DepthPlane, DepthWalk,
+    area_sign, color_channels, depth_planes_fit_i64, first_row_xy, xy, DepthPlane, DepthWalk,
     PlaneSolver, TriangleWalk, WalkDepth, MAX_DRAWN_DEPTH,
 };
 use crate::scene::{Instance, MeshColors, Scene, MAX_SCENE_TRIANGLES};
@@ -426,7 +426,7 @@ enum Placement {
 impl Placement {
     #[inline]
     fn of<const S: u32>(s: &[(i32, i32); 3], vp: &Viewport<S>, cull: bool) -> Self {
-        let area = signed_area_xy(s);
+        let area = area_sign(s);
         // Front faces have negative area in y-down screen coordinates.
         if area == 0 {
             return Placement::Degenerate;
