@@ -4,7 +4,7 @@
 //! | preset | sub-pixel bits | set-up arithmetic | set-up math | Gouraud interpolation |
 //! |---|---|---|---|---|
 //! | [`Fast`] | 2 | [`Quick`]: narrow transform, reciprocal projection, 15-bit normals | [`Libm`] | [`Affine`] |
-//! | [`Balanced`] | 4 | [`Frugal`]: wide transform, reciprocal projection, 15-bit normals | [`Libm`] | [`PerSegment<16>`](PerSegment) |
+//! | [`Balanced`] | 4 | [`Precise`], as [`RenderOptions::default`] | [`Libm`] | [`PerSegment<16>`](PerSegment) |
 //! | [`Exact`] | 8 | [`Precise`]: wide transform, exact division, 30-bit normals | [`Libm`] | [`PerPixel`] |
 //!
 //! Sub-pixel bits set how finely vertices snap (`2^-S` pixel); the set-up [`Arithmetic`] how
@@ -22,8 +22,10 @@
 //! scene, instructions on thumbv7em and thumbv6m for the demo orbit and every corpus scene, host
 //! time, flash), with the default and single-knob variations beside the presets. On thumbv6m,
 //! which multiplies and divides 64-bit integers in software, `Fast` takes about 1.3× fewer
-//! instructions per demo frame than `Exact`; `Balanced` now takes slightly more than the
-//! default (whose exact set-up has become the cheaper one there), for the same accuracy.
+//! instructions per demo frame than `Exact`. `Balanced` keeps the default's set-up: its exact
+//! division and 30-bit normals, written in 32-bit operations, measured cheaper than the
+//! reciprocal projection and 15-bit normals ([`Frugal`]) on all three targets, for the same
+//! accuracy; it adds perspective-correct Gouraud colour every 16 pixels.
 //! [`Micromath`] set-up is in no preset: its camera error moves vertices beyond the sub-pixel
 //! error bound (real mismatches) and saves under 1 KB of flash.
 //!
@@ -37,7 +39,9 @@
 //! # Ok::<(), scanline3d::scene::SceneError>(())
 //! ```
 
-use crate::arithmetic::{Arithmetic, Frugal, Precise, Quick};
+#[cfg(doc)]
+use crate::arithmetic::Frugal;
+use crate::arithmetic::{Arithmetic, Precise, Quick};
 use crate::clip::FrustumClip;
 #[cfg(doc)]
 use crate::math::Micromath;
@@ -83,8 +87,9 @@ pub trait Preset {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Fast;
 
-/// Middle: 4 sub-pixel bits (as [`RenderOptions::default`]), [`Frugal`] arithmetic, [`Libm`]
-/// set-up, Gouraud colour perspective-correct every 16 pixels ([`PerSegment<16>`](PerSegment)).
+/// Middle: the default's 4 sub-pixel bits, [`Precise`] arithmetic and [`Libm`] set-up (flat
+/// frames are the default's), Gouraud colour perspective-correct every 16 pixels
+/// ([`PerSegment<16>`](PerSegment)).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Balanced;
 
@@ -110,12 +115,12 @@ impl Preset for Fast {
 impl Preset for Balanced {
     const NAME: &'static str = "balanced";
     const SUB_BITS: u32 = 4;
-    type Options = RenderOptions<4, FrustumClip, Frugal>;
+    type Options = RenderOptions<4>;
     type Math = Libm;
-    type Arithmetic = Frugal;
+    type Arithmetic = Precise;
     type Interpolation = PerSegment<16>;
     fn options() -> Self::Options {
-        RenderOptions::default().with_arithmetic(Frugal::default())
+        RenderOptions::default()
     }
 }
 
@@ -168,10 +173,7 @@ mod tests {
     fn balanced_has_the_default_bits_and_camera() {
         let d = RenderOptions::default();
         assert_eq!(d.cull_back_faces, Balanced::options().cull_back_faces);
-        assert_eq!(
-            RenderOptions::default().with_arithmetic(Frugal::default()),
-            Balanced::options()
-        );
+        assert_eq!(RenderOptions::default(), Balanced::options());
         let c = Camera::look_at([1.0, 2.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0])
             .and_then(|v| v.perspective(50.0, 0.5, 9.0));
         assert_eq!(c.map(|c| c.focal()), Ok(camera::<Balanced>().focal()));
@@ -187,7 +189,7 @@ mod tests {
         let bits = |o: &dyn core::any::Any| {
             if o.is::<RenderOptions<2, FrustumClip, Quick>>() {
                 2
-            } else if o.is::<RenderOptions<4, FrustumClip, Frugal>>() {
+            } else if o.is::<RenderOptions<4>>() {
                 4
             } else if o.is::<RenderOptions<8>>() {
                 8

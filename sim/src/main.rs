@@ -230,7 +230,7 @@ struct View {
     /// Precision preset (scanline3d::preset): fast, balanced or exact. Sets the sub-pixel
     /// bits, the set-up arithmetic and the set-up math together. Without it the renderer uses
     /// the library default (RenderOptions::default(): precise arithmetic, libm). The narrow
-    /// arithmetic of fast and balanced is built for span-zbuffer only.
+    /// arithmetic of fast is built for span-zbuffer only.
     #[arg(long, conflicts_with = "sub_pixel_bits")]
     preset: Option<PresetChoice>,
     #[command(flatten)]

@@ -53,7 +53,7 @@ pub const VARIANTS: [Variant; 10] = [
     preset(
         PresetChoice::Balanced,
         "balanced",
-        choices(4, SetupArith::Frugal),
+        choices(4, SetupArith::Precise),
     ),
     preset(
         PresetChoice::Exact,

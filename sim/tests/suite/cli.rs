@@ -257,11 +257,11 @@ fn presets_set_sub_pixel_bits_and_set_up_math_together() {
         stats.contains("\"arithmetic\": \"precise\", \"sub_pixel_bits\": 8"),
         "{stats}"
     );
-    // Balanced keeps the default's 4 bits with frugal arithmetic; fast is 2 bits, quick.
+    // Balanced keeps the default's 4 bits and precise arithmetic; fast is 2 bits, quick.
     let (_, stats) = ids(&["--preset", "balanced"], "balanced.ids");
     assert!(
         stats.contains(
-            "\"preset\": \"balanced\", \"arithmetic\": \"frugal\", \"sub_pixel_bits\": 4"
+            "\"preset\": \"balanced\", \"arithmetic\": \"precise\", \"sub_pixel_bits\": 4"
         ),
         "{stats}"
     );
