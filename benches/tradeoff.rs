@@ -7,7 +7,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
-use scanline3d::arithmetic::{Arithmetic, Frugal, Precise, Quick, Setup};
+use scanline3d::arithmetic::{Arithmetic, Precise, Setup};
 use scanline3d::arithmetic::{ExactDivision, Reciprocal};
 use scanline3d::arithmetic::{NarrowTransform, WideTransform};
 use scanline3d::depth::{Depth16, DepthFormat};
@@ -80,8 +80,10 @@ fn bench(c: &mut Criterion) {
                     time::<4, Precise, Depth16>(&mut group, id, &mut ws16, s, cull)
                 }
                 (0, SetupArith::Precise) => time::<0, Precise, _>(&mut group, id, &mut ws, s, cull),
-                (2, SetupArith::Quick) => time::<2, Quick, _>(&mut group, id, &mut ws, s, cull),
-                (4, SetupArith::Frugal) => time::<4, Frugal, _>(&mut group, id, &mut ws, s, cull),
+                (2, SetupArith::NarrowTransform) => {
+                    type A = Setup<NarrowTransform, ExactDivision, WideNormals>;
+                    time::<2, A, _>(&mut group, id, &mut ws, s, cull)
+                }
                 (4, SetupArith::Precise) => time::<4, Precise, _>(&mut group, id, &mut ws, s, cull),
                 (8, SetupArith::Precise) => time::<8, Precise, _>(&mut group, id, &mut ws, s, cull),
                 (4, SetupArith::NarrowTransform) => {

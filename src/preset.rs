@@ -3,7 +3,7 @@
 //!
 //! | preset | sub-pixel bits | set-up arithmetic | set-up math | Gouraud interpolation |
 //! |---|---|---|---|---|
-//! | [`Fast`] | 2 | [`Quick`]: narrow transform, reciprocal projection, 15-bit normals | [`Libm`] | [`Affine`] |
+//! | [`Fast`] | 2 | [`Precise`] but for the transform: 32-bit products ([`NarrowTransform`]) | [`Libm`] | [`Affine`] |
 //! | [`Balanced`] | 4 | [`Precise`], as [`RenderOptions::default`] | [`Libm`] | [`PerSegment<16>`](PerSegment) |
 //! | [`Exact`] | 8 | [`Precise`]: wide transform, exact division, 30-bit normals | [`Libm`] | [`PerPixel`] |
 //!
@@ -20,9 +20,13 @@
 //! What each preset costs and how accurate it is are measured, not assumed: `cargo xtask
 //! tradeoff` writes `docs/tradeoff.md` (accuracy against the f64 reference on every corpus
 //! scene, instructions on thumbv7em and thumbv6m for the demo orbit and every corpus scene, host
-//! time, flash), with the default and single-knob variations beside the presets. On thumbv6m,
-//! which multiplies and divides 64-bit integers in software, `Fast` takes about 1.3× fewer
-//! instructions per demo frame than `Exact`. `Balanced` keeps the default's set-up: its exact
+//! time, flash), with the default and single-knob variations beside the presets. `Fast` takes
+//! fewer instructions per demo frame than the default on thumbv7em, thumbv6m and riscv32imc:
+//! its coarser vertices, and on thumbv6m, which multiplies 64-bit integers in software, its
+//! 32-bit transform. The other narrow knobs ([`Quick`]'s reciprocal projection and 15-bit
+//! normals) measured dearer than the exact forms on thumbv7em and thumbv6m, so no preset takes
+//! them.
+//! `Balanced` keeps the default's set-up: its exact
 //! division and 30-bit normals, written in 32-bit operations, measured cheaper than the
 //! reciprocal projection and 15-bit normals ([`Frugal`]) on all three targets, for the same
 //! accuracy; it adds perspective-correct Gouraud colour every 16 pixels.
@@ -39,13 +43,13 @@
 //! # Ok::<(), scanline3d::scene::SceneError>(())
 //! ```
 
+use crate::arithmetic::{Arithmetic, ExactDivision, NarrowTransform, Precise, Setup};
 #[cfg(doc)]
-use crate::arithmetic::Frugal;
-use crate::arithmetic::{Arithmetic, Precise, Quick};
+use crate::arithmetic::{Frugal, Quick};
 use crate::clip::FrustumClip;
 #[cfg(doc)]
 use crate::math::Micromath;
-use crate::math::{Libm, MathBackend};
+use crate::math::{Libm, MathBackend, WideNormals};
 use crate::method::Options;
 use crate::options::RenderOptions;
 use crate::scene::{Camera, SceneError};
@@ -82,10 +86,16 @@ pub trait Preset {
     }
 }
 
-/// Coarse and cheap: 2 sub-pixel bits, [`Quick`] arithmetic, [`Libm`] set-up, [`Affine`]
-/// Gouraud colour.
+/// Coarse and cheap: 2 sub-pixel bits, [`FastArithmetic`] (the default's but for 32-bit
+/// transform products), [`Libm`] set-up, [`Affine`] Gouraud colour.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Fast;
+
+/// [`Fast`]'s set-up arithmetic: [`Precise`] but for the transform, whose products are 32-bit
+/// ([`NarrowTransform`]; vertices move by about 10^-4 of their offsets). With 2 sub-pixel bits
+/// it measured cheaper than the default on thumbv7em, thumbv6m and riscv32imc, and cheaper than
+/// [`Quick`], whose reciprocal projection and 15-bit normals add instructions there.
+pub type FastArithmetic = Setup<NarrowTransform, ExactDivision, WideNormals>;
 
 /// Middle: the default's 4 sub-pixel bits, [`Precise`] arithmetic and [`Libm`] set-up (flat
 /// frames are the default's), Gouraud colour perspective-correct every 16 pixels
@@ -101,14 +111,14 @@ pub struct Exact;
 impl Preset for Fast {
     const NAME: &'static str = "fast";
     const SUB_BITS: u32 = 2;
-    type Options = RenderOptions<2, FrustumClip, Quick>;
+    type Options = RenderOptions<2, FrustumClip, FastArithmetic>;
     type Math = Libm;
-    type Arithmetic = Quick;
+    type Arithmetic = FastArithmetic;
     type Interpolation = Affine;
     fn options() -> Self::Options {
         RenderOptions::default()
             .with_sub_pixel_bits::<2>()
-            .with_arithmetic(Quick::default())
+            .with_arithmetic(FastArithmetic::default())
     }
 }
 
@@ -187,7 +197,7 @@ mod tests {
         const { assert!(Fast::SUB_BITS < Balanced::SUB_BITS && Balanced::SUB_BITS < Exact::SUB_BITS) };
         // The options carry the same bits as the constants.
         let bits = |o: &dyn core::any::Any| {
-            if o.is::<RenderOptions<2, FrustumClip, Quick>>() {
+            if o.is::<RenderOptions<2, FrustumClip, FastArithmetic>>() {
                 2
             } else if o.is::<RenderOptions<4>>() {
                 4

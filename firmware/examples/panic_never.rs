@@ -51,6 +51,7 @@ mod view;
 mod firmware {
     use core::hint::black_box;
     use embedded_graphics::pixelcolor::Rgb565;
+    use scanline3d::arithmetic::Quick;
     use scanline3d::depth::Depth16;
     use scanline3d::preset::{Fast, Preset};
     use scanline3d::resolve::bsp::{BspNode, BspTree, BspWorkspace, NO_CHILD};
@@ -331,9 +332,12 @@ mod firmware {
             if let Ok(scene) = demo::scene(&instances, frame, demo::ORBIT_FRAMES) {
                 let out = demo::render_panel_frame(&mut ws, &scene);
                 core::hint::black_box(&out);
-                // The narrow set-up arithmetic of the fast preset, too.
+                // The fast preset's set-up arithmetic, and the narrow one at every stage.
                 let mut sink = scanline3d::sink::HashSink::new();
-                let quick = ws.render(&scene, &Fast::options(), &mut sink);
+                let fast = ws.render(&scene, &Fast::options(), &mut sink);
+                core::hint::black_box((&fast, sink.hash()));
+                let quick = Fast::options().with_arithmetic(Quick::default());
+                let quick = ws.render(&scene, &quick, &mut sink);
                 core::hint::black_box((&quick, sink.hash()));
                 // Perspective-correct Gouraud, per segment with 16-bit depth and per pixel.
                 let options = RenderOptions::default();

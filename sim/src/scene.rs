@@ -1038,12 +1038,10 @@ impl PresetChoice {
             let a = TypeId::of::<P::Arithmetic>();
             if a == TypeId::of::<scanline3d::arithmetic::Precise>() {
                 SetupArith::Precise
-            } else if a == TypeId::of::<scanline3d::arithmetic::Quick>() {
-                SetupArith::Quick
-            } else if a == TypeId::of::<scanline3d::arithmetic::Frugal>() {
-                SetupArith::Frugal
+            } else if a == TypeId::of::<scanline3d::preset::FastArithmetic>() {
+                SetupArith::NarrowTransform
             } else {
-                unreachable!("presets use Precise, Frugal or Quick arithmetic")
+                unreachable!("presets use Precise arithmetic or Fast's")
             }
         }
         match self {

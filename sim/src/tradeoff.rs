@@ -49,7 +49,11 @@ const fn choices(sub_bits: u32, arith: SetupArith) -> Precision {
 /// equal to `scanline3d::preset`). A knob's name is also its `scanline3d_variant` cfg value with
 /// `:` and spaces removed.
 pub const VARIANTS: [Variant; 10] = [
-    preset(PresetChoice::Fast, "fast", choices(2, SetupArith::Quick)),
+    preset(
+        PresetChoice::Fast,
+        "fast",
+        choices(2, SetupArith::NarrowTransform),
+    ),
     preset(
         PresetChoice::Balanced,
         "balanced",

@@ -3,7 +3,7 @@
 //! tables and colours baked here for a narrow-normals preset) and corpus meshes.
 
 use embedded_graphics::pixelcolor::Rgb888;
-use scanline3d::arithmetic::Arithmetic;
+use scanline3d::arithmetic::{Arithmetic, Frugal, Quick};
 use scanline3d::clip::Clipping;
 use scanline3d::preset::{self, Preset};
 use scanline3d::scene::{Instance, Mesh, MeshColors, Scene};
@@ -152,11 +152,20 @@ fn baked_colours_drawn_unlit_give_the_flat_frames_with_wide_normals() {
 
 #[test]
 fn baked_colours_drawn_unlit_give_the_flat_frames_with_narrow_normals() {
-    // Balanced: 15-bit normals (Frugal); Fast: narrow arithmetic everywhere (Quick).
-    demo_with(<preset::Balanced as Preset>::options());
-    corpus_with(<preset::Balanced as Preset>::options());
+    // Frugal: 15-bit normals; Quick: narrow arithmetic everywhere, with Fast's 2 sub-pixel bits.
+    let frugal = RenderOptions::default().with_arithmetic(Frugal::default());
+    demo_with(frugal);
+    corpus_with(frugal);
+    let quick = <preset::Fast as Preset>::options().with_arithmetic(Quick::default());
+    demo_with(quick);
+    corpus_with(quick);
+}
+
+#[test]
+fn baked_colours_drawn_unlit_give_the_flat_frames_of_the_presets() {
     demo_with(<preset::Fast as Preset>::options());
     corpus_with(<preset::Fast as Preset>::options());
+    demo_with(<preset::Exact as Preset>::options());
 }
 
 #[test]

@@ -273,7 +273,9 @@ fn presets_set_sub_pixel_bits_and_set_up_math_together() {
     let (fast, stats) = ids(&["--preset", "fast"], "fast.ids");
     assert_ne!(fast, default);
     assert!(
-        stats.contains("\"preset\": \"fast\", \"arithmetic\": \"quick\", \"sub_pixel_bits\": 2"),
+        stats.contains(
+            "\"preset\": \"fast\", \"arithmetic\": \"narrow transform\", \"sub_pixel_bits\": 2"
+        ),
         "{stats}"
     );
     // The narrow arithmetic is built for the span z-buffer only, and says so.
