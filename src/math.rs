@@ -624,6 +624,11 @@ fn div_rem_u64_u32_in_halves(n: u64, d: u32) -> (u64, u32) {
 /// `(u1·2^32 + u0) / v` and its remainder for `u1 < v` (so the quotient fits 32 bits).
 #[inline]
 pub(crate) fn div_rem_below(u1: u32, u0: u32, v: u32) -> (u32, u32) {
+    if cfg!(target_pointer_width = "64") {
+        // A 64-bit core divides natively: one instruction, the same quotient and remainder.
+        let (n, v) = ((u64::from(u1) << 32) | u64::from(u0), u64::from(v.max(1)));
+        return ((n / v) as u32, (n % v) as u32);
+    }
     div_rem_below_with::<NO_HARDWARE_DIVIDE>(u1, u0, v)
 }
 
@@ -1379,7 +1384,8 @@ mod tests {
             let want = (n / d as u64, (n % d as u64) as u32);
             assert_eq!(div_rem_u64_u32_in_halves(n, d), want, "{n} / {d}");
             assert_eq!(div_rem_u64_u32(n, d), want, "{n} / {d}");
-            // The low word's division as the core without a divider does it.
+            // The low word's division as each 32-bit core does it: without a divider, with
+            // one (the host's own `div_rem_below` divides `u64`).
             let (hi, lo) = ((n >> 32) as u32, n as u32);
             let r_hi = hi % d;
             let want_lo = (want.0 as u32, want.1);
@@ -1388,6 +1394,12 @@ mod tests {
                 want_lo,
                 "{n} / {d}"
             );
+            assert_eq!(
+                div_rem_below_with::<false>(r_hi, lo, d),
+                want_lo,
+                "{n} / {d}"
+            );
+            assert_eq!(div_rem_below(r_hi, lo, d), want_lo, "{n} / {d}");
         };
         for n in ns {
             for d in ds {
