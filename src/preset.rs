@@ -25,11 +25,10 @@
 //! its coarser vertices, and on thumbv6m, which multiplies 64-bit integers in software, its
 //! 32-bit transform. The other narrow knobs ([`Quick`]'s reciprocal projection and 15-bit
 //! normals) measured dearer than the exact forms on thumbv7em and thumbv6m, so no preset takes
-//! them.
-//! `Balanced` keeps the default's set-up: its exact
-//! division and 30-bit normals, written in 32-bit operations, measured cheaper than the
-//! reciprocal projection and 15-bit normals ([`Frugal`]) on all three targets, for the same
-//! accuracy; it adds perspective-correct Gouraud colour every 16 pixels.
+//! them. `Balanced` keeps the default's set-up: its exact division and 30-bit normals, written
+//! in 32-bit operations, measured cheaper than the reciprocal projection and 15-bit normals
+//! ([`Frugal`]) on all three targets, for the same accuracy; it adds perspective-correct
+//! Gouraud colour every 16 pixels.
 //! [`Micromath`] set-up is in no preset: its camera error moves vertices beyond the sub-pixel
 //! error bound (real mismatches) and saves under 1 KB of flash.
 //!
