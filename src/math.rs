@@ -454,10 +454,16 @@ impl Lambert {
 /// (`(A+1)·2^14` saturating, both then capped at `i32::MAX`).
 /// Test `lambert_bounds_hold`.
 pub(crate) fn lambert_i64(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
-    let s = fit_bits(v, 30)?;
-    let dot: i64 = (0..3).map(|k| mul_wide(s[k], unit[k])).sum();
+    Some(lambert_of_fitted(fit_bits(v, 30)?, unit))
+}
+
+/// [`lambert_i64`] of a vector already fitted to 30 bits: `lambert_i64(v, unit)` is
+/// `Some(lambert_of_fitted(fit_bits(v, 30)?, unit))`.
+#[inline]
+fn lambert_of_fitted(s: [i32; 3], unit: [i32; 3]) -> Lambert {
+    let dot = mul_wide(s[0], unit[0]) + mul_wide(s[1], unit[1]) + mul_wide(s[2], unit[2]);
     if dot <= 0 {
-        return Some(Lambert::exactly(0));
+        return Lambert::exactly(0);
     }
     let square: u64 = s.iter().map(|&c| mul_wide(c, c) as u64).sum();
     // S < 3·2^60, so S' < 3·2^30; r >= 2^14 (S >= 2^58).
@@ -468,12 +474,12 @@ pub(crate) fn lambert_i64(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
             // Not met by any tested input (S' >= 2^28 here). Bounds that hold whatever the
             // term: the caller takes the exact one.
             None => {
-                return Some(Lambert {
+                return Lambert {
                     lo: 0,
                     hi: i32::MAX,
                     dot: dot as u64,
                     square,
-                })
+                }
             }
         }
     } else {
@@ -481,12 +487,12 @@ pub(crate) fn lambert_i64(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
     };
     let lo = (a << 14).saturating_sub(a + 1);
     let hi = (a + 1).saturating_mul(1 << 14);
-    Some(Lambert {
+    Lambert {
         lo: lo.min(i32::MAX as u32) as i32,
         hi: hi.min(i32::MAX as u32) as i32,
         dot: dot as u64,
         square,
-    })
+    }
 }
 
 /// `(⌊√x⌋, ⌊n / ⌊√x⌋⌋)` for `x` in `[2^28, 2^32)` from 32-bit multiplies alone, for cores
@@ -1104,6 +1110,13 @@ pub trait NormalPrecision:
     fn lambert(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
         Self::cosine(v, unit).map(|c| Lambert::exactly(c.max(0)))
     }
+    /// [`Self::lambert`] of `s`, a vector already brought to 30 bits (its largest component
+    /// `2^29` to `2^30` in magnitude, as a face normal under the identity normal matrix is):
+    /// the same bounds, without fitting it again.
+    fn lambert_fitted(s: [i32; 3], unit: [i32; 3]) -> Lambert {
+        let zero = Lambert::exactly(0);
+        Self::lambert(s.map(i64::from), unit).unwrap_or(zero)
+    }
 }
 
 mod sealed {
@@ -1129,6 +1142,10 @@ impl NormalPrecision for WideNormals {
     #[inline]
     fn lambert(v: [i64; 3], unit: [i32; 3]) -> Option<Lambert> {
         lambert_i64(v, unit)
+    }
+    #[inline]
+    fn lambert_fitted(s: [i32; 3], unit: [i32; 3]) -> Lambert {
+        lambert_of_fitted(s, unit)
     }
 }
 
@@ -1900,6 +1917,32 @@ mod tests {
         }
         // About 2^-14 of the largest cosine (2^30), as documented.
         assert!(widest <= 5 << 16, "{widest}");
+    }
+
+    /// The Lambert bounds of a vector fitted to 30 bits are those of any vector it was fitted
+    /// from, at both normal precisions: lighting under the identity normal matrix fits once.
+    #[test]
+    fn fitted_lambert_is_the_lambert_of_the_fitted_vector() {
+        let dirs = [[0.3, -0.5, 0.8], [1.0, 0.0, 0.0], [-0.2, -0.9, -0.1]];
+        let mut lit = 0;
+        for (i, v) in vectors(200_000).enumerate() {
+            let (unit, _) = exact(v, dirs[i % 3]);
+            let Some(s) = fit_bits(v, 30) else {
+                assert_eq!(lambert_i64(v, unit), None);
+                continue;
+            };
+            let wide = WideNormals::lambert(v, unit);
+            assert_eq!(Some(WideNormals::lambert_fitted(s, unit)), wide, "{v:?}");
+            assert_eq!(lambert_i64(s.map(i64::from), unit), wide, "{v:?}");
+            let narrow = NarrowNormals::lambert(s.map(i64::from), unit);
+            assert_eq!(
+                Some(NarrowNormals::lambert_fitted(s, unit)),
+                narrow,
+                "{v:?}"
+            );
+            lit += usize::from(wide.is_some_and(|l| l.hi > 0));
+        }
+        assert!(lit > 50_000, "{lit}");
     }
 
     #[test]
