@@ -1919,8 +1919,10 @@ mod tests {
         assert!(widest <= 5 << 16, "{widest}");
     }
 
-    /// The Lambert bounds of a vector fitted to 30 bits are those of any vector it was fitted
-    /// from, at both normal precisions: lighting under the identity normal matrix fits once.
+    /// Lighting under the identity normal matrix fits a face normal once: the wide bounds of
+    /// the fitted vector are those of any vector it was fitted from, and at both precisions
+    /// `lambert_fitted` gives what `lambert` gives for the fitted vector, which is what
+    /// `normal_to_world` hands it under that matrix.
     #[test]
     fn fitted_lambert_is_the_lambert_of_the_fitted_vector() {
         let dirs = [[0.3, -0.5, 0.8], [1.0, 0.0, 0.0], [-0.2, -0.9, -0.1]];
