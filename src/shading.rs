@@ -336,33 +336,93 @@ impl Shading for Flat {
         depth: &mut [Z],
         pixels: &mut [P],
     ) -> u32 {
-        let mut q = span.q;
-        let mut written = 0;
-        for (z, p) in depth.iter_mut().zip(pixels.iter_mut()) {
-            // One pixel per iteration on Arm: without this empty barrier the compiler unrolls
-            // the loop four times, which runs out of registers on Cortex-M (spills in the
-            // loop, a remainder loop, a longer entry) and costs more than it saves on the
-            // short spans of a frame (docs/speed.md, item 12). On RISC-V the unrolled loop is
-            // the cheaper one, so it is left alone there.
-            if cfg!(target_arch = "arm") {
-                core::hint::black_box(());
-            }
-            // Strictly nearer wins: on an exact tie the surface drawn first keeps the pixel.
-            let stored = Z::store(q);
-            if stored > *z {
-                *z = stored;
-                *p = *color;
-                written += 1;
-            }
-            q = q.wrapping_add(span.dq);
+        if cfg!(all(target_arch = "arm", target_has_atomic = "32")) {
+            flat_fill_by_pairs(color, span, depth, pixels)
+        } else {
+            flat_fill(color, span, depth, pixels)
         }
-        written
     }
 
     #[inline]
     fn paint<P: RowPixel>(color: &P, _: i32, _: i32, pixels: &mut [P]) {
         pixels.fill(*color);
     }
+}
+
+/// [`Flat::fill`]'s depth test of one pixel at depth `q`, stepping `q`: strictly nearer wins,
+/// so on an exact tie the surface drawn first keeps the pixel.
+#[inline(always)]
+fn flat_test<P: Copy, Z: DepthFormat>(
+    color: &P,
+    q: &mut i32,
+    dq: i32,
+    z: &mut Z,
+    p: &mut P,
+    written: &mut u32,
+) {
+    let stored = Z::store(*q);
+    if stored > *z {
+        *z = stored;
+        *p = *color;
+        *written += 1;
+    }
+    *q = q.wrapping_add(dq);
+}
+
+/// [`Flat::fill`] one pixel per iteration: on ARMv6-M (with an empty barrier: unrolled, the
+/// loop runs out of registers there, docs/speed.md item 12) and on RISC-V (where the
+/// compiler's unrolled loop is the cheaper one).
+#[inline(always)]
+fn flat_fill<P: Copy, Z: DepthFormat>(
+    color: &P,
+    span: SpanDepth,
+    depth: &mut [Z],
+    pixels: &mut [P],
+) -> u32 {
+    let (mut q, mut written) = (span.q, 0);
+    for (z, p) in depth.iter_mut().zip(pixels.iter_mut()) {
+        if cfg!(target_arch = "arm") {
+            core::hint::black_box(());
+        }
+        flat_test(color, &mut q, span.dq, z, p, &mut written);
+    }
+    written
+}
+
+/// [`Flat::fill`] two pixels per iteration, an odd span's first pixel alone: on Armv7-M,
+/// where it takes 10 instructions a pixel instead of 11 (docs/speed.md item 36; the empty
+/// barrier keeps the compiler from unrolling further, which spills on Cortex-M). The same
+/// pixels, depths and count as [`flat_fill`] (test `pairs_fill_as_single_pixels_do`).
+#[inline(always)]
+fn flat_fill_by_pairs<P: Copy, Z: DepthFormat>(
+    color: &P,
+    span: SpanDepth,
+    depth: &mut [Z],
+    pixels: &mut [P],
+) -> u32 {
+    let (mut q, mut written) = (span.q, 0);
+    let n = depth.len().min(pixels.len());
+    let (depth, pixels) = (&mut depth[..n], &mut pixels[..n]);
+    // The odd pixel first: after the pairs it cost more (a second exit test, spills).
+    let (depth, pixels) = if n & 1 == 1 {
+        match (depth.split_first_mut(), pixels.split_first_mut()) {
+            (Some((z, zs)), Some((p, ps))) => {
+                flat_test(color, &mut q, span.dq, z, p, &mut written);
+                (zs, ps)
+            }
+            _ => return written,
+        }
+    } else {
+        (depth, pixels)
+    };
+    for (zs, ps) in depth.chunks_exact_mut(2).zip(pixels.chunks_exact_mut(2)) {
+        core::hint::black_box(());
+        if let ([z0, z1], [p0, p1]) = (zs, ps) {
+            flat_test(color, &mut q, span.dq, z0, p0, &mut written);
+            flat_test(color, &mut q, span.dq, z1, p1, &mut written);
+        }
+    }
+    written
 }
 
 /// Lights `mesh`'s faces ahead of time: writes to `out[t]` the colour [`Flat`] shading gives
@@ -525,6 +585,46 @@ mod tests {
     use crate::project::SubPx;
     use fixed::types::I16F16;
     use std::vec::Vec;
+
+    /// `flat_fill_by_pairs` (Armv7-M's fill) writes the pixels, depths and count the one-pixel
+    /// loop does, for every span length from 0 to 19 (odd and even), over rows holding
+    /// nearer, farther and exactly equal depths, in both depth formats.
+    #[test]
+    fn pairs_fill_as_single_pixels_do() {
+        fn check<Z: DepthFormat + PartialEq + core::fmt::Debug>(next: &mut impl FnMut() -> u64) {
+            for case in 0..4_000 {
+                let n = case % 20;
+                let span = SpanDepth {
+                    x0: 0,
+                    y: 0,
+                    q: (next() >> 34) as i32,
+                    dq: (next() >> 44) as i32 - (1 << 19),
+                };
+                // Rows around the span's depths, so that both outcomes and ties occur.
+                let row: Vec<Z> = (0..n)
+                    .map(|k| {
+                        let q = span.q.wrapping_add(span.dq.wrapping_mul(k));
+                        match next() % 3 {
+                            0 => Z::store(q),
+                            1 => Z::store(q.saturating_add((next() % 4096) as i32)),
+                            _ => Z::store(q.saturating_sub((next() % 4096) as i32)),
+                        }
+                    })
+                    .collect();
+                let pixels: Vec<u16> = (0..n).map(|k| k as u16).collect();
+                let (mut z1, mut p1) = (row.clone(), pixels.clone());
+                let (mut z2, mut p2) = (row, pixels);
+                let colour = 0xBEEF_u16;
+                let single = flat_fill(&colour, span, &mut z1, &mut p1);
+                let pairs = flat_fill_by_pairs(&colour, span, &mut z2, &mut p2);
+                assert_eq!((pairs, &z2, &p2), (single, &z1, &p1), "case {case}");
+            }
+        }
+        let mut rng = crate::test_rng::XorShift64::new(0x9e37_79b9_7f4a_7c15);
+        let mut next = || rng.next_u64();
+        check::<Depth>(&mut next);
+        check::<crate::depth::Depth16>(&mut next);
+    }
 
     /// A triangle receding steeply to the right: vertex depths `q` 1.0 on the left and 0.05 on
     /// the right (20× farther), red left, blue right. Screen positions in pixels at 4 sub-bits.
