@@ -336,7 +336,11 @@ impl Shading for Flat {
         depth: &mut [Z],
         pixels: &mut [P],
     ) -> u32 {
-        if cfg!(all(target_arch = "arm", target_has_atomic = "32")) {
+        // Armv7-M is the Arm profile with 32-bit atomics (ARMv6-M has none).
+        if cfg!(any(
+            target_arch = "riscv32",
+            all(target_arch = "arm", target_has_atomic = "32")
+        )) {
             flat_fill_by_pairs(color, span, depth, pixels)
         } else {
             flat_fill(color, span, depth, pixels)
@@ -369,9 +373,9 @@ fn flat_test<P: Copy, Z: DepthFormat>(
     *q = q.wrapping_add(dq);
 }
 
-/// [`Flat::fill`] one pixel per iteration: on ARMv6-M (with an empty barrier: unrolled, the
-/// loop runs out of registers there, docs/speed.md item 12) and on RISC-V (where the
-/// compiler's unrolled loop is the cheaper one).
+/// [`Flat::fill`] one pixel per iteration: on ARMv6-M, where pairs took more instructions,
+/// with an empty barrier (unrolled by the compiler, the loop runs out of registers there,
+/// docs/speed.md item 12); elsewhere (the host) as the compiler likes.
 #[inline(always)]
 fn flat_fill<P: Copy, Z: DepthFormat>(
     color: &P,
@@ -389,10 +393,11 @@ fn flat_fill<P: Copy, Z: DepthFormat>(
     written
 }
 
-/// [`Flat::fill`] two pixels per iteration, an odd span's first pixel alone: on Armv7-M,
-/// where it takes 10 instructions a pixel instead of 11 (docs/speed.md item 36; the empty
-/// barrier keeps the compiler from unrolling further, which spills on Cortex-M). The same
-/// pixels, depths and count as [`flat_fill`] (test `pairs_fill_as_single_pixels_do`).
+/// [`Flat::fill`] two pixels per iteration, an odd span's first pixel alone: on Armv7-M 10
+/// instructions a pixel instead of 11, and fewer than the compiler's four-fold unrolling on
+/// RISC-V (docs/speed.md item 36; the empty barrier keeps the compiler from unrolling
+/// further, which spills on Cortex-M). The same pixels, depths and count as
+/// [`flat_fill`] (test `pairs_fill_as_single_pixels_do`).
 #[inline(always)]
 fn flat_fill_by_pairs<P: Copy, Z: DepthFormat>(
     color: &P,
