@@ -591,9 +591,9 @@ mod tests {
     use fixed::types::I16F16;
     use std::vec::Vec;
 
-    /// `flat_fill_by_pairs` (Armv7-M's fill) writes the pixels, depths and count the one-pixel
-    /// loop does, for every span length from 0 to 19 (odd and even), over rows holding
-    /// nearer, farther and exactly equal depths, in both depth formats.
+    /// `flat_fill_by_pairs` (the Armv7-M and RISC-V fill) writes the pixels, depths and count
+    /// the one-pixel loop does, for every span length from 0 to 19 (odd and even), over rows
+    /// holding nearer, farther and exactly equal depths, in both depth formats.
     #[test]
     fn pairs_fill_as_single_pixels_do() {
         fn check<Z: DepthFormat + PartialEq + core::fmt::Debug>(next: &mut impl FnMut() -> u64) {
