@@ -10,7 +10,9 @@
 
 use crate::math::{mul_i64, mul_wide_u32};
 use crate::trace::shape::{AaBox, Ellipsoid, Facet, Frustum, Plane, Shape, Sphere};
-use crate::trace::vector::{mul, narrow, narrow_bits, ratio16, sqrt, wide, Vec3};
+use crate::trace::vector::{
+    mul, narrow, narrow_bits, narrow_bits_in_range, ratio16, sqrt, wide, Vec3,
+};
 use fixed::types::{I16F16, I32F32};
 
 /// A ray: origin and unit direction.
@@ -54,7 +56,14 @@ fn sphere(s: &Sphere, ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16>
     let disc = if b.unsigned_abs() <= s.radius.unsigned_abs() {
         I32F32::from_bits(wide(b.to_bits(), b.to_bits())) - (oc.dot(oc) - s.radius2)
     } else {
-        let q = oc.sub(ray.dir.scale(b));
+        // A ray's direction (components at most 1 + 2^-12, a reflected one's) times
+        // |b| < 2^14, as it is for an origin in the envelope (|oc| < 2^13.8): no range test.
+        let along = if b.to_bits().unsigned_abs() < 1 << 30 {
+            ray.dir.scale_in_range(b)
+        } else {
+            ray.dir.scale(b)
+        };
+        let q = oc.sub(along);
         s.radius2 - q.dot(q)
     };
     if disc < I32F32::ZERO {
@@ -184,7 +193,7 @@ fn inside(vertices: &[Vec3], axis: u8, p: Vec3) -> bool {
 
 fn facet(f: &Facet, vertices: &[Vec3], ray: &Ray, t_min: I16F16, t_max: I16F16) -> Option<I16F16> {
     let t = plane_t_in(f.normal, f.offset, ray, t_min, t_max)?;
-    inside(vertices, f.axis, ray.origin.along(ray.dir, t)).then_some(t)
+    inside(vertices, f.axis, ray.origin.along_ray(ray.dir, t)).then_some(t)
 }
 
 /// `a / b` for two I16F16 values, saturating to the I16F16 range (±∞ for `b` = 0).
@@ -661,11 +670,13 @@ fn frustum_normal(f: &Frustum, p: Vec3) -> Vec3 {
     }
 }
 
-/// `a − 2(a·n)n`: `a` mirrored about the plane with unit normal `n`.
+/// `a − 2(a·n)n`: the unit vector `a` (a ray's direction) mirrored about the plane with unit
+/// normal `n`.
 #[inline]
-pub fn reflect(a: Vec3, n: Vec3) -> Vec3 {
-    let k = narrow_bits(a.dot_bits(n)).wrapping_mul(2);
-    a.sub(n.scale(I16F16::from_bits(k)))
+pub(crate) fn reflect(a: Vec3, n: Vec3) -> Vec3 {
+    // Two unit vectors: |a·n| ≤ 1, |k| ≤ 2.
+    let k = narrow_bits_in_range(a.dot_bits(n)).wrapping_mul(2);
+    a.sub(n.scale_in_range(I16F16::from_bits(k)))
 }
 
 #[cfg(test)]

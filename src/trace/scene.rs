@@ -91,15 +91,15 @@ impl Colour {
 pub struct Material {
     /// Surface colour C.
     pub colour: Colour,
-    /// Ambient coefficient KA.
+    /// Ambient coefficient KA, in [0, [`MAX_COEFFICIENT`]].
     pub ka: I16F16,
-    /// Diffuse coefficient KD.
+    /// Diffuse coefficient KD, in [0, [`MAX_COEFFICIENT`]].
     pub kd: I16F16,
-    /// Reflection coefficient KR.
+    /// Reflection coefficient KR, in [0, [`MAX_COEFFICIENT`]].
     pub kr: I16F16,
-    /// Transmission coefficient KT.
+    /// Transmission coefficient KT, in [0, [`MAX_COEFFICIENT`]].
     pub kt: I16F16,
-    /// Index of refraction (inside the object; outside is air, 1.0).
+    /// Index of refraction (inside the object; outside is air, 1.0), in [1, [`MAX_IOR`]].
     pub ior: I16F16,
 }
 
@@ -111,23 +111,31 @@ impl Material {
         [ka, kd, kr, kt]: [I16F16; 4],
         ior: I16F16,
     ) -> Result<Material, TraceSceneError> {
-        if [ka, kd, kr, kt]
-            .iter()
-            .any(|k| *k < I16F16::ZERO || *k > MAX_COEFFICIENT)
-        {
-            return Err(TraceSceneError::BadCoefficient);
-        }
-        if ior < I16F16::ONE || ior > MAX_IOR {
-            return Err(TraceSceneError::BadIor);
-        }
-        Ok(Material {
+        let material = Material {
             colour,
             ka,
             kd,
             kr,
             kt,
             ior,
-        })
+        };
+        material.check()?;
+        Ok(material)
+    }
+
+    /// Whether the material keeps the limits its fields document.
+    fn check(&self) -> Result<(), TraceSceneError> {
+        Colour::new(self.colour.0)?;
+        if [self.ka, self.kd, self.kr, self.kt]
+            .iter()
+            .any(|k| *k < I16F16::ZERO || *k > MAX_COEFFICIENT)
+        {
+            return Err(TraceSceneError::BadCoefficient);
+        }
+        if self.ior < I16F16::ONE || self.ior > MAX_IOR {
+            return Err(TraceSceneError::BadIor);
+        }
+        Ok(())
     }
 }
 
@@ -198,16 +206,13 @@ pub enum LightKind {
 pub struct Light {
     /// Position or direction.
     pub kind: LightKind,
-    /// Intensity I.
+    /// Intensity I, in [0, [`MAX_COEFFICIENT`]].
     pub intensity: I16F16,
 }
 
 impl Light {
     /// A point light at `position`.
     pub fn point(position: Vec3, intensity: I16F16) -> Result<Light, TraceSceneError> {
-        if !position.in_envelope() {
-            return Err(TraceSceneError::BadLight);
-        }
         Light::with(LightKind::Point(position), intensity)
     }
 
@@ -221,15 +226,30 @@ impl Light {
     }
 
     fn with(kind: LightKind, intensity: I16F16) -> Result<Light, TraceSceneError> {
-        if intensity < I16F16::ZERO || intensity > MAX_COEFFICIENT {
-            return Err(TraceSceneError::BadLight);
+        let light = Light { kind, intensity };
+        light.check()?;
+        Ok(light)
+    }
+
+    /// Whether the light keeps its limits: the intensity in [0, [`MAX_COEFFICIENT`]], a point
+    /// light's position in the envelope, a directional light's components in [−1, 1].
+    fn check(&self) -> Result<(), TraceSceneError> {
+        let place = match self.kind {
+            LightKind::Point(p) => p.in_envelope(),
+            LightKind::Directional(d) => d.bits().iter().all(|c| c.unsigned_abs() <= 1 << 16),
+        };
+        if place && self.intensity >= I16F16::ZERO && self.intensity <= MAX_COEFFICIENT {
+            Ok(())
+        } else {
+            Err(TraceSceneError::BadLight)
         }
-        Ok(Light { kind, intensity })
     }
 }
 
 /// A traced scene: objects (ids are their indices), materials, lights, background colour and
-/// ambient level, all borrowed.
+/// ambient level, all borrowed. Made by [`Scene::new`] or [`Scene::textured`], which check the
+/// limits its parts document; a field replaced afterwards must keep them too (outside them
+/// colours are unspecified, though the tracer never panics).
 #[derive(Clone, Copy, Debug)]
 pub struct Scene<'a> {
     /// Primitives; an object's id is its index.
@@ -289,8 +309,9 @@ impl<'a> Scene<'a> {
         })
     }
 
-    /// A scene, or an error for an unknown material index, more than [`MAX_LIGHTS`] lights or
-    /// an ambient level outside [0, 1].
+    /// A scene, or an error for an unknown material index, more than [`MAX_LIGHTS`] lights,
+    /// an ambient level or background channel outside [0, 1], or a material or light outside
+    /// the limits its fields document.
     pub fn new(
         objects: &'a [Object<'a>],
         materials: &'a [Material],
@@ -341,6 +362,11 @@ impl<'a> Scene<'a> {
         if ambient < I16F16::ZERO || ambient > I16F16::ONE {
             return Err(TraceSceneError::BadColour);
         }
+        // Checked again here, for materials and lights made field by field: the tracer's
+        // products rely on these limits.
+        Colour::new(background.0)?;
+        materials.iter().try_for_each(Material::check)?;
+        lights.iter().try_for_each(Light::check)?;
         Ok(Scene {
             objects,
             materials,
@@ -643,6 +669,70 @@ mod tests {
         assert_eq!(
             textured.material_at(&floor, p(1.5, 0.0, 0.5)),
             Some(&materials[1])
+        );
+    }
+
+    #[test]
+    fn parts_made_field_by_field_are_checked_by_the_scene() {
+        let grey = Colour::new([I16F16::from_num(0.5); 3]).unwrap();
+        let m = Material::new(grey, [I16F16::ONE; 4], I16F16::ONE).unwrap();
+        let light = Light::point(p(0.0, 4.0, 0.0), I16F16::ONE).unwrap();
+        let scene = |materials: &[Material], lights: &[Light], background: Colour| {
+            Scene::new(&[], materials, lights, background, I16F16::ZERO).map(|_| ())
+        };
+        assert_eq!(scene(&[m], &[light], Colour::BLACK), Ok(()));
+        let over = MAX_COEFFICIENT + I16F16::DELTA;
+        let bad_materials = [
+            (Material { kd: over, ..m }, TraceSceneError::BadCoefficient),
+            (
+                Material {
+                    kr: -I16F16::DELTA,
+                    ..m
+                },
+                TraceSceneError::BadCoefficient,
+            ),
+            (
+                Material {
+                    ior: MAX_IOR + I16F16::DELTA,
+                    ..m
+                },
+                TraceSceneError::BadIor,
+            ),
+            (
+                Material {
+                    colour: Colour([I16F16::from_num(1.5); 3]),
+                    ..m
+                },
+                TraceSceneError::BadColour,
+            ),
+        ];
+        for (bad, error) in bad_materials {
+            assert_eq!(scene(&[m, bad], &[light], Colour::BLACK), Err(error));
+        }
+        let bad_lights = [
+            Light {
+                intensity: over,
+                ..light
+            },
+            Light {
+                kind: LightKind::Point(p(5000.0, 0.0, 0.0)),
+                ..light
+            },
+            Light {
+                kind: LightKind::Directional(p(0.0, 2.0, 0.0)),
+                ..light
+            },
+        ];
+        for bad in bad_lights {
+            assert_eq!(
+                scene(&[m], &[light, bad], Colour::BLACK),
+                Err(TraceSceneError::BadLight)
+            );
+        }
+        let bright = Colour([I16F16::from_num(2); 3]);
+        assert_eq!(
+            scene(&[m], &[light], bright),
+            Err(TraceSceneError::BadColour)
         );
     }
 

@@ -30,7 +30,9 @@ use crate::sink::{Row, RowPixel, RowSink};
 use crate::trace::intersect::{reflect, Ray};
 use crate::trace::row_shadow::{any_blocks, RowShadows, ShadowCandidate, ShadowWindows};
 use crate::trace::scene::{Colour, LightKind, Scene, TraceCamera, MAX_LIGHTS};
-use crate::trace::vector::{mul, mul_shr32, narrow_bits, sqrt, wide, Vec3};
+use crate::trace::vector::{
+    mul, mul_in_range, mul_shr32, narrow_bits, narrow_bits_in_range, sqrt, wide, Vec3,
+};
 use embedded_graphics::pixelcolor::Rgb888;
 use fixed::types::{I16F16, I32F32};
 
@@ -628,7 +630,7 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
             return (0, None);
         };
         let ray = &pending.ray;
-        let point = ray.origin.along(ray.dir, hit.t);
+        let point = ray.origin.along_ray(ray.dir, hit.t);
         let index = scene.material_index_at(object, point);
         let Some(material) = index.and_then(|m| scene.materials.get(usize::from(m))) else {
             return (0, None);
@@ -649,7 +651,8 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                         .unwrap_or((Vec3::ZERO, I16F16::ZERO))
                 }
             };
-            let nl = I16F16::from_bits(narrow_bits(normal.dot_bits(towards)));
+            // Two unit vectors: |N·L| ≤ 1.
+            let nl = I16F16::from_bits(narrow_bits_in_range(normal.dot_bits(towards)));
             let lit = nl > I16F16::ZERO && {
                 stats.shadow_rays += 1;
                 let shadow_ray = Ray {
@@ -671,13 +674,17 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
                 }
             };
             if lit {
-                diffuse = diffuse.saturating_add(mul(nl, light.intensity));
+                // N·L in (0, 1], the intensity at most 8.
+                diffuse = diffuse.saturating_add(mul_in_range(nl, light.intensity));
             } else {
                 shadow |= 1u8.checked_shl(k as u32).unwrap_or(0);
             }
         }
-        let factor = mul(material.ka, scene.ambient).saturating_add(mul(material.kd, diffuse));
-        let local = Colour(material.colour.0.map(|c| mul(c, factor)));
+        // KA and KD at most 8, the ambient level at most 1, the diffuse sum at most 8 a
+        // light (8 · MAX_LIGHTS = 64): the factor is at most 520, a colour channel at most 1.
+        let factor = mul_in_range(material.ka, scene.ambient)
+            .saturating_add(mul_in_range(material.kd, diffuse));
+        let local = Colour(material.colour.0.map(|c| mul_in_range(c, factor)));
         add_weighted(sum, &local, pending.weight);
 
         // A diffuse surface (KR = KT = 0) spawns nothing, as the pushes below would decide:
@@ -719,10 +726,12 @@ impl<'s, 'a, const STACK: usize> Tracer<'s, 'a, STACK> {
 }
 
 /// The refracted direction of unit `d` through a surface with unit normal `n` facing it, from
-/// IOR `n1` into `n2` (Snell's law), or `None` on total internal reflection.
-pub fn refract(d: Vec3, n: Vec3, n1: I16F16, n2: I16F16) -> Option<Vec3> {
+/// IOR `n1` into `n2` (Snell's law; each IOR in [1, MAX_IOR], as a material's), or `None` on
+/// total internal reflection.
+pub(crate) fn refract(d: Vec3, n: Vec3, n1: I16F16, n2: I16F16) -> Option<Vec3> {
     let eta = ior_ratio(n1, n2)?;
-    let cos_i = I16F16::from_bits(narrow_bits(-d.dot_bits(n)));
+    // Two unit vectors: |cos θi| ≤ 1; η at most MAX_IOR (4), so |along_n| ≤ 5.
+    let cos_i = I16F16::from_bits(narrow_bits_in_range(-d.dot_bits(n)));
     // k = 1 − η²(1 − cos²θi): the squared cosine of the refracted angle.
     let sin2_i = I32F32::ONE - I32F32::from_bits(wide(cos_i.to_bits(), cos_i.to_bits()));
     let eta2 = I32F32::from_bits(wide(eta.to_bits(), eta.to_bits()));
@@ -731,8 +740,10 @@ pub fn refract(d: Vec3, n: Vec3, n1: I16F16, n2: I16F16) -> Option<Vec3> {
         return None;
     }
     let cos_t = sqrt(k);
-    let along_n = mul(eta, cos_i) - cos_t;
-    d.scale(eta).add(n.scale(along_n)).normalized()
+    let along_n = mul_in_range(eta, cos_i) - cos_t;
+    d.scale_in_range(eta)
+        .add(n.scale_in_range(along_n))
+        .normalized()
 }
 
 /// `n1 / n2` exactly as `n1.checked_div(n2)` (truncated; `None` if `n2` is 0 or the quotient
