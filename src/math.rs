@@ -846,13 +846,19 @@ impl Divisor32 {
     }
 }
 
-/// ⌊√v⌋ for a 32-bit integer: [`isqrt32_newton`] where the target divides 32-bit integers in
-/// hardware (Cortex-M3/M4 `udiv`, RV32 `M`, the host), [`isqrt32_bitwise`] on ARMv6-M, whose
-/// division is a library call. Both are exact, so every target gets the same bits.
+/// ⌊√v⌋ for a 32-bit integer: the double-precision square root where the core has one (x86
+/// with SSE2, AArch64: one instruction where Newton's steps take four divisions), else
+/// [`isqrt32_newton`] where the target divides 32-bit integers in hardware (Cortex-M3/M4
+/// `udiv`, RV32 `M`), [`isqrt32_bitwise`] on ARMv6-M, whose division is a library call. All are
+/// exact, so every target gets the same bits: an integer below 2^32 is exact in `f64`, and
+/// where it is not a square its root lies at least 2^-17 below the next integer, far more
+/// than the correctly rounded root's error (below 2^-36), so the root floors to ⌊√v⌋.
 #[inline]
-pub const fn isqrt32(v: u32) -> u32 {
-    // ARMv6-M is the Arm profile without 32-bit atomics (and without a divider).
-    if cfg!(all(target_arch = "arm", not(target_has_atomic = "32"))) {
+pub fn isqrt32(v: u32) -> u32 {
+    if cfg!(any(target_feature = "sse2", target_arch = "aarch64")) {
+        libm::sqrt(f64::from(v)) as u32
+    } else if cfg!(all(target_arch = "arm", not(target_has_atomic = "32"))) {
+        // ARMv6-M is the Arm profile without 32-bit atomics (and without a divider).
         isqrt32_bitwise(v)
     } else {
         isqrt32_newton(v)
