@@ -131,9 +131,9 @@ impl Vec3 {
         let a = self.bits();
         let s = s.to_bits();
         Vec3::from_bits(
-            narrow_bits_in_range(wide(a[0], s)),
-            narrow_bits_in_range(wide(a[1], s)),
-            narrow_bits_in_range(wide(a[2], s)),
+            mul_shr16_in_range(a[0], s),
+            mul_shr16_in_range(a[1], s),
+            mul_shr16_in_range(a[2], s),
         )
     }
 
@@ -242,7 +242,35 @@ pub(crate) const fn narrow_bits_in_range(v: i64) -> i32 {
 /// (see [`narrow_bits_in_range`]).
 #[inline]
 pub(crate) fn mul_in_range(a: I16F16, b: I16F16) -> I16F16 {
-    I16F16::from_bits(narrow_bits_in_range(wide(a.to_bits(), b.to_bits())))
+    I16F16::from_bits(mul_shr16_in_range(a.to_bits(), b.to_bits()))
+}
+
+/// `narrow_bits_in_range(wide(a, b))`, the product of two raw I16F16 values narrowed to I16F16
+/// where its call site bounds it inside the range: on ARMv6-M from three 32-bit multiplies
+/// instead of the wide product's four and its 64-bit sums (`mul_shr16_in_words`); elsewhere
+/// the wide multiply. The same bits within the range (test
+/// `range_free_forms_equal_the_saturating_ones_within_their_bounds`).
+#[inline]
+fn mul_shr16_in_range(a: i32, b: i32) -> i32 {
+    if crate::math::NO_WIDE_MULTIPLY {
+        mul_shr16_in_words(a, b)
+    } else {
+        narrow_bits_in_range(wide(a, b))
+    }
+}
+
+/// [`mul_shr16_in_range`] in 32-bit words, on every target (tested on the host): with
+/// `a = ah·2^16 + al` and `b = bh·2^16 + bl` (`ah`, `bh` signed, `al`, `bl` in `[0, 2^16)`),
+/// `a·b = (a·bh + ah·bl)·2^16 + al·bl`, so `⌊a·b / 2^16⌋ = a·bh + ah·bl + ⌊al·bl / 2^16⌋`
+/// (`al·bl` is non-negative and below 2^32). Only `a·bh` can leave `i32`; the sum is taken
+/// modulo 2^32, which gives the value itself wherever it fits `i32`.
+#[inline]
+fn mul_shr16_in_words(a: i32, b: i32) -> i32 {
+    let (ah, al) = (a >> 16, (a & 0xFFFF) as u32);
+    let (bh, bl) = (b >> 16, (b & 0xFFFF) as u32);
+    a.wrapping_mul(bh)
+        .wrapping_add(ah * bl as i32)
+        .wrapping_add(((al * bl) >> 16) as i32)
 }
 
 /// `a · b` for two I16F16 values, truncated, saturating outside the I16F16 range.
@@ -803,6 +831,17 @@ mod tests {
             let other = any().max(i32::MIN + 1);
             let v = unit as i64 * other as i64;
             assert_eq!(narrow_bits_in_range(v), narrow_bits(v), "{v}");
+            assert_eq!(
+                mul_shr16_in_words(unit, other),
+                narrow_bits(v),
+                "{unit} {other}"
+            );
+            // Any two factors whose product's narrowing fits.
+            let (x, y) = (any(), any());
+            let xy = x as i64 * y as i64;
+            if xy >> 47 == xy >> 63 {
+                assert_eq!(mul_shr16_in_words(x, y), narrow_bits(xy), "{x} {y}");
+            }
             let (a, b) = (I16F16::from_bits(unit), I16F16::from_bits(other));
             assert_eq!(mul_in_range(a, b), mul(a, b), "{a} {b}");
             let d = Vec3::from_bits(unit, any() % (1 << 16), any() % (1 << 16));
