@@ -109,7 +109,7 @@ fn main() -> ExitCode {
             Some(result) => result,
             None => {
                 eprintln!(
-                    "usage: cargo xtask test | package | firmware | trace [alone] | metaball | metaball-trade | patch | patch-trade | lean | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | profile trace [pure|hybrid] [TARGET] | profile patch [TARGET] (each profile [--blocks PATTERN]) | scene-ram SCENE [TARGET...] | speed [before|after|doc] | fuzz [SECONDS]"
+                    "usage: cargo xtask test | package | firmware | trace [alone] | metaball | metaball-trade | patch | patch-trade | lean | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | profile trace [pure|hybrid] [TARGET] | profile patch [TARGET] | profile firmware [TARGET] (each profile [--blocks PATTERN]) | scene-ram SCENE [TARGET...] | speed [before|after|doc] | fuzz [SECONDS]"
                 );
                 return ExitCode::from(2);
             }
@@ -180,6 +180,11 @@ fn host_task(task: &str) -> Option<Result<(), String>> {
                 .find(|a| a.as_str() != target)
                 .map_or("pure", String::as_str);
             install().and_then(|_| profile::profile_trace(mode, target, blocks.as_deref()))
+        }
+        "profile" if std::env::args().nth(2).as_deref() == Some("firmware") => {
+            let (rest, blocks) = blocks_option(std::env::args().skip(3).collect());
+            let target = rest.first().map_or("thumbv7em-none-eabihf", String::as_str);
+            install().and_then(|_| profile::profile_firmware(target, blocks.as_deref()))
         }
         "profile" if std::env::args().nth(2).as_deref() == Some("patch") => {
             let (rest, blocks) = blocks_option(std::env::args().skip(3).collect());

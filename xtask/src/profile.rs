@@ -342,6 +342,16 @@ pub fn profile_trace(mode: &str, target: &str, blocks: Option<&str>) -> Result<(
     })
 }
 
+/// `cargo xtask profile firmware [TARGET]`: the demo firmware's orbit with the vertex cache,
+/// built as `cargo xtask firmware` measures it (`--cfg scanline3d_vertex_cache`; thumbv7em
+/// unless a TARGET is named), profiled like a trade-off variant.
+pub fn profile_firmware(target: &str, blocks: Option<&str>) -> Result<(), String> {
+    step(&format!("demo firmware with the vertex cache for {target}"));
+    let cfgs = ["scanline3d_vertex_cache".to_string()];
+    let elf = build_example_with_cfgs("firmware", Some(target), &cfgs, None)?;
+    profile_elf(target, &elf, "firmware", blocks, |l| l.starts_with("frame "))
+}
+
 /// `cargo xtask profile patch [TARGET]`: the patch firmware's teapot frames (tolerance
 /// 0.5 px), profiled like a trade-off variant (thumbv7em unless a TARGET is named).
 pub fn profile_patch(target: &str, blocks: Option<&str>) -> Result<(), String> {
