@@ -82,7 +82,7 @@ pub(crate) fn cargo() -> Command {
 
 /// The commands compiled only with the `host` feature (see Cargo.toml), in the usage line's order.
 #[cfg(not(feature = "host"))]
-const HOST_TASKS: [&str; 14] = [
+const HOST_TASKS: [&str; 15] = [
     "firmware",
     "trace",
     "metaball",
@@ -90,6 +90,7 @@ const HOST_TASKS: [&str; 14] = [
     "patch",
     "patch-trade",
     "lean",
+    "flash",
     "hsr-table",
     "peers",
     "tradeoff",
@@ -109,7 +110,7 @@ fn main() -> ExitCode {
             Some(result) => result,
             None => {
                 eprintln!(
-                    "usage: cargo xtask test | package | firmware | trace [alone] | metaball | metaball-trade | patch | patch-trade | lean | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | profile trace [pure|hybrid] [TARGET] | profile patch [TARGET] | profile firmware [TARGET] (each profile [--blocks PATTERN]) | scene-ram SCENE [TARGET...] | speed [before|after|doc] | fuzz [SECONDS]"
+                    "usage: cargo xtask test | package | firmware | trace [alone] | metaball | metaball-trade | patch | patch-trade | lean | flash [TARGET] [VARIANT] | hsr-table | peers | tradeoff | profile [VARIANT [cache] [TARGET] [SCENE]] | profile trace [pure|hybrid] [TARGET] | profile patch [TARGET] | profile firmware [TARGET] (each profile [--blocks PATTERN]) | scene-ram SCENE [TARGET...] | speed [before|after|doc] | fuzz [SECONDS]"
                 );
                 return ExitCode::from(2);
             }
@@ -156,6 +157,18 @@ fn host_task(task: &str) -> Option<Result<(), String>> {
         }
         "trace" => install().and_then(|_| trace::trace()),
         "lean" => install().and_then(|_| lean()),
+        "flash" => {
+            let args: Vec<String> = std::env::args().skip(2).collect();
+            let target = args
+                .iter()
+                .find(|a| a.contains("-none-") || a.contains("-unknown-"))
+                .map_or("thumbv6m-none-eabi", String::as_str);
+            let variant = args
+                .iter()
+                .find(|a| a.as_str() != target)
+                .map_or("minimal", String::as_str);
+            install().and_then(|_| profile::flash(target, variant))
+        }
         "metaball" => install().and_then(|_| metaball::metaball()),
         "patch" => install().and_then(|_| patch::patch()),
         "metaball-trade" => install().and_then(|_| metaball::metaball_trade()),

@@ -15,9 +15,15 @@
 //! traced firmware's frame in one mode (thumbv7em unless a TARGET is named), and also prints per
 //! symbol the functions inlined into it (which separates, say, the shadow rays' walk in `shade`
 //! from the nearest-hit walk in `nearest`). `cargo xtask profile patch [TARGET]` profiles the
-//! patch firmware's teapot frames. Any of them with `--blocks PATTERN` also takes apart the
+//! patch firmware's teapot frames; `cargo xtask profile firmware [TARGET]` the demo firmware as
+//! `cargo xtask firmware` builds it. Any of them with `--blocks PATTERN` also takes apart the
 //! symbols whose name contains PATTERN block by block (instructions a frame, where in the
 //! sources). The log goes through a named pipe, never to disk.
+//!
+//! `cargo xtask flash [TARGET] [VARIANT]` is the same attribution for code size: every byte of
+//! a lean firmware's code and read-only data charged to the source function it comes from
+//! (innermost in this repository's sources, inlined or not; else its symbol), less the
+//! renderer-less baseline's bytes of the same function (thumbv6m and `minimal` unless named).
 
 use crate::tradeoff::{build_example_with_cfgs, run_on_qemu_with, CORPUS};
 use crate::{root, step};
@@ -358,6 +364,108 @@ pub fn profile_patch(target: &str, blocks: Option<&str>) -> Result<(), String> {
     step(&format!("patch firmware (teapot, 0.5 px) for {target}"));
     let elf = build_example_with_cfgs("patch", Some(target), &[], None)?;
     profile_elf(target, &elf, "patch", blocks, |l| l.starts_with("frame "))
+}
+
+/// `cargo xtask flash [TARGET] [VARIANT]`: where the renderer flash of a lean build goes
+/// (`cargo xtask lean`'s "renderer flash": the variant's flash less `lean_baseline`'s). Each
+/// instruction's bytes (to the next instruction, or to its symbol's end) and each read-only
+/// data symbol are charged to a source function as [`source_lines`] names it; the table is
+/// per function, the variant's bytes less the baseline's, largest first.
+pub fn flash(target: &str, variant: &str) -> Result<(), String> {
+    step(&format!("lean firmware ({variant} and baseline) for {target}"));
+    crate::firmware_build::build_firmware_examples_on(
+        &[target],
+        "lean",
+        &[&format!("lean_{variant}"), "lean_baseline"],
+    )?;
+    // The two examples' own functions (`lean_minimal::lean::run`, `lean_baseline::lean::run`)
+    // compared under one name.
+    let of = |example: &str| -> Result<HashMap<String, i64>, String> {
+        let bytes = code_bytes_by_function(&crate::firmware::firmware_elf(target, "lean", example))?;
+        let own = format!("{example}::");
+        let mut merged: HashMap<String, i64> = HashMap::new();
+        for (f, n) in bytes {
+            *merged.entry(f.replace(&own, "example::")).or_default() += n;
+        }
+        Ok(merged)
+    };
+    let (build, base) = (of(&format!("lean_{variant}"))?, of("lean_baseline")?);
+    let mut rows: Vec<(i64, i64, &str)> = build
+        .keys()
+        .chain(base.keys())
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .map(|f| {
+            let (b, a) = (base.get(f).copied().unwrap_or(0), build.get(f).copied().unwrap_or(0));
+            (a - b, a, f.as_str())
+        })
+        .filter(|r| r.0 != 0)
+        .collect();
+    rows.sort_by_key(|r| (-r.0, r.2));
+    let total: i64 = rows.iter().map(|r| r.0).sum();
+    println!(
+        "lean_{variant} on {target}: {total} B of code and read-only data more than lean_baseline, by source function (innermost in src/ or firmware/examples/, else the symbol):"
+    );
+    println!("| function | bytes more than the baseline | bytes in lean_{variant} |");
+    println!("|---|---:|---:|");
+    for (more, bytes, f) in &rows {
+        println!("| {f} | {more} | {bytes} |");
+    }
+    Ok(())
+}
+
+/// Bytes of code (every instruction to the next, or to its symbol's end) and of read-only
+/// data symbols, by the function [`source_lines`] charges them to.
+fn code_bytes_by_function(elf: &std::path::Path) -> Result<HashMap<String, i64>, String> {
+    let syms = symbols(elf)?;
+    let listing = Command::new("llvm-objdump")
+        .args(["-d", "--no-show-raw-insn"])
+        .arg(elf)
+        .output()
+        .map_err(|e| format!("llvm-objdump (install llvm): {e}"))?
+        .stdout;
+    let listing = String::from_utf8_lossy(&listing);
+    let addrs: Vec<u64> = listing
+        .lines()
+        .filter_map(|l| {
+            let (addr, rest) = l.trim_start().split_once(':')?;
+            (!rest.is_empty() && !l.ends_with(">:"))
+                .then(|| u64::from_str_radix(addr.trim(), 16).ok())
+                .flatten()
+        })
+        .collect();
+    let sites = source_lines(elf, &addrs)?;
+    let mut bytes: HashMap<String, i64> = HashMap::new();
+    for (k, &a) in addrs.iter().enumerate() {
+        let symbol = name_of(&syms, a);
+        let end = syms
+            .iter()
+            .find(|s| s.0 <= a && a < s.0 + s.1)
+            .map_or(a, |s| s.0 + s.1);
+        let next = addrs.get(k + 1).copied().filter(|&n| n > a && n <= end);
+        let size = next.unwrap_or(end).saturating_sub(a) as i64;
+        let key = match sites.get(&a) {
+            Some(site) if !site.function.is_empty() => site.function.clone(),
+            _ => function_name(symbol),
+        };
+        *bytes.entry(key).or_default() += size;
+    }
+    // Read-only data (tables, literal strings), by symbol.
+    let out = Command::new("llvm-nm")
+        .args(["-C", "-S", "--defined-only"])
+        .arg(elf)
+        .output()
+        .map_err(|e| format!("llvm-nm (install llvm): {e}"))?;
+    for l in String::from_utf8_lossy(&out.stdout).lines() {
+        let p: Vec<&str> = l.splitn(4, ' ').collect();
+        if let [_, size, kind, name] = p[..] {
+            if kind.eq_ignore_ascii_case("r") {
+                let size = i64::from_str_radix(size, 16).unwrap_or(0);
+                *bytes.entry(format!("(data) {}", function_name(name))).or_default() += size;
+            }
+        }
+    }
+    Ok(bytes)
 }
 
 /// What the log says ran: per block and per instruction address, with the built-ins apart.
