@@ -135,6 +135,25 @@ fn host_task(task: &str) -> Option<Result<(), String>> {
     })
 }
 
+/// The target named in `args` (a triple with `-none-` or `-unknown-`) and the first other
+/// argument, each `default_*` when missing.
+#[cfg(feature = "host")]
+fn target_and_word<'a>(
+    args: &'a [String],
+    default_target: &'a str,
+    default_word: &'a str,
+) -> (&'a str, &'a str) {
+    let target = args
+        .iter()
+        .find(|a| a.contains("-none-") || a.contains("-unknown-"))
+        .map_or(default_target, String::as_str);
+    let word = args
+        .iter()
+        .find(|a| a.as_str() != target)
+        .map_or(default_word, String::as_str);
+    (target, word)
+}
+
 /// `args` without `--blocks PATTERN` (the profile commands' option), and PATTERN.
 #[cfg(feature = "host")]
 fn blocks_option(mut args: Vec<String>) -> (Vec<String>, Option<String>) {
@@ -159,14 +178,7 @@ fn host_task(task: &str) -> Option<Result<(), String>> {
         "lean" => install().and_then(|_| lean()),
         "flash" => {
             let args: Vec<String> = std::env::args().skip(2).collect();
-            let target = args
-                .iter()
-                .find(|a| a.contains("-none-") || a.contains("-unknown-"))
-                .map_or("thumbv6m-none-eabi", String::as_str);
-            let variant = args
-                .iter()
-                .find(|a| a.as_str() != target)
-                .map_or("minimal", String::as_str);
+            let (target, variant) = target_and_word(&args, "thumbv6m-none-eabi", "minimal");
             install().and_then(|_| profile::flash(target, variant))
         }
         "metaball" => install().and_then(|_| metaball::metaball()),
@@ -184,14 +196,7 @@ fn host_task(task: &str) -> Option<Result<(), String>> {
         }
         "profile" if std::env::args().nth(2).as_deref() == Some("trace") => {
             let (rest, blocks) = blocks_option(std::env::args().skip(3).collect());
-            let target = rest
-                .iter()
-                .find(|a| a.contains("-none-") || a.contains("-unknown-"))
-                .map_or("thumbv7em-none-eabihf", String::as_str);
-            let mode = rest
-                .iter()
-                .find(|a| a.as_str() != target)
-                .map_or("pure", String::as_str);
+            let (target, mode) = target_and_word(&rest, "thumbv7em-none-eabihf", "pure");
             install().and_then(|_| profile::profile_trace(mode, target, blocks.as_deref()))
         }
         "profile" if std::env::args().nth(2).as_deref() == Some("firmware") => {
