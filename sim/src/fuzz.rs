@@ -1,12 +1,18 @@
 //! The fuzz harness for scene input: arbitrary bytes become a camera, a target size, render
-//! settings and OBJ text, which go through the same loading and rendering as `sim render`.
-//! Any `Err` is fine; a panic, hang or crash is a bug.
+//! settings and OBJ text, which go through the same loading and rendering as `sim render`;
+//! or, with the header's [`TRACED`] bit, a traced scene's text, which goes through `sim
+//! trace`'s parsing, the f64 tracer, the fixed-point tracer (pure and hybrid, which must give
+//! the same image) and the firmware export. Any `Err` is fine; a panic, hang or crash is a bug.
 //!
 //! The coverage-guided fuzzer (AFL++, through `cargo afl` on stable Rust) drives it from
 //! `fuzz/`; `cargo xtask fuzz SECONDS` runs it, and the test command runs a short bounded
 //! session. The tests here feed it the corpus and hand-written hostile inputs.
 
 use crate::scene::{CameraSpec, MeshData};
+use crate::trace::accel::Structure;
+use crate::trace::fixed::{self, Accel, FixedScene};
+use crate::trace::scene::TracedScene;
+use crate::trace::whitted::Limits;
 use embedded_graphics::pixelcolor::Rgb888;
 use scanline3d::scene::{Instance, Light, Scene, Transform};
 use scanline3d::sink::{FnSink, Row};
@@ -17,6 +23,12 @@ pub const HEADER: usize = 16;
 
 /// Largest fuzzed target (kept small so each input runs in well under a millisecond).
 const MAX: usize = 64;
+
+/// The bit of header byte 12 that makes the text after the header a traced scene.
+pub const TRACED: u8 = 4;
+
+/// Largest fuzzed traced image (every pixel is a ray tree, traced four times).
+const TRACED_MAX: usize = 12;
 
 fn render<S: scanline3d::Shading, const SUB: u32>(
     scene: &Scene<'_>,
@@ -53,28 +65,30 @@ fn render<S: scanline3d::Shading, const SUB: u32>(
     }
 }
 
+/// The camera a header describes.
+fn camera_of(head: &[u8; HEADER]) -> CameraSpec {
+    let b = |i: usize| head[i] as f64;
+    CameraSpec {
+        eye: [0, 1, 2].map(|i| (b(i) - 128.0) / 8.0),
+        target: [3, 4, 5].map(|i| (b(i) - 128.0) / 32.0),
+        up: [(b(13) - 128.0) / 64.0, 1.0, 0.0],
+        fovy: b(6) * 0.75,
+        near: b(7) / 64.0,
+        far: b(7) / 64.0 + b(8) * 8.0,
+    }
+}
+
 /// Runs one fuzz input.
 pub fn one(data: &[u8]) {
     let Some((head, obj)) = data.split_first_chunk::<HEADER>() else {
         return;
     };
+    let camera = camera_of(head);
     let b = |i: usize| head[i] as f64;
-    let camera = CameraSpec {
-        eye: [
-            (b(0) - 128.0) / 8.0,
-            (b(1) - 128.0) / 8.0,
-            (b(2) - 128.0) / 8.0,
-        ],
-        target: [
-            (b(3) - 128.0) / 32.0,
-            (b(4) - 128.0) / 32.0,
-            (b(5) - 128.0) / 32.0,
-        ],
-        up: [(b(13) - 128.0) / 64.0, 1.0, 0.0],
-        fovy: b(6) * 0.75,
-        near: b(7) / 64.0,
-        far: b(7) / 64.0 + b(8) * 8.0,
-    };
+    if head[12] & TRACED != 0 {
+        traced(head, &camera, obj);
+        return;
+    }
     let (w, h) = (1 + head[9] as usize % MAX, 1 + head[10] as usize % MAX);
     let (sub, cull, gouraud) = (head[11] % 4, head[12] & 1 == 1, head[12] & 2 == 2);
     let Ok(mesh) = MeshData::load_obj_bytes(obj, "fuzz input") else {
@@ -109,8 +123,118 @@ pub fn one(data: &[u8]) {
     }
 }
 
-/// Seed inputs: every corpus scene behind a header that looks at it.
+/// Traces `text` (a traced scene; `mesh` lines read from `sim/scenes/`) through `camera` at
+/// a size, depth limit, threshold and acceleration structure from `head`: the f64 tracer, the
+/// fixed-point tracer pure and hybrid, and the export of the fixed-point scene. Whether the
+/// fixed-point tracer traced the frame (what the seeds must reach).
+fn traced(head: &[u8; HEADER], camera: &CameraSpec, text: &[u8]) -> bool {
+    let Ok(text) = std::str::from_utf8(text) else {
+        return false;
+    };
+    let dir = crate::trace::corpus::scenes_dir();
+    let Ok(scene) = TracedScene::parse(text, &dir, "fuzz input") else {
+        return false;
+    };
+    let (w, h) = (
+        1 + head[9] as usize % TRACED_MAX,
+        1 + head[10] as usize % TRACED_MAX,
+    );
+    // Depths beyond both tracers' limits and thresholds above 1 are errors to reach too.
+    let limits = Limits {
+        max_depth: u32::from(head[11] % 8),
+        threshold: f64::from(head[15]) / 128.0,
+    };
+    let structure = Structure::ALL[head[14] as usize % Structure::ALL.len()];
+    if let Ok(image) = crate::trace::render::render(&scene, camera, w, h, limits, structure) {
+        assert_eq!(
+            image.ids.len(),
+            w * h,
+            "the f64 tracer's image has every pixel"
+        );
+    }
+    let Ok(fixed_scene) = FixedScene::new(&scene) else {
+        return false;
+    };
+    let _ = fixed::export_source(&fixed_scene, "fuzz");
+    let Ok(options) = fixed::options(limits.max_depth, limits.threshold) else {
+        return false;
+    };
+    let accel = [Accel::None, Accel::Bvh, Accel::Grid][head[14] as usize % 3];
+    let pure = fixed::render(&fixed_scene, camera, w, h, options, accel, false);
+    let hybrid = fixed::render(&fixed_scene, camera, w, h, options, accel, true);
+    match (pure, hybrid) {
+        (Ok(pure), Ok(hybrid)) => {
+            assert_eq!(
+                pure.ids.len(),
+                w * h,
+                "the fixed tracer's image has every pixel"
+            );
+            assert_eq!(
+                pure.ids, hybrid.ids,
+                "hybrid primary ids differ from the pure tracer's"
+            );
+            assert_eq!(
+                pure.colour, hybrid.colour,
+                "hybrid colours differ from the pure tracer's"
+            );
+            assert_eq!(
+                pure.shadow, hybrid.shadow,
+                "hybrid shadow masks differ from the pure tracer's"
+            );
+            true
+        }
+        (Err(_), Err(_)) => false,
+        (pure, hybrid) => panic!(
+            "the pure tracer and the hybrid mode disagree on the camera: {:?} / {:?}",
+            pure.err(),
+            hybrid.err()
+        ),
+    }
+}
+
+/// The header byte for a camera coordinate `v` under `one(data)`'s mapping `(b − 128) / scale`
+/// (rounded, clamped to a byte).
+fn header_byte(v: f64, scale: f64) -> u8 {
+    (128.0 + v * scale).round().clamp(0.0, 255.0) as u8
+}
+
+/// Seed inputs: every corpus scene behind a header that looks at it, then every traced corpus
+/// scene behind a header near its first camera.
 pub fn seeds() -> Vec<Vec<u8>> {
+    let mut seeds = mesh_seeds();
+    for corpus in crate::trace::corpus::all() {
+        let Ok(text) = std::fs::read(corpus.path()) else {
+            continue;
+        };
+        let Some((_, c)) = corpus.cameras.first() else {
+            continue;
+        };
+        let mut d = vec![
+            header_byte(c.eye[0], 8.0),
+            header_byte(c.eye[1], 8.0),
+            header_byte(c.eye[2], 8.0),
+            header_byte(c.target[0], 32.0),
+            header_byte(c.target[1], 32.0),
+            header_byte(c.target[2], 32.0),
+            (c.fovy / 0.75).round() as u8,
+            7,
+            12,
+            11,
+            9,
+            4,
+            TRACED,
+            128,
+            1,
+            1,
+        ];
+        d.extend(text);
+        seeds.push(d);
+    }
+    seeds
+}
+
+/// The mesh seeds: every corpus scene behind a header that looks at it.
+fn mesh_seeds() -> Vec<Vec<u8>> {
     crate::corpus::all()
         .iter()
         .map(|s| {
@@ -171,6 +295,24 @@ mod tests {
         ];
         for h in hostile {
             one(h);
+        }
+    }
+
+    #[test]
+    fn traced_seeds_reach_the_fixed_point_tracer() {
+        let traced_seeds: Vec<_> = seeds()
+            .into_iter()
+            .filter(|s| s.get(12).is_some_and(|b| b & TRACED != 0))
+            .collect();
+        assert_eq!(traced_seeds.len(), crate::trace::corpus::all().len());
+        for seed in traced_seeds {
+            let (head, text) = seed.split_first_chunk::<HEADER>().unwrap();
+            let camera = camera_of(head);
+            assert!(
+                traced(head, &camera, text),
+                "seed {:?} does not reach the fixed-point tracer",
+                &head[..]
+            );
         }
     }
 }

@@ -37,7 +37,8 @@ pub mod progress;
 pub mod reference;
 #[cfg(not(target_os = "none"))]
 pub mod scene;
-#[cfg(all(not(target_os = "none"), feature = "tools"))]
+// Without `tools` too: the fuzz target feeds traced scenes through it.
+#[cfg(not(target_os = "none"))]
 pub mod trace;
 #[cfg(all(not(target_os = "none"), feature = "tools"))]
 pub mod tradeoff;
