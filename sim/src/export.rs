@@ -2,7 +2,7 @@
 //! flash, no parsing on the target) and the capacities `sim analyze` measured for it.
 
 use crate::analyze::Analysis;
-use crate::scene::{CameraSpec, LightSpec, MeshData};
+use crate::scene::{f32_literal, CameraSpec, LightSpec, MeshData};
 use embedded_graphics::pixelcolor::RgbColor;
 use std::fmt::Write;
 
@@ -88,16 +88,6 @@ fn vertex_normals(mesh: &MeshData) -> Vec<[i32; 3]> {
                 .map(|c| (c * 65536.0).round() as i32)
         })
         .collect()
-}
-
-/// The shortest literal that parses back to exactly `v as f32` (the value the host uses).
-pub(crate) fn f32_literal(v: f64) -> String {
-    let s = format!("{:?}", v as f32);
-    if s.contains('.') || s.contains('e') {
-        s
-    } else {
-        format!("{s}.0")
-    }
 }
 
 fn vec3(v: [f64; 3]) -> String {

@@ -23,11 +23,13 @@ pub mod hsr;
 pub mod interpolation;
 #[cfg(not(target_os = "none"))]
 pub use scanline3d_meshgen as meshgen;
-#[cfg(all(not(target_os = "none"), feature = "tools"))]
+// Without `tools` too: the fuzz target feeds their scene files through them.
+#[cfg(not(target_os = "none"))]
 pub mod metaball;
 #[cfg(not(target_os = "none"))]
 pub mod metrics;
-#[cfg(all(not(target_os = "none"), feature = "tools"))]
+// Without `tools` too: the fuzz target feeds their scene files through them.
+#[cfg(not(target_os = "none"))]
 pub mod patch;
 #[cfg(all(not(target_os = "none"), feature = "peers"))]
 pub mod peers;

@@ -1436,3 +1436,14 @@ pub fn read_depth(path: &Path, n: usize) -> Result<Vec<f32>, String> {
         .map(f32::from_le_bytes)
         .collect())
 }
+
+/// The shortest literal that parses back to exactly `v as f32` (the value the host uses), for
+/// the exports' Rust source.
+pub(crate) fn f32_literal(v: f64) -> String {
+    let s = format!("{:?}", v as f32);
+    if s.contains('.') || s.contains('e') {
+        s
+    } else {
+        format!("{s}.0")
+    }
+}

@@ -154,11 +154,11 @@ impl FixedMeta {
             s,
             "/// The light: towards the light, ambient, diffuse (`scanline3d::scene::Light::new`'s arguments).\n\
              pub const LIGHT: ([f32; 3], f32, f32) = ([{}, {}, {}], {}, {});\n",
-            crate::export::f32_literal(f64::from(d[0])),
-            crate::export::f32_literal(f64::from(d[1])),
-            crate::export::f32_literal(f64::from(d[2])),
-            crate::export::f32_literal(f64::from(a)),
-            crate::export::f32_literal(f64::from(di))
+            crate::scene::f32_literal(f64::from(d[0])),
+            crate::scene::f32_literal(f64::from(d[1])),
+            crate::scene::f32_literal(f64::from(d[2])),
+            crate::scene::f32_literal(f64::from(a)),
+            crate::scene::f32_literal(f64::from(di))
         );
         s += "/// The animation, checked when this file is compiled.\n";
         s += "pub static ANIMATION: Animation<'static> = match Animation::new(&BALLS, THRESHOLD) {\n";

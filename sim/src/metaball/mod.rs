@@ -204,6 +204,17 @@ impl MetaScene {
 /// The test corpus: named scenes with their cameras (single ball, two merging, negative
 /// density, grazing, eye inside the surface, and the animated six-ball scene at frame 0).
 pub fn corpus() -> Vec<(&'static str, MetaScene, crate::scene::CameraSpec)> {
+    corpus_texts()
+        .into_iter()
+        .map(|(name, text, camera)| {
+            let scene = MetaScene::parse(text, name).expect("corpus scene");
+            (name, scene, camera)
+        })
+        .collect()
+}
+
+/// [`corpus`] as the scene files' text (what the fuzzer is seeded with).
+pub fn corpus_texts() -> Vec<(&'static str, &'static str, crate::scene::CameraSpec)> {
     let camera = |eye: [f64; 3], target: [f64; 3]| crate::scene::CameraSpec {
         eye,
         target,
@@ -212,47 +223,34 @@ pub fn corpus() -> Vec<(&'static str, MetaScene, crate::scene::CameraSpec)> {
         near: 0.1,
         far: 100.0,
     };
-    let scene = |text: &str, name: &str| MetaScene::parse(text, name).expect("corpus scene");
     vec![
         (
             "single",
-            scene("threshold 0.5\nmetaball 0 0 0 1.5 1 0.9 0.5 0.2\n", "single"),
+            "threshold 0.5\nmetaball 0 0 0 1.5 1 0.9 0.5 0.2\n",
             camera([0.0, 0.0, 4.0], [0.0; 3]),
         ),
         (
             "merging",
-            scene(
-                "threshold 0.4\nmetaball -0.7 0 0 1.2 1 0.9 0.2 0.2\nmetaball 0.7 0.1 0 1.2 1 0.2 0.4 0.9\n",
-                "merging",
-            ),
+            "threshold 0.4\nmetaball -0.7 0 0 1.2 1 0.9 0.2 0.2\nmetaball 0.7 0.1 0 1.2 1 0.2 0.4 0.9\n",
             camera([0.5, 1.0, 4.0], [0.0; 3]),
         ),
         (
             "negative",
-            scene(
-                "threshold 0.3\nmetaball 0 0 0 1.6 1 0.3 0.8 0.3\nmetaball 0.6 0.4 0.8 0.9 -1.5 1 1 1\n",
-                "negative",
-            ),
+            "threshold 0.3\nmetaball 0 0 0 1.6 1 0.3 0.8 0.3\nmetaball 0.6 0.4 0.8 0.9 -1.5 1 1 1\n",
             camera([1.5, 1.5, 3.5], [0.0; 3]),
         ),
         (
             "grazing",
-            scene(
-                "threshold 0.5\nmetaball 0 0 0 1 1\nmetaball 1.05 0 0 1 1 0.2 0.9 0.9\nmetaball 0 0 -3 1 1 0.9 0.9 0.2\n",
-                "grazing",
-            ),
+            "threshold 0.5\nmetaball 0 0 0 1 1\nmetaball 1.05 0 0 1 1 0.2 0.9 0.9\nmetaball 0 0 -3 1 1 0.9 0.9 0.2\n",
             // Nearly along the line of centres: rays skim both surfaces.
             camera([0.6, 0.05, 6.0], [0.55, 0.0, 0.0]),
         ),
         (
             "inside",
-            scene(
-                "threshold 0.3\nlight 0.2 1 0.3 0.3 0.7\nmetaball 0 0 0 3 1 0.6 0.7 0.9\nmetaball 1.2 0.5 -1.5 1.2 -1 1 1 1\n",
-                "inside",
-            ),
+            "threshold 0.3\nlight 0.2 1 0.3 0.3 0.7\nmetaball 0 0 0 3 1 0.6 0.7 0.9\nmetaball 1.2 0.5 -1.5 1.2 -1 1 1 1\n",
             camera([0.0, 0.0, 0.5], [0.5, 0.2, -2.0]),
         ),
-        ("six", scene(SIX_BALLS, "six"), camera([0.0, 1.5, 5.0], [0.0; 3])),
+        ("six", SIX_BALLS, camera([0.0, 1.5, 5.0], [0.0; 3])),
     ]
 }
 
