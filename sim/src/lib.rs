@@ -23,12 +23,12 @@ pub mod hsr;
 pub mod interpolation;
 #[cfg(not(target_os = "none"))]
 pub use scanline3d_meshgen as meshgen;
-// Without `tools` too: the fuzz target feeds their scene files through them.
+// Without `tools` too: the fuzz target feeds metaball scenes through it.
 #[cfg(not(target_os = "none"))]
 pub mod metaball;
 #[cfg(not(target_os = "none"))]
 pub mod metrics;
-// Without `tools` too: the fuzz target feeds their scene files through them.
+// Without `tools` too: the fuzz target feeds patch models through it.
 #[cfg(not(target_os = "none"))]
 pub mod patch;
 #[cfg(all(not(target_os = "none"), feature = "peers"))]
