@@ -355,6 +355,8 @@ pub fn seeds() -> Vec<Vec<u8>> {
             seeds.push(seed(c, TRACED, &text));
         }
     }
+    // Not the patch firmware's z-up camera (`patch::trade::camera`): a header's up vector is
+    // near +y. From here each model is in view (the seeds' test checks they are drawn).
     let patch_camera = CameraSpec {
         eye: [0.0, 4.0, 9.0],
         target: [0.0, 1.0, 0.0],
